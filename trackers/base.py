@@ -1,0 +1,151 @@
+"""The tracker protocol shared by every tracker, and input validation.
+
+A tracker is constructed with keyword parameters (``trackers.make(name, **params)``),
+initialised on the first frame with one box per target, then stepped frame by frame::
+
+    tracker = trackers.make("dps", n_particles=300, rng=0)
+    tracker.init(frames[0], boxes0)          # boxes0: (K, 4) [x, y, w, h]
+    for frame in frames[1:]:
+        estimate = tracker.step(frame)       # estimate.boxes: (K, 4)
+
+Trackers keep their randomness in ``self.rng`` (a ``numpy.random.Generator`` made once
+from the ``rng`` argument) and never touch global random state.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from dataclasses import dataclass, field
+from typing import Any, ClassVar
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ["Estimate", "Tracker", "as_generator", "check_boxes", "check_frame"]
+
+RngLike = np.random.Generator | int | None
+
+
+def as_generator(rng: RngLike) -> np.random.Generator:
+    """Turn an ``rng`` argument into a Generator (a Generator is used as is)."""
+    if isinstance(rng, np.random.Generator):
+        return rng
+    if rng is None or isinstance(rng, (int, np.integer)):
+        return np.random.default_rng(rng)
+    raise ValueError(f"rng must be a numpy Generator, an int or None, not {rng!r}")
+
+
+@dataclass
+class Estimate:
+    """What ``Tracker.step`` returns for one frame.
+
+    Attributes
+    ----------
+    boxes : ndarray of shape (K, 4)
+        Estimated box [x, y, w, h] per target, in the order of ``init``.
+    extras : dict
+        Per-frame diagnostics of the tracker (e.g. ``order_prob`` of shape (L,) for the
+        SHM trackers, ``confidence`` of shape (K,) for mean shift).
+    """
+
+    boxes: NDArray[np.float64]
+    extras: dict[str, Any] = field(default_factory=dict)
+
+
+def check_frame(frame: Any, expected_shape: tuple[int, ...] | None = None) -> NDArray[np.uint8]:
+    """Validate one RGB frame and return it as a C-contiguous uint8 array (H, W, 3).
+
+    Raises
+    ------
+    ValueError
+        If the frame is not (H, W, 3), or its shape differs from ``expected_shape``.
+    """
+    arr = np.asarray(frame)
+    if arr.ndim != 3 or arr.shape[2] != 3 or arr.shape[0] < 1 or arr.shape[1] < 1:
+        raise ValueError(f"frame must have shape (H, W, 3), got {arr.shape}")
+    if expected_shape is not None and arr.shape != tuple(expected_shape):
+        raise ValueError(
+            f"frame shape changed mid-sequence: got {arr.shape}, expected {tuple(expected_shape)}"
+        )
+    if arr.dtype != np.uint8:
+        if np.issubdtype(arr.dtype, np.floating) and arr.size and arr.max() <= 1.0:
+            arr = arr * 255.0
+        arr = np.clip(arr, 0, 255).astype(np.uint8)
+    return np.ascontiguousarray(arr)
+
+
+def check_boxes(boxes: Any, frame_shape: tuple[int, ...]) -> NDArray[np.float64]:
+    """Validate initial boxes (K, 4) against a frame of shape (H, W, ...).
+
+    A box must have positive width and height and overlap the frame.
+
+    Raises
+    ------
+    ValueError
+        Naming the first offending box and what is wrong with it.
+    """
+    arr = np.asarray(boxes, dtype=np.float64)
+    if arr.ndim == 1 and arr.shape[0] == 4:
+        arr = arr[None, :]
+    if arr.ndim != 2 or arr.shape[1] != 4 or arr.shape[0] < 1:
+        raise ValueError(f"boxes must have shape (K, 4) with K >= 1, got {np.shape(boxes)}")
+    h, w = frame_shape[0], frame_shape[1]
+    for k, (x, y, bw, bh) in enumerate(arr):
+        if not np.all(np.isfinite([x, y, bw, bh])):
+            raise ValueError(f"box {k} is not finite: {arr[k].tolist()}")
+        if bw <= 0 or bh <= 0:
+            raise ValueError(f"box {k} has zero or negative size: {arr[k].tolist()}")
+        if x >= w or y >= h or x + bw <= 0 or y + bh <= 0:
+            raise ValueError(
+                f"box {k} {arr[k].tolist()} lies outside the {w}x{h} frame"
+            )
+    return arr.copy()
+
+
+class Tracker(ABC):
+    """Base class of every tracker: ``init`` on the first frame, then ``step``.
+
+    Subclasses set ``name`` and implement ``_init`` and ``_step``; this class validates
+    frames and boxes so that every tracker rejects bad input the same way.
+    """
+
+    name: ClassVar[str] = ""
+
+    def __init__(self, *, rng: RngLike = None) -> None:
+        self.rng = as_generator(rng)
+        self._frame_shape: tuple[int, ...] | None = None
+        self.n_targets = 0
+
+    def init(self, frame: Any, boxes: Any) -> None:
+        """Initialise on ``frame`` (H, W, 3) with one box per target, ``boxes`` (K, 4)."""
+        frame = check_frame(frame)
+        boxes = check_boxes(boxes, frame.shape)
+        self._frame_shape = frame.shape
+        self.n_targets = boxes.shape[0]
+        self._init(frame, boxes)
+
+    def step(self, frame: Any) -> Estimate:
+        """Advance one frame (H, W, 3) and return the estimate."""
+        if self._frame_shape is None:
+            raise ValueError(f"tracker {self.name!r}: call init() before step()")
+        frame = check_frame(frame, self._frame_shape)
+        est = self._step(frame)
+        est.boxes = clip_boxes(est.boxes, self._frame_shape)
+        return est
+
+    @abstractmethod
+    def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None: ...
+
+    @abstractmethod
+    def _step(self, frame: NDArray[np.uint8]) -> Estimate: ...
+
+
+def clip_boxes(boxes: NDArray[np.float64], frame_shape: tuple[int, ...]) -> NDArray[np.float64]:
+    """Keep every box's centre inside the frame (sizes unchanged), shape (K, 4)."""
+    b = np.array(boxes, dtype=np.float64, copy=True)
+    h, w = frame_shape[0], frame_shape[1]
+    cx = np.clip(b[:, 0] + b[:, 2] / 2, 0.0, w)
+    cy = np.clip(b[:, 1] + b[:, 3] / 2, 0.0, h)
+    b[:, 0] = cx - b[:, 2] / 2
+    b[:, 1] = cy - b[:, 3] / 2
+    return b
