@@ -1,0 +1,17 @@
+"""Errors a user can cause. Each carries one line that names the field or value at fault.
+
+The CLI maps :class:`ConfigError` (bad usage, bad config, bad parameter) to exit code 2 and
+:class:`DataError` (an invalid or mismatched data file, a failed check) to exit code 1.
+"""
+
+from __future__ import annotations
+
+__all__ = ["ConfigError", "DataError"]
+
+
+class ConfigError(ValueError):
+    """A configuration or usage error; the message names the field and the bad value."""
+
+
+class DataError(ValueError):
+    """An invalid, damaged or mismatched data file; the message names the file and problem."""
