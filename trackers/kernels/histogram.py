@@ -1,0 +1,501 @@
+"""Batched kernel-weighted colour histograms on a bin-index image (numba).
+
+Every particle tracker spends its time building the colour histograms of candidate
+regions (ALGORITHMS.md §2.2). The frame is quantised once into a bin-index image
+(``quantize_rgb`` or ``quantize_hsv``); then one compiled call builds the histograms of
+all candidate boxes of all objects (``region_histograms``), or directly their
+Bhattacharyya distances to reference histograms (``region_distances``, which never
+materialises the (P, B) histogram array).
+
+Conventions shared by every function here (CONTRACT.md "Coordinates"):
+
+- A box is [x, y, w, h]. Pixel (row r, column c) belongs to a box if its centre
+  (c + 0.5, r + 0.5) lies in [x, x + w) × [y, y + h). Pixels outside the frame are
+  skipped, so a region cut by the border is the histogram of its visible part.
+- Kernel profiles, at the normalised elliptical radius
+  r = sqrt(((px - cx) / (w / 2))² + ((py - cy) / (h / 2))²) of a pixel centre:
+  ``KERNEL_UNIFORM`` weight 1 on the whole box; ``KERNEL_EPANECHNIKOV`` 1 − r²;
+  ``KERNEL_CONE`` 1 − r (the linear kernel of KAMS §2); both elliptic kernels are 0 outside
+  the ellipse inscribed in the box.
+- ``n_parts`` splits the box into that many horizontal bands of equal height (the
+  "spatial components" of Pérez et al. 2002, DPS §3.2); the kernel is still the one of the
+  whole box. Each band's histogram is normalised to sum 1, the bands are concatenated and
+  divided by ``n_parts``, so the whole vector sums to 1.
+- A band with no pixel of positive weight (box outside the frame, or smaller than a pixel)
+  gets the uniform histogram 1 / n_bins: it carries no colour information, so it is
+  neither attracted to nor repelled from any reference.
+"""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+from numba import njit
+from numpy.typing import NDArray
+
+__all__ = [
+    "KERNEL_CONE",
+    "KERNEL_EPANECHNIKOV",
+    "KERNEL_UNIFORM",
+    "KERNELS",
+    "bhattacharyya_coefficient",
+    "bhattacharyya_distance",
+    "hsv_n_bins",
+    "quantize_hsv",
+    "quantize_rgb",
+    "region_distances",
+    "region_histograms",
+]
+
+KERNEL_UNIFORM = 0
+KERNEL_EPANECHNIKOV = 1
+KERNEL_CONE = 2
+
+#: Kernel profile names, as accepted by the observation models, mapped to their codes.
+KERNELS: dict[str, int] = {
+    "uniform": KERNEL_UNIFORM,
+    "epanechnikov": KERNEL_EPANECHNIKOV,
+    "cone": KERNEL_CONE,
+}
+
+
+def _check_frame(frame: NDArray[np.uint8]) -> NDArray[np.uint8]:
+    arr = np.asarray(frame)
+    if arr.ndim != 3 or arr.shape[2] != 3 or arr.dtype != np.uint8:
+        raise ValueError(f"frame must be uint8 of shape (H, W, 3), got {arr.dtype} {arr.shape}")
+    return np.ascontiguousarray(arr)
+
+
+def _check_bins(name: str, value: int) -> int:
+    if int(value) != value or not 1 <= value <= 256:
+        raise ValueError(f"{name} must be an integer in [1, 256], got {value!r}")
+    return int(value)
+
+
+@njit(cache=True)
+def _quantize_rgb(frame, bins):
+    rows, cols = frame.shape[0], frame.shape[1]
+    out = np.empty((rows, cols), dtype=np.int32)
+    for r in range(rows):
+        for c in range(cols):
+            rb = np.int32(frame[r, c, 0]) * bins // 256
+            gb = np.int32(frame[r, c, 1]) * bins // 256
+            bb = np.int32(frame[r, c, 2]) * bins // 256
+            out[r, c] = (rb * bins + gb) * bins + bb
+    return out
+
+
+def quantize_rgb(frame: NDArray[np.uint8], bins: int = 10) -> NDArray[np.int32]:
+    """Bin index of every pixel of an RGB frame in a ``bins``³ RGB histogram.
+
+    Parameters
+    ----------
+    frame : ndarray of shape (H, W, 3), uint8
+        RGB frame.
+    bins : int, optional
+        Bins per channel (KAMS uses 10, giving 1000 bins).
+
+    Returns
+    -------
+    ndarray of shape (H, W), int32
+        ``r_bin * bins² + g_bin * bins + b_bin`` with ``c_bin = c * bins // 256``; values in
+        [0, bins³).
+
+    Example
+    -------
+    >>> quantize_rgb(np.array([[[255, 0, 128]]], dtype=np.uint8)).tolist()
+    [[905]]
+    """
+    return _quantize_rgb(_check_frame(frame), np.int32(_check_bins("bins", bins)))
+
+
+@njit(cache=True)
+def _quantize_hsv(hsv, h_bins, s_bins, v_bins, s_thr, v_thr):
+    rows, cols = hsv.shape[0], hsv.shape[1]
+    out = np.empty((rows, cols), dtype=np.int32)
+    v_offset = h_bins * s_bins
+    for r in range(rows):
+        for c in range(cols):
+            h = np.int32(hsv[r, c, 0])
+            s = np.int32(hsv[r, c, 1])
+            v = np.int32(hsv[r, c, 2])
+            if s >= s_thr and v >= v_thr:
+                # OpenCV's 8-bit hue lies in [0, 180).
+                hb = h * h_bins // 180
+                if hb >= h_bins:
+                    hb = h_bins - 1
+                out[r, c] = hb * s_bins + s * s_bins // 256
+            else:
+                out[r, c] = v_offset + v * v_bins // 256
+    return out
+
+
+def hsv_n_bins(h_bins: int = 10, s_bins: int = 10, v_bins: int = 10) -> int:
+    """Number of bins of the HSV quantisation: ``h_bins * s_bins + v_bins``."""
+    return h_bins * s_bins + v_bins
+
+
+def quantize_hsv(
+    frame: NDArray[np.uint8],
+    h_bins: int = 10,
+    s_bins: int = 10,
+    v_bins: int = 10,
+    s_min: float = 0.1,
+    v_min: float = 0.2,
+) -> NDArray[np.int32]:
+    """Bin index of every pixel in the HSV histogram of Pérez et al. 2002.
+
+    Pixels with saturation ≥ ``s_min`` and value ≥ ``v_min`` (both in [0, 1]) fall in an
+    ``h_bins`` × ``s_bins`` hue–saturation histogram; the others (greyish or dark, where
+    hue is unreliable) fall in a value-only histogram of ``v_bins`` bins placed after it.
+
+    Parameters
+    ----------
+    frame : ndarray of shape (H, W, 3), uint8
+        RGB frame.
+    h_bins, s_bins, v_bins : int, optional
+        Bins of hue, saturation and value.
+    s_min, v_min : float, optional
+        Saturation and value thresholds, as fractions of the full range.
+
+    Returns
+    -------
+    ndarray of shape (H, W), int32
+        ``h_bin * s_bins + s_bin`` for coloured pixels, ``h_bins * s_bins + v_bin`` for the
+        others; values in [0, ``hsv_n_bins(h_bins, s_bins, v_bins)``).
+
+    Example
+    -------
+    >>> quantize_hsv(np.array([[[255, 0, 0], [128, 128, 128]]], dtype=np.uint8)).tolist()
+    [[9, 105]]
+    """
+    h_bins = _check_bins("h_bins", h_bins)
+    s_bins = _check_bins("s_bins", s_bins)
+    v_bins = _check_bins("v_bins", v_bins)
+    for name, val in (("s_min", s_min), ("v_min", v_min)):
+        if not 0.0 <= val <= 1.0:
+            raise ValueError(f"{name} must lie in [0, 1], got {val!r}")
+    hsv = cv2.cvtColor(_check_frame(frame), cv2.COLOR_RGB2HSV)
+    # Thresholds on the 8-bit scale: x/255 >= t  <=>  x >= ceil(255 t).
+    s_thr = int(np.ceil(255.0 * s_min - 1e-9))
+    v_thr = int(np.ceil(255.0 * v_min - 1e-9))
+    return _quantize_hsv(hsv, np.int32(h_bins), np.int32(s_bins), np.int32(v_bins),
+                         np.int32(s_thr), np.int32(v_thr))
+
+
+@njit(cache=True)
+def _first_inside(lo):
+    """First pixel index whose centre i + 0.5 is >= lo."""
+    return int(np.ceil(lo - 0.5))
+
+
+@njit(cache=True)
+def _pixel_range(lo, size, n):
+    """Pixel indices [i0, i1) whose centres lie in [lo, lo + size), clipped to [0, n)."""
+    i0 = _first_inside(lo)
+    i1 = _first_inside(lo + size)
+    if i0 < 0:
+        i0 = 0
+    if i1 > n:
+        i1 = n
+    return i0, i1
+
+
+@njit(cache=True)
+def _accumulate(bin_img, x, y, w, h, n_bins, kernel, n_parts, hist, totals):
+    """Add the kernel-weighted pixels of box [x, y, w, h] into ``hist`` (n_parts * n_bins).
+
+    ``totals`` (n_parts) receives each band's total weight.
+    """
+    rows, cols = bin_img.shape
+    r0, r1 = _pixel_range(y, h, rows)
+    c0, c1 = _pixel_range(x, w, cols)
+    for j in range(n_parts):
+        totals[j] = 0.0
+    if r0 >= r1 or c0 >= c1:
+        return
+    cx = x + 0.5 * w
+    cy = y + 0.5 * h
+    inv_hw = 2.0 / w
+    inv_hh = 2.0 / h
+    band = h / n_parts
+    for r in range(r0, r1):
+        py = r + 0.5
+        part = int((py - y) / band)
+        if part >= n_parts:
+            part = n_parts - 1
+        offset = part * n_bins
+        dy = (py - cy) * inv_hh
+        dy2 = dy * dy
+        ca = c0
+        cb = c1
+        if kernel != KERNEL_UNIFORM:
+            if dy2 >= 1.0:
+                continue
+            # Columns of the ellipse's chord on this row, widened by one pixel so that
+            # rounding never drops a pixel; the exact test r² < 1 is done per pixel.
+            half = 0.5 * w * np.sqrt(1.0 - dy2)
+            ca = max(c0, _first_inside(cx - half) - 1)
+            cb = min(c1, _first_inside(cx + half) + 1)
+        row = bin_img[r]
+        acc = 0.0
+        for c in range(ca, cb):
+            if kernel == KERNEL_UNIFORM:
+                k = 1.0
+            else:
+                dx = (c + 0.5 - cx) * inv_hw
+                r2 = dx * dx + dy2
+                if kernel == KERNEL_EPANECHNIKOV:
+                    k = 1.0 - r2
+                else:
+                    k = 1.0 - np.sqrt(r2)
+                # Also drops a cone weight that rounds to 0 just inside the ellipse.
+                if r2 >= 1.0 or k <= 0.0:
+                    continue
+            hist[offset + row[c]] += k
+            acc += k
+        totals[part] += acc
+
+
+@njit(cache=True)
+def _region_histograms(bin_img, boxes, n_bins, kernel, n_parts):
+    n_boxes = boxes.shape[0]
+    out = np.zeros((n_boxes, n_parts * n_bins))
+    totals = np.empty(n_parts)
+    for p in range(n_boxes):
+        hist = out[p]
+        _accumulate(bin_img, boxes[p, 0], boxes[p, 1], boxes[p, 2], boxes[p, 3], n_bins,
+                    kernel, n_parts, hist, totals)
+        for j in range(n_parts):
+            lo = j * n_bins
+            if totals[j] > 0.0:
+                scale = 1.0 / (totals[j] * n_parts)
+                for b in range(lo, lo + n_bins):
+                    hist[b] *= scale
+            else:
+                fill = 1.0 / (n_bins * n_parts)
+                for b in range(lo, lo + n_bins):
+                    hist[b] = fill
+    return out
+
+
+@njit(cache=True, fastmath=True)
+def _sweep(hist, sqrt_q, lo, hi, scale):
+    """Σ sqrt(hist_b · scale) sqrt(q_b) over bins [lo, hi), clearing ``hist`` there.
+
+    A dense sweep (vectorised) costs less than tracking the touched bins: that
+    bookkeeping puts a load-compare-increment chain on every pixel.
+    """
+    acc = 0.0
+    for b in range(lo, hi):
+        acc += np.sqrt(hist[b] * scale) * sqrt_q[b]
+        hist[b] = 0.0
+    return acc
+
+
+@njit(cache=True)
+def _region_distances(bin_img, boxes, sqrt_refs, ref_index, n_bins, kernel, n_parts):
+    n_boxes = boxes.shape[0]
+    out = np.empty(n_boxes)
+    hist = np.zeros(n_parts * n_bins)
+    totals = np.empty(n_parts)
+    for p in range(n_boxes):
+        sqrt_q = sqrt_refs[ref_index[p]]
+        _accumulate(bin_img, boxes[p, 0], boxes[p, 1], boxes[p, 2], boxes[p, 3], n_bins,
+                    kernel, n_parts, hist, totals)
+        rho = 0.0
+        for j in range(n_parts):
+            lo = j * n_bins
+            if totals[j] > 0.0:
+                rho += _sweep(hist, sqrt_q, lo, lo + n_bins, 1.0 / (totals[j] * n_parts))
+            else:
+                # Uniform band (module docstring); hist is still zero there.
+                hist[lo:lo + n_bins] = 1.0
+                rho += _sweep(hist, sqrt_q, lo, lo + n_bins, 1.0 / (n_bins * n_parts))
+        one_minus = 1.0 - rho
+        out[p] = np.sqrt(one_minus) if one_minus > 0.0 else 0.0
+    return out
+
+
+def _check_region_args(bin_img, boxes, n_bins, kernel, n_parts):
+    img = np.ascontiguousarray(bin_img)
+    if img.ndim != 2 or not np.issubdtype(img.dtype, np.integer):
+        raise ValueError(f"bin_img must be an integer array of shape (H, W), got "
+                         f"{img.dtype} {img.shape}")
+    if int(n_bins) != n_bins or n_bins < 1:
+        raise ValueError(f"n_bins must be a positive integer, got {n_bins!r}")
+    if img.size and (img.min() < 0 or img.max() >= n_bins):
+        raise ValueError(f"bin_img values must lie in [0, {n_bins}), got "
+                         f"[{img.min()}, {img.max()}]")
+    if kernel not in KERNELS.values():
+        raise ValueError(f"kernel must be one of {sorted(KERNELS.values())} "
+                         f"({', '.join(KERNELS)}), got {kernel!r}")
+    if int(n_parts) != n_parts or n_parts < 1:
+        raise ValueError(f"n_parts must be a positive integer, got {n_parts!r}")
+    bx = np.ascontiguousarray(boxes, dtype=np.float64)
+    if bx.ndim != 2 or bx.shape[1] != 4:
+        raise ValueError(f"boxes must have shape (P, 4), got {bx.shape}")
+    if bx.size and not (np.all(np.isfinite(bx)) and np.all(bx[:, 2:] > 0)):
+        raise ValueError("boxes must be finite with positive width and height")
+    return img.astype(np.int32, copy=False), bx, int(n_bins), int(kernel), int(n_parts)
+
+
+def region_histograms(
+    bin_img: NDArray[np.integer],
+    boxes: NDArray[np.floating],
+    n_bins: int,
+    kernel: int,
+    n_parts: int = 1,
+) -> NDArray[np.float64]:
+    """Kernel-weighted histograms of many boxes of one bin-index image, in one call.
+
+    Parameters
+    ----------
+    bin_img : ndarray of shape (H, W), integer
+        Bin index of every pixel, in [0, ``n_bins``) (``quantize_rgb``, ``quantize_hsv``).
+    boxes : ndarray of shape (P, 4)
+        Boxes [x, y, w, h] in pixels, finite, w > 0 and h > 0; they may leave the frame.
+    n_bins : int
+        Number of colour bins B.
+    kernel : int
+        ``KERNEL_UNIFORM``, ``KERNEL_EPANECHNIKOV`` or ``KERNEL_CONE``.
+    n_parts : int, optional
+        Horizontal bands (spatial components), concatenated top to bottom.
+
+    Returns
+    -------
+    ndarray of shape (P, n_parts * n_bins)
+        One histogram per box; each row sums to 1 (see the module docstring for bands and
+        empty regions).
+
+    Raises
+    ------
+    ValueError
+        For bad shapes, bin indices outside [0, n_bins), an unknown kernel, or boxes that
+        are not finite or have a non-positive size.
+
+    Example
+    -------
+    >>> img = np.array([[0, 1], [1, 1]], dtype=np.int32)
+    >>> region_histograms(img, np.array([[0.0, 0.0, 2.0, 2.0]]), 2, KERNEL_UNIFORM).tolist()
+    [[0.25, 0.75]]
+    """
+    img, bx, n_bins, kernel, n_parts = _check_region_args(bin_img, boxes, n_bins, kernel,
+                                                          n_parts)
+    return _region_histograms(img, bx, n_bins, kernel, n_parts)
+
+
+def region_distances(
+    bin_img: NDArray[np.integer],
+    boxes: NDArray[np.floating],
+    refs: NDArray[np.floating],
+    ref_index: NDArray[np.integer],
+    kernel: int,
+    n_parts: int = 1,
+) -> NDArray[np.float64]:
+    """Bhattacharyya distance of every box's histogram to its reference, in one call.
+
+    Equal to ``bhattacharyya_distance(region_histograms(...), refs[ref_index])`` (to
+    rounding) but without building the (P, B) histogram array: one scratch histogram is
+    reused, which is what makes a frame of thousands of candidates cheap.
+
+    Parameters
+    ----------
+    bin_img : ndarray of shape (H, W), integer
+        Bin index of every pixel, in [0, n_bins) with n_bins = ``refs.shape[1] // n_parts``.
+    boxes : ndarray of shape (P, 4)
+        Candidate boxes [x, y, w, h] (as in ``region_histograms``).
+    refs : ndarray of shape (R, n_parts * n_bins)
+        Reference histograms (each summing to 1), one per object.
+    ref_index : ndarray of shape (P,), integer
+        Row of ``refs`` that box p is compared with.
+    kernel : int
+        Kernel code, as in ``region_histograms``.
+    n_parts : int, optional
+        Horizontal bands, as in ``region_histograms``.
+
+    Returns
+    -------
+    ndarray of shape (P,)
+        d = sqrt(max(0, 1 − Σ sqrt(p q))), in [0, 1].
+
+    Raises
+    ------
+    ValueError
+        For inconsistent shapes or indices, as well as the cases of ``region_histograms``.
+
+    Example
+    -------
+    >>> img = np.array([[0, 1], [1, 1]], dtype=np.int32)
+    >>> d = region_distances(img, np.array([[0.0, 0.0, 2.0, 2.0]]),
+    ...                      np.array([[0.25, 0.75]]), np.array([0]), KERNEL_UNIFORM)
+    >>> np.round(d, 12).tolist()
+    [0.0]
+    """
+    q = np.ascontiguousarray(refs, dtype=np.float64)
+    if q.ndim != 2 or q.shape[0] < 1 or q.shape[1] < 1:
+        raise ValueError(f"refs must have shape (R, n_parts * n_bins), got {q.shape}")
+    if int(n_parts) != n_parts or n_parts < 1 or q.shape[1] % n_parts:
+        raise ValueError(f"n_parts must be a positive divisor of refs.shape[1] = "
+                         f"{q.shape[1]}, got {n_parts!r}")
+    img, bx, n_bins, kernel, n_parts = _check_region_args(bin_img, boxes,
+                                                          q.shape[1] // int(n_parts),
+                                                          kernel, n_parts)
+    idx = np.ascontiguousarray(ref_index, dtype=np.int64)
+    if idx.shape != (bx.shape[0],):
+        raise ValueError(f"ref_index must have shape ({bx.shape[0]},), got {idx.shape}")
+    if idx.size and (idx.min() < 0 or idx.max() >= q.shape[0]):
+        raise ValueError(f"ref_index must lie in [0, {q.shape[0]}), got "
+                         f"[{idx.min()}, {idx.max()}]")
+    return _region_distances(img, bx, np.sqrt(q), idx, n_bins, kernel, n_parts)
+
+
+def bhattacharyya_coefficient(
+    hists: NDArray[np.floating], refs: NDArray[np.floating]
+) -> NDArray[np.float64]:
+    """ρ = Σ_u sqrt(p_u q_u) per row (ALGORITHMS.md §2.1).
+
+    Parameters
+    ----------
+    hists : ndarray of shape (P, B)
+        Normalised histograms.
+    refs : ndarray of shape (B,) or (P, B)
+        One reference for all rows, or one per row.
+
+    Returns
+    -------
+    ndarray of shape (P,)
+    """
+    p = np.asarray(hists, dtype=np.float64)
+    q = np.asarray(refs, dtype=np.float64)
+    if p.ndim != 2 or q.shape not in ((p.shape[1],), p.shape):
+        raise ValueError(f"refs must have shape ({p.shape[-1]},) or {p.shape} for hists of "
+                         f"shape (P, B); got hists {p.shape}, refs {q.shape}")
+    return np.sqrt(p * q).sum(axis=1)
+
+
+def bhattacharyya_distance(
+    hists: NDArray[np.floating], refs: NDArray[np.floating]
+) -> NDArray[np.float64]:
+    """d = sqrt(max(0, 1 − ρ)) per row; what ``cv2.HISTCMP_BHATTACHARYYA`` gives for
+    normalised histograms.
+
+    Parameters
+    ----------
+    hists : ndarray of shape (P, B)
+        Normalised histograms.
+    refs : ndarray of shape (B,) or (P, B)
+        One reference for all rows, or one per row.
+
+    Returns
+    -------
+    ndarray of shape (P,)
+        Distances in [0, 1].
+
+    Example
+    -------
+    >>> bhattacharyya_distance(np.array([[0.5, 0.5], [1.0, 0.0]]), np.array([0.5, 0.5]))
+    array([0.        , 0.54119610])
+    """
+    rho = bhattacharyya_coefficient(hists, refs)
+    return np.sqrt(np.maximum(0.0, 1.0 - rho))
