@@ -96,9 +96,7 @@ def check_boxes(boxes: Any, frame_shape: tuple[int, ...]) -> NDArray[np.float64]
         if bw <= 0 or bh <= 0:
             raise ValueError(f"box {k} has zero or negative size: {arr[k].tolist()}")
         if x >= w or y >= h or x + bw <= 0 or y + bh <= 0:
-            raise ValueError(
-                f"box {k} {arr[k].tolist()} lies outside the {w}x{h} frame"
-            )
+            raise ValueError(f"box {k} {arr[k].tolist()} lies outside the {w}x{h} frame")
     return arr.copy()
 
 

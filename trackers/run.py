@@ -61,7 +61,9 @@ def track(
     keys = per_frame[1].keys() if n > 1 else ()
     for key in keys:
         first = np.asarray(per_frame[1][key])
-        stacked = np.empty((n, *first.shape), dtype=first.dtype if first.dtype.kind != "f" else np.float64)
+        stacked = np.empty(
+            (n, *first.shape), dtype=first.dtype if first.dtype.kind != "f" else np.float64
+        )
         if first.dtype.kind == "f":
             stacked[0] = np.nan
         else:

@@ -1,0 +1,71 @@
+"""The ``scenegen`` command line. Each verb group lives in its own module with a
+``register(subparsers)`` function; handlers return an exit code.
+
+Exit codes: 0 success; 1 invalid data or a failed check; 2 bad usage or a bad config.
+Errors print one line on stderr; ``--debug`` shows the traceback instead.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Sequence
+
+from scenegen.errors import ConfigError, DataError
+
+__all__ = ["main"]
+
+
+def _parser() -> argparse.ArgumentParser:
+    from scenegen import __version__
+    from scenegen.cli import bench, data, demo, track
+
+    parser = argparse.ArgumentParser(
+        prog="scenegen",
+        description="Synthetic video scenarios with exact ground truth, and trackers to test.",
+    )
+    parser.add_argument("--version", action="version", version=f"scenegen {__version__}")
+    parser.add_argument("--debug", action="store_true", help="show tracebacks on errors")
+    sub = parser.add_subparsers(dest="verb", metavar="VERB")
+    sub.required = True
+    for module in (data, track, bench, demo):
+        module.register(sub)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the CLI; returns the exit code (also used as the console script)."""
+    args_list = list(sys.argv[1:] if argv is None else argv)
+    debug = "--debug" in args_list
+    parser = _parser()
+    try:
+        args = parser.parse_args(args_list)
+        return int(args.func(args) or 0)
+    except SystemExit as exc:  # argparse: usage errors exit 2, --help exits 0
+        return int(exc.code or 0) if isinstance(exc.code, int) else 2
+    except KeyboardInterrupt:
+        print("scenegen: interrupted", file=sys.stderr)
+        return 130
+    except ConfigError as err:
+        if debug:
+            raise
+        print(f"scenegen: error: {err}", file=sys.stderr)
+        return 2
+    except DataError as err:
+        if debug:
+            raise
+        print(f"scenegen: error: {err}", file=sys.stderr)
+        return 1
+    except Exception as err:
+        if debug:
+            raise
+        first = str(err).strip().splitlines()[0] if str(err).strip() else ""
+        print(
+            f"scenegen: internal error: {type(err).__name__}: {first} (rerun with --debug)",
+            file=sys.stderr,
+        )
+        return 1
+
+
+def entry() -> None:  # pragma: no cover - console script wrapper
+    sys.exit(main())

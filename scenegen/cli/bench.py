@@ -1,0 +1,31 @@
+"""The ``bench`` verb: speed figures as medians and ratios against same-run baselines."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+__all__ = ["register"]
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("bench", help="measure speed (medians, ratios against baselines)")
+    p.add_argument("--json", action="store_true", help="print one JSON document")
+    p.add_argument("--repeats", type=int, default=7, help="timed repeats per row (default 7)")
+    p.add_argument("--only", default=None, help="only modules whose name contains this")
+    p.set_defaults(func=cmd_bench)
+
+
+def cmd_bench(args: argparse.Namespace) -> int:
+    from scenegen.bench import format_table, run_all
+    from scenegen.errors import ConfigError
+
+    if args.repeats < 1:
+        raise ConfigError(f"--repeats must be >= 1, got {args.repeats}")
+    rows = run_all(args.repeats, only=args.only, log=lambda m: print(m, file=sys.stderr))
+    if args.json:
+        print(json.dumps({"repeats": args.repeats, "rows": [r.to_dict() for r in rows]}, indent=2))
+    else:
+        print(format_table(rows))
+    return 0

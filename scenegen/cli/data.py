@@ -1,0 +1,213 @@
+"""Verbs on sequences and files: presets, generate, inspect, validate, preview, export."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+from scenegen import presets
+from scenegen.cli.progress import bar
+from scenegen.errors import ConfigError, DataError
+
+__all__ = ["register"]
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("presets", help="list the presets")
+    p.add_argument("--json", action="store_true", help="print one JSON document")
+    p.set_defaults(func=cmd_presets)
+
+    p = sub.add_parser("generate", help="generate a sequence into an HDF5 file")
+    src = p.add_mutually_exclusive_group(required=True)
+    src.add_argument("--preset", help="preset name (see `scenegen presets`)")
+    src.add_argument("--config", type=Path, help="scenario config, .yaml or .json")
+    p.add_argument("--seed", type=int, default=None, help="random seed (default: fresh)")
+    p.add_argument("-o", "--output", type=Path, required=True, help="output .h5 file")
+    p.add_argument("--frames", type=int, default=None, help="override the frame count")
+    p.add_argument("--compression", default="gzip", help="gzip | lzf | none (default gzip)")
+    p.set_defaults(func=cmd_generate)
+
+    p = sub.add_parser("inspect", help="summarise a scenegen file")
+    p.add_argument("file", type=Path)
+    p.add_argument("--json", action="store_true", help="print one JSON document")
+    p.set_defaults(func=cmd_inspect)
+
+    p = sub.add_parser("validate", help="check a scenegen file; exit 1 on any problem")
+    p.add_argument("file", type=Path)
+    p.set_defaults(func=cmd_validate)
+
+    p = sub.add_parser("preview", help="PNG contact sheet, GIF or MP4 with ground truth drawn")
+    p.add_argument("file", type=Path)
+    p.add_argument("-o", "--output", type=Path, required=True, help=".png, .gif or .mp4")
+    p.add_argument("--result", type=Path, default=None, help="tracker result file to overlay")
+    p.add_argument("--sequence", default=None, help="sequence name if the file holds several")
+    p.set_defaults(func=cmd_preview)
+
+    p = sub.add_parser("export", help="export a sequence (MOTChallenge layout)")
+    p.add_argument("file", type=Path)
+    p.add_argument("--format", required=True, choices=["mot"], help="output format")
+    p.add_argument("-o", "--output", type=Path, required=True, help="output folder")
+    p.add_argument("--sequence", default=None, help="sequence name if the file holds several")
+    p.set_defaults(func=cmd_export)
+
+
+def cmd_presets(args: argparse.Namespace) -> int:
+    rows = []
+    for name in presets.names():
+        cfg = presets.get(name)
+        rows.append(
+            {
+                "name": name,
+                "width": cfg.width,
+                "height": cfg.height,
+                "n_frames": cfg.n_frames,
+                "entities": len(cfg.entities) + sum(c.count for c in cfg.clutter),
+                "description": presets.describe(name),
+            }
+        )
+    if args.json:
+        print(json.dumps(rows, indent=2))
+        return 0
+    for r in rows:
+        size = f"{r['width']}x{r['height']}x{r['n_frames']}"
+        print(f"{r['name']:<14} {size:<12} {r['entities']:>4} entities  {r['description']}")
+    return 0
+
+
+def load_source(preset: str | None, config: Path | None) -> tuple[Any, str]:
+    from scenegen.config import load_config
+
+    if preset is not None:
+        return presets.get(preset), preset
+    assert config is not None
+    return load_config(config), ""
+
+
+def cmd_generate(args: argparse.Namespace) -> int:
+    from scenegen.generator import plan
+    from scenegen.io import COMPRESSIONS, write_scenario
+
+    if args.compression not in COMPRESSIONS:
+        raise ConfigError(
+            f"--compression must be one of {', '.join(COMPRESSIONS)}; got {args.compression!r}"
+        )
+    if args.seed is not None and args.seed < 0:
+        raise ConfigError(f"--seed must be >= 0, got {args.seed}")
+    cfg, preset = load_source(args.preset, args.config)
+    if args.frames is not None:
+        if args.frames < 1:
+            raise ConfigError(f"--frames must be >= 1, got {args.frames}")
+        cfg = replace(cfg, n_frames=args.frames)
+    scn = plan(cfg, args.seed, preset=preset)
+    with bar(cfg.n_frames, f"generate {cfg.name}", unit="frame") as pb:
+        write_scenario(
+            args.output, scn, compression=args.compression, progress=lambda n: pb.update(n - pb.n)
+        )
+    print(f"wrote {args.output} ({cfg.n_frames} frames, seed {scn.seed})")
+    return 0
+
+
+def _inspect(path: Path) -> dict[str, Any]:
+    from scenegen.io import open_checked
+
+    out: dict[str, Any] = {"file": str(path)}
+    with open_checked(path) as f:
+        out["schema"] = str(f.attrs["schema"])
+        out["generator_version"] = str(f.attrs.get("generator_version", ""))
+        out["sequences"] = []
+        for name, g in f.get("sequences", {}).items():
+            try:
+                roles = [
+                    r.decode() if isinstance(r, bytes) else str(r) for r in g["entities/role"][()]
+                ]
+                frames = g["frames"]
+                out["sequences"].append(
+                    {
+                        "name": name,
+                        "preset": str(g.attrs["preset"]),
+                        "seed": int(g.attrs["seed"]),
+                        "n_frames": int(g.attrs["n_frames"]),
+                        "height": int(g.attrs["height"]),
+                        "width": int(g.attrs["width"]),
+                        "entities": {r: roles.count(r) for r in sorted(set(roles))},
+                        "compression": frames.compression or "none",
+                        "chunks": list(frames.chunks or ()),
+                    }
+                )
+            except (KeyError, OSError) as err:
+                raise DataError(f"{path}: sequence {name!r} is damaged: {err}") from None
+        out["results"] = []
+        for name, g in f.get("results", {}).items():
+            out["results"].append(
+                {"tracker": name, "sequence": str(g.attrs.get("sequence", "")),
+                 "shape": list(g["boxes"].shape) if "boxes" in g else None}
+            )  # fmt: skip
+    return out
+
+
+def cmd_inspect(args: argparse.Namespace) -> int:
+    info = _inspect(args.file)
+    if args.json:
+        print(json.dumps(info, indent=2))
+        return 0
+    print(f"{info['file']}: schema {info['schema']}, generator {info['generator_version']}")
+    for s in info["sequences"]:
+        ents = ", ".join(f"{n} {r}" for r, n in s["entities"].items())
+        print(
+            f"  sequence {s['name']}: {s['n_frames']} frames {s['width']}x{s['height']}, "
+            f"seed {s['seed']}, preset {s['preset'] or '-'}, {ents}; "
+            f"compression {s['compression']}"
+        )
+    for r in info["results"]:
+        print(f"  result {r['tracker']} on {r['sequence']}: boxes {r['shape']}")
+    return 0
+
+
+def cmd_validate(args: argparse.Namespace) -> int:
+    import sys
+
+    from scenegen.validate import check_file
+
+    problems = check_file(args.file)
+    if problems:
+        for line in problems:
+            print(line, file=sys.stderr)
+        return 1
+    print(f"{args.file}: valid")
+    return 0
+
+
+def _read(path: Path, name: str | None) -> Any:
+    from scenegen.io import read
+
+    return read(path, name)
+
+
+def cmd_preview(args: argparse.Namespace) -> int:
+    from scenegen.io import read_result
+    from scenegen.preview import write_preview
+
+    seq = _read(args.file, args.sequence)
+    boxes = None
+    if args.result is not None:
+        res = read_result(args.result)
+        if res.boxes.shape[0] != seq.n_frames:
+            raise DataError(
+                f"{args.result}: {res.boxes.shape[0]} frames, but {args.file} has {seq.n_frames}"
+            )
+        boxes = res.boxes
+    write_preview(seq, args.output, boxes=boxes)
+    print(f"wrote {args.output}")
+    return 0
+
+
+def cmd_export(args: argparse.Namespace) -> int:
+    from scenegen.export import export_mot
+
+    seq = _read(args.file, args.sequence)
+    export_mot(seq, args.output)
+    print(f"wrote {args.output}")
+    return 0

@@ -1,0 +1,521 @@
+"""Declarative scenario configuration: frozen dataclasses validated on construction.
+
+A scenario is described by a :class:`SceneConfig` built from Python objects, a dict, or a
+YAML/JSON file (:func:`load_config`). Every error raises :class:`~scenegen.errors.ConfigError`
+whose one-line message names the field path (``entities[1].motion.x.boundary``) and the bad
+value.
+
+Example
+-------
+>>> cfg = from_dict({
+...     "width": 64, "height": 48, "n_frames": 10,
+...     "entities": [{"name": "t1", "role": "target", "position": [20, 20],
+...                   "appearance": {"shape": "ellipse", "size": [9, 9]},
+...                   "motion": {"x": {"sigma": 1, "boundary": "reflect"},
+...                              "y": {"sigma": 1, "boundary": "reflect"}}}]})
+>>> cfg.entities[0].motion.x.a1
+2.0
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import types
+import typing
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Literal, get_args, get_origin
+
+from scenegen.errors import ConfigError
+
+__all__ = [
+    "AR2",
+    "Appearance",
+    "Background",
+    "ClutterSpec",
+    "EntitySpec",
+    "Motion",
+    "SceneConfig",
+    "Variation",
+    "from_dict",
+    "load_config",
+    "to_dict",
+]
+
+Color = tuple[int, int, int]
+Shape = Literal["rect", "ellipse", "triangle", "diamond"]
+Pattern = Literal["solid", "rings", "sectors", "stripes", "bands", "checker", "texture"]
+Boundary = Literal["reflect", "clamp", "free"]
+Role = Literal["target", "distractor", "occluder", "clutter"]
+
+_MAX_ENTITIES = 65535  # labels are uint16 and 0 is the background
+
+
+def _fail(path: str, msg: str) -> typing.NoReturn:
+    raise ConfigError(f"{path}: {msg}" if path else msg)
+
+
+def _check_color(path: str, c: Color) -> None:
+    if len(c) != 3 or any(not 0 <= v <= 255 for v in c):
+        _fail(path, f"colour must be three integers in 0..255, got {list(c)}")
+
+
+@dataclass(frozen=True)
+class AR2:
+    """Second-order autoregression of one coordinate (ALGORITHMS §1.1).
+
+    ``c_t = mean + a1 (c_{t-1} - mean) + a2 (c_{t-2} - mean) + sigma * eps_t``.
+    ``a1 = 2, a2 = -1`` is constant velocity plus acceleration noise; ``a1 = 1 + d,
+    a2 = -d`` damps the velocity. ``mean`` defaults to the initial value.
+
+    ``boundary`` (required) says what happens at the frame border: ``reflect`` mirrors the
+    coordinate and its previous value (so the velocity reverses) about the limit, ``clamp``
+    stops it at the limit with zero velocity, ``free`` lets the entity leave the frame.
+    The limits keep the entity's centre at least ``margin`` pixels plus half its size inside
+    the frame (for ``scale`` the limits are ``[-margin, margin]`` around the mean in log
+    units, and a margin of 0 means unbounded).
+    """
+
+    boundary: Boundary
+    a1: float = 2.0
+    a2: float = -1.0
+    sigma: float = 0.0
+    mean: float | None = None
+    margin: float = 0.0
+
+    def __post_init__(self) -> None:
+        if self.sigma < 0:
+            _fail("sigma", f"must be >= 0, got {self.sigma}")
+        if self.margin < 0:
+            _fail("margin", f"must be >= 0, got {self.margin}")
+
+
+@dataclass(frozen=True)
+class Motion:
+    """Per-coordinate AR2 motion of an entity's centre (x, y) and, optionally, log scale.
+
+    ``velocity`` sets the initial velocity: the value before the first frame is
+    ``position - velocity``.
+    """
+
+    x: AR2
+    y: AR2
+    scale: AR2 | None = None
+    velocity: tuple[float, float] = (0.0, 0.0)
+
+
+@dataclass(frozen=True)
+class Appearance:
+    """How an entity looks: a silhouette ``shape`` of ``size`` (w, h) filled with ``pattern``.
+
+    Patterns: ``solid`` (first colour), ``rings`` (concentric rings), ``sectors`` (pie
+    wedges: a multicoloured disc), ``stripes`` (diagonal stripes of ``stripe_width``),
+    ``bands`` (horizontal parts, top to bottom: per-part colours such as head/torso/legs),
+    ``checker`` (squares of ``stripe_width``), ``texture`` (the colours plus Gaussian
+    texture of std ``texture_sigma``, drawn from the entity's random stream).
+    """
+
+    shape: Shape = "rect"
+    size: tuple[int, int] = (20, 20)
+    pattern: Pattern = "solid"
+    colors: tuple[Color, ...] = ((255, 0, 0),)
+    stripe_width: int = 4
+    texture_sigma: float = 20.0
+
+    def __post_init__(self) -> None:
+        if self.size[0] < 1 or self.size[1] < 1:
+            _fail("size", f"width and height must be >= 1, got {list(self.size)}")
+        if len(self.colors) < 1:
+            _fail("colors", "needs at least one colour")
+        for i, c in enumerate(self.colors):
+            _check_color(f"colors[{i}]", c)
+        if self.stripe_width < 1:
+            _fail("stripe_width", f"must be >= 1, got {self.stripe_width}")
+        if self.texture_sigma < 0:
+            _fail("texture_sigma", f"must be >= 0, got {self.texture_sigma}")
+
+
+@dataclass(frozen=True)
+class Variation:
+    """Small pose changes of the appearance over time (SHM §5: hands change with pose).
+
+    The angle is ``rotation * sin(2 pi t / period + phase)`` degrees and the brightness
+    factor ``1 + shading * sin(2 pi t / period + phase)``.
+    """
+
+    rotation: float = 0.0
+    shading: float = 0.0
+    period: float = 40.0
+    phase: float = 0.0
+
+    def __post_init__(self) -> None:
+        if self.period <= 0:
+            _fail("period", f"must be > 0, got {self.period}")
+        if not 0 <= self.shading < 1:
+            _fail("shading", f"must be in [0, 1), got {self.shading}")
+
+
+@dataclass(frozen=True)
+class EntitySpec:
+    """One entity of the scene.
+
+    Attributes
+    ----------
+    name : str
+        Unique name; it also keys the entity's own random stream, so adding or removing
+        another entity never changes this one's trajectory.
+    role : {'target', 'distractor', 'occluder', 'clutter'}
+    appearance : Appearance
+    position : (x, y) or None
+        Initial centre in pixels. ``None`` only for a distractor with ``mimic``: it then
+        starts at the mimicked target's drawn centre at its ``appear`` frame, plus
+        ``mimic_offset``.
+    motion : Motion or None
+        ``None``: static.
+    position_noise : float
+        Std (pixels) of Gaussian noise added to the drawn centre every frame (KAMS
+        "measurement noise"); the motion state itself is not perturbed.
+    appear, disappear : int, int or None
+        The entity exists for frames ``appear <= t < disappear``.
+    depth : tuple of (frame, depth)
+        Depth keyframes: from ``frame`` on the entity has ``depth`` (smaller is nearer).
+        Two entities may never share a depth at the same frame.
+    mimic : str or None
+        Name of a target whose appearance this entity copies (distractors).
+    color_jitter : float
+        Std of a per-channel colour offset applied to a mimicked appearance.
+    variation : Variation or None
+    """
+
+    name: str
+    role: Role
+    appearance: Appearance = field(default_factory=Appearance)
+    position: tuple[float, float] | None = None
+    motion: Motion | None = None
+    position_noise: float = 0.0
+    appear: int = 0
+    disappear: int | None = None
+    depth: tuple[tuple[int, int], ...] = ((0, 0),)
+    mimic: str | None = None
+    mimic_offset: tuple[float, float] = (0.0, 0.0)
+    color_jitter: float = 0.0
+    variation: Variation | None = None
+
+    def __post_init__(self) -> None:
+        if not self.name:
+            _fail("name", "must not be empty")
+        if self.position_noise < 0:
+            _fail("position_noise", f"must be >= 0, got {self.position_noise}")
+        if self.appear < 0:
+            _fail("appear", f"must be >= 0, got {self.appear}")
+        if self.disappear is not None and self.disappear <= self.appear:
+            _fail("disappear", f"must be > appear ({self.appear}), got {self.disappear}")
+        if not self.depth:
+            _fail("depth", "needs at least one (frame, depth) keyframe")
+        frames = [f for f, _ in self.depth]
+        if frames[0] != 0:
+            _fail("depth", f"the first keyframe must be at frame 0, got {frames[0]}")
+        if any(b <= a for a, b in zip(frames, frames[1:], strict=False)):
+            _fail("depth", f"keyframe frames must increase, got {frames}")
+        if any(d < 0 for _, d in self.depth):
+            _fail("depth", f"depths must be >= 0, got {[d for _, d in self.depth]}")
+        if self.position is None and self.mimic is None:
+            _fail("position", "is required unless the entity mimics a target")
+        if self.color_jitter < 0:
+            _fail("color_jitter", f"must be >= 0, got {self.color_jitter}")
+
+    def depth_at(self, t: int) -> int:
+        """Depth value at frame ``t`` (the last keyframe at or before ``t``)."""
+        d = self.depth[0][1]
+        for f, v in self.depth:
+            if f <= t:
+                d = v
+        return d
+
+
+@dataclass(frozen=True)
+class ClutterSpec:
+    """A group of ``count`` static clutter entities drawn behind every other entity.
+
+    Each item takes ``appearance`` with its size drawn uniformly in
+    ``[min_size, appearance.size]`` (keeping the aspect ratio) and ``n_colors`` colours
+    drawn from ``palette``. ``placement`` is ``uniform`` (centres uniform over ``region``,
+    default the whole frame) or ``grid`` (a jittered grid over ``region``).
+    """
+
+    count: int
+    appearance: Appearance = field(default_factory=Appearance)
+    palette: tuple[Color, ...] = ((255, 0, 0), (0, 160, 0), (0, 0, 255), (255, 200, 0))
+    n_colors: int = 1
+    min_size: int = 0
+    placement: Literal["uniform", "grid"] = "uniform"
+    region: tuple[float, float, float, float] | None = None
+    name: str = "clutter"
+
+    def __post_init__(self) -> None:
+        if self.count < 0:
+            _fail("count", f"must be >= 0, got {self.count}")
+        if not self.palette:
+            _fail("palette", "needs at least one colour")
+        for i, c in enumerate(self.palette):
+            _check_color(f"palette[{i}]", c)
+        if self.n_colors < 1:
+            _fail("n_colors", f"must be >= 1, got {self.n_colors}")
+        if self.min_size < 0 or self.min_size > min(self.appearance.size):
+            _fail("min_size", f"must be in 0..{min(self.appearance.size)}, got {self.min_size}")
+        if self.region is not None and (self.region[2] <= 0 or self.region[3] <= 0):
+            _fail("region", f"width and height must be > 0, got {list(self.region)}")
+
+
+@dataclass(frozen=True)
+class Background:
+    """The static background: ``uniform`` (``color``), ``noise`` (i.i.d. uniform pixels in
+    ``[low, high]`` per channel) or ``texture`` (noise smoothed by a Gaussian of std
+    ``scale`` pixels, tinted by ``color``)."""
+
+    kind: Literal["uniform", "noise", "texture"] = "uniform"
+    color: Color = (255, 255, 255)
+    low: int = 0
+    high: int = 255
+    scale: float = 4.0
+
+    def __post_init__(self) -> None:
+        _check_color("color", self.color)
+        if not 0 <= self.low <= self.high <= 255:
+            _fail("low", f"need 0 <= low <= high <= 255, got low={self.low} high={self.high}")
+        if self.scale <= 0:
+            _fail("scale", f"must be > 0, got {self.scale}")
+
+
+@dataclass(frozen=True)
+class SceneConfig:
+    """A whole scenario: canvas, background, entities, clutter and sensor noise.
+
+    Attributes
+    ----------
+    width, height : int
+        Frame size in pixels.
+    n_frames : int
+        Number of frames T.
+    background : Background
+    entities : tuple of EntitySpec
+        Targets, distractors and occluders, in id order (ids 1, 2, ... in this order;
+        clutter items follow).
+    clutter : tuple of ClutterSpec
+    sensor_noise : float
+        Std of i.i.d. Gaussian pixel noise added to every frame (frames only, not labels).
+    name : str
+        The sequence name used in HDF5 files.
+    """
+
+    width: int
+    height: int
+    n_frames: int
+    background: Background = field(default_factory=Background)
+    entities: tuple[EntitySpec, ...] = ()
+    clutter: tuple[ClutterSpec, ...] = ()
+    sensor_noise: float = 0.0
+    name: str = "scene"
+
+    def __post_init__(self) -> None:
+        for f in ("width", "height", "n_frames"):
+            v = getattr(self, f)
+            if v < 1:
+                _fail(f, f"must be >= 1, got {v}")
+        if self.sensor_noise < 0:
+            _fail("sensor_noise", f"must be >= 0, got {self.sensor_noise}")
+        if not self.name or "/" in self.name:
+            _fail("name", f"must be a non-empty name without '/', got {self.name!r}")
+        names: dict[str, int] = {}
+        for i, e in enumerate(self.entities):
+            if e.name in names:
+                _fail(f"entities[{i}].name", f"duplicate name {e.name!r}")
+            names[e.name] = i
+        for i, e in enumerate(self.entities):
+            if e.mimic is not None:
+                if e.mimic not in names:
+                    _fail(f"entities[{i}].mimic", f"no entity named {e.mimic!r}")
+                if self.entities[names[e.mimic]].mimic is not None:
+                    _fail(f"entities[{i}].mimic", f"{e.mimic!r} itself mimics another entity")
+            if e.disappear is not None and e.appear >= self.n_frames:
+                _fail(f"entities[{i}].appear", f"{e.appear} is past the last frame")
+        cnames = [c.name for c in self.clutter]
+        for j, c in enumerate(self.clutter):
+            if c.name in names or cnames.index(c.name) != j:
+                _fail(f"clutter[{j}].name", f"duplicate name {c.name!r}")
+        n_total = len(self.entities) + sum(c.count for c in self.clutter)
+        if n_total > _MAX_ENTITIES:
+            _fail("entities", f"at most {_MAX_ENTITIES} entities in all, got {n_total}")
+        self._check_depth_ties()
+
+    def _check_depth_ties(self) -> None:
+        keyframes = sorted({f for e in self.entities for f, _ in e.depth if f < self.n_frames})
+        for t in keyframes:
+            seen: dict[int, int] = {}
+            for i, e in enumerate(self.entities):
+                d = e.depth_at(t)
+                if d in seen:
+                    other = self.entities[seen[d]].name
+                    _fail(
+                        f"entities[{i}].depth",
+                        f"depth tie: {e.name!r} and {other!r} both have depth {d} at frame {t}",
+                    )
+                seen[d] = i
+
+
+# --------------------------------------------------------------------------------------
+# Parsing from plain data (dicts from YAML/JSON) with field paths in every error.
+
+
+def _type_name(tp: Any) -> str:
+    return getattr(tp, "__name__", str(tp))
+
+
+def _convert(value: Any, tp: Any, path: str) -> Any:
+    origin = get_origin(tp)
+    if origin is typing.Union or origin is types.UnionType:
+        args = get_args(tp)
+        if value is None:
+            if type(None) in args:
+                return None
+            _fail(path, "must not be null")
+        inner = [a for a in args if a is not type(None)]
+        return _convert(value, inner[0], path)
+    if origin is Literal:
+        choices = get_args(tp)
+        if value not in choices:
+            _fail(path, f"must be one of {', '.join(map(str, choices))}; got {value!r}")
+        return value
+    if dataclasses.is_dataclass(tp):
+        if isinstance(value, tp):
+            return value
+        return _build(tp, value, path)
+    if origin is tuple:
+        args = get_args(tp)
+        if isinstance(value, (str, bytes, dict)) or not hasattr(value, "__iter__"):
+            _fail(path, f"must be a list, got {value!r}")
+        items = list(value)
+        if len(args) == 2 and args[1] is Ellipsis:
+            return tuple(_convert(v, args[0], f"{path}[{i}]") for i, v in enumerate(items))
+        if len(items) != len(args):
+            _fail(path, f"must have {len(args)} items, got {items!r}")
+        return tuple(
+            _convert(v, a, f"{path}[{i}]") for i, (v, a) in enumerate(zip(items, args, strict=True))
+        )
+    if tp is bool:
+        if not isinstance(value, bool):
+            _fail(path, f"must be true or false, got {value!r}")
+        return value
+    if tp is int:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            _fail(path, f"must be an integer, got {value!r}")
+        if isinstance(value, float) and not value.is_integer():
+            _fail(path, f"must be an integer, got {value!r}")
+        return int(value)
+    if tp is float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            _fail(path, f"must be a number, got {value!r}")
+        if not math.isfinite(value):
+            _fail(path, f"must be finite, got {value!r}")
+        return float(value)
+    if tp is str:
+        if not isinstance(value, str):
+            _fail(path, f"must be a string, got {value!r}")
+        return value
+    _fail(path, f"cannot read a value of type {_type_name(tp)}")
+
+
+def _normalise_depth(value: Any) -> Any:
+    # A single number is shorthand for a constant depth from frame 0.
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        return [[0, value]]
+    return value
+
+
+def _build(cls: type, data: Any, path: str) -> Any:
+    if not isinstance(data, dict):
+        _fail(path, f"must be a mapping, got {data!r}")
+    hints = typing.get_type_hints(cls)
+    fields = {f.name: f for f in dataclasses.fields(cls)}
+    for key in data:
+        if key not in fields:
+            _fail(
+                f"{path}.{key}" if path else str(key),
+                f"unknown field; valid fields: {', '.join(fields)}",
+            )
+    kwargs = {}
+    for name, f in fields.items():
+        sub = f"{path}.{name}" if path else name
+        if name not in data:
+            if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
+                _fail(sub, "is required")
+            continue
+        value = data[name]
+        if cls is EntitySpec and name == "depth":
+            value = _normalise_depth(value)
+        kwargs[name] = _convert(value, hints[name], sub)
+    try:
+        return cls(**kwargs)
+    except ConfigError as err:
+        msg = str(err)
+        raise ConfigError(f"{path}.{msg}" if path else msg) from None
+
+
+def from_dict(data: Any) -> SceneConfig:
+    """Build and validate a :class:`SceneConfig` from plain data (as read from YAML/JSON).
+
+    Raises
+    ------
+    ConfigError
+        Naming the field path and the bad value.
+    """
+    return _build(SceneConfig, data, "")
+
+
+def _plain(value: Any) -> Any:
+    if dataclasses.is_dataclass(value):
+        return {f.name: _plain(getattr(value, f.name)) for f in dataclasses.fields(value)}
+    if isinstance(value, tuple):
+        return [_plain(v) for v in value]
+    return value
+
+
+def to_dict(config: SceneConfig) -> dict[str, Any]:
+    """The fully resolved config as plain data; ``from_dict(to_dict(c)) == c``."""
+    return _plain(config)
+
+
+def load_config(path: str | Path) -> SceneConfig:
+    """Read a YAML (``.yaml``/``.yml``) or JSON (``.json``) config file and validate it.
+
+    Raises
+    ------
+    ConfigError
+        If the file cannot be read or parsed, or the config is invalid (message prefixed
+        with the file name).
+    """
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except OSError as err:
+        raise ConfigError(f"{p}: cannot read config: {err.strerror or err}") from None
+    try:
+        if p.suffix.lower() in (".yaml", ".yml"):
+            import yaml
+
+            data = yaml.safe_load(text)
+        elif p.suffix.lower() == ".json":
+            data = json.loads(text)
+        else:
+            raise ConfigError(f"{p}: config must be .yaml, .yml or .json, got {p.suffix!r}")
+    except ConfigError:
+        raise
+    except Exception as err:  # parser errors of yaml/json: report as one line
+        first = str(err).splitlines()[0] if str(err) else type(err).__name__
+        raise ConfigError(f"{p}: not valid {p.suffix[1:].upper()}: {first}") from None
+    try:
+        return from_dict(data)
+    except ConfigError as err:
+        raise ConfigError(f"{p}: {err}") from None

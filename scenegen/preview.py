@@ -1,0 +1,118 @@
+"""Previews: a PNG contact sheet, a GIF or an MP4 with ground truth drawn on the frames.
+
+Each entity's amodal box is drawn thin and its visible box thick, labelled with
+``id:depth``; tracker estimates (``--result``) are drawn in white with a black outline.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import cv2
+import numpy as np
+from numpy.typing import NDArray
+
+from scenegen.errors import ConfigError
+from scenegen.io import atomic_path
+from scenegen.sequence import Sequence
+
+__all__ = ["annotate", "contact_sheet", "write_preview"]
+
+_ROLE_COLORS = {
+    "target": (0, 200, 0),
+    "distractor": (230, 0, 0),
+    "occluder": (0, 90, 255),
+    "clutter": (160, 160, 160),
+}
+
+
+def annotate(
+    seq: Sequence, t: int, *, boxes: NDArray[Any] | None = None, clutter: bool = False
+) -> NDArray[np.uint8]:
+    """Frame ``t`` (H, W, 3) with ground truth (and optional estimates (M, 4)) drawn."""
+    img = np.ascontiguousarray(np.asarray(seq.frames[t]).copy())
+    gt = seq.gt
+    for k in range(len(seq.entities)):
+        role = str(seq.entities.role[k])
+        if (role == "clutter" and not clutter) or not gt.present[t, k]:
+            continue
+        color = _ROLE_COLORS.get(role, (255, 255, 0))
+        x, y, w, h = gt.box[t, k]
+        cv2.rectangle(img, (int(x), int(y)), (int(x + w) - 1, int(y + h) - 1), color, 1)
+        vb = gt.visible_box[t, k]
+        if np.all(np.isfinite(vb)):
+            vx, vy, vw, vh = vb
+            cv2.rectangle(img, (int(vx), int(vy)), (int(vx + vw) - 1, int(vy + vh) - 1), color, 2)
+        label = f"{int(seq.entities.id[k])}:{int(gt.depth[t, k])}"
+        cv2.putText(img, label, (int(x), max(int(y) - 3, 8)), cv2.FONT_HERSHEY_SIMPLEX, 0.35,
+                    color, 1, cv2.LINE_AA)  # fmt: skip
+    if boxes is not None:
+        for x, y, w, h in np.asarray(boxes, dtype=np.float64):
+            if not np.all(np.isfinite([x, y, w, h])):
+                continue
+            p0, p1 = (int(x), int(y)), (int(x + w) - 1, int(y + h) - 1)
+            cv2.rectangle(img, p0, p1, (0, 0, 0), 3)
+            cv2.rectangle(img, p0, p1, (255, 255, 255), 1)
+    cv2.putText(img, f"t={t}", (4, 12), cv2.FONT_HERSHEY_SIMPLEX, 0.4, (0, 0, 0), 3, cv2.LINE_AA)
+    cv2.putText(img, f"t={t}", (4, 12), cv2.FONT_HERSHEY_SIMPLEX, 0.4, (255, 255, 0), 1,
+                cv2.LINE_AA)  # fmt: skip
+    return img
+
+
+def contact_sheet(
+    seq: Sequence, *, n: int = 12, cols: int = 4, boxes: NDArray[Any] | None = None
+) -> NDArray[np.uint8]:
+    """``n`` evenly spaced annotated frames tiled ``cols`` wide, shape (rows*H, cols*W, 3)."""
+    t_n = seq.n_frames
+    idx = np.unique(np.linspace(0, t_n - 1, min(n, t_n)).round().astype(int))
+    tiles = [annotate(seq, int(t), boxes=None if boxes is None else boxes[t]) for t in idx]
+    h, w = tiles[0].shape[:2]
+    cols = min(cols, len(tiles))
+    rows = -(-len(tiles) // cols)
+    sheet = np.full((rows * h, cols * w, 3), 255, dtype=np.uint8)
+    for i, tile in enumerate(tiles):
+        r, c = divmod(i, cols)
+        sheet[r * h : (r + 1) * h, c * w : (c + 1) * w] = tile
+    return sheet
+
+
+def write_preview(
+    seq: Sequence, out: str | Path, *, boxes: NDArray[Any] | None = None, max_frames: int = 200
+) -> None:
+    """Write a preview of ``seq`` to ``out`` (.png contact sheet, .gif or .mp4 animation).
+
+    ``boxes`` (T, M, 4): tracker estimates to draw. Animations show at most
+    ``max_frames`` evenly spaced frames.
+    """
+    out = Path(out)
+    ext = out.suffix.lower()
+    if ext not in (".png", ".gif", ".mp4"):
+        raise ConfigError(f"{out}: preview must be .png, .gif or .mp4, got {ext or 'no suffix'!r}")
+    if ext == ".png":
+        sheet = contact_sheet(seq, boxes=boxes)
+        ok, data = cv2.imencode(".png", cv2.cvtColor(sheet, cv2.COLOR_RGB2BGR))
+        if not ok:
+            raise ConfigError(f"{out}: could not encode PNG")
+        with atomic_path(out) as tmp:
+            tmp.write_bytes(data.tobytes())
+        return
+    t_n = seq.n_frames
+    idx = np.unique(np.linspace(0, t_n - 1, min(max_frames, t_n)).round().astype(int))
+    frames = [annotate(seq, int(t), boxes=None if boxes is None else boxes[t]) for t in idx]
+    with atomic_path(out, ext) as tmp:  # the suffix lets OpenCV pick the container
+        if ext == ".gif":
+            from PIL import Image
+
+            imgs = [Image.fromarray(f) for f in frames]
+            imgs[0].save(
+                tmp, format="GIF", save_all=True, append_images=imgs[1:], duration=80, loop=0
+            )
+        else:
+            h, w = frames[0].shape[:2]
+            writer = cv2.VideoWriter(str(tmp), cv2.VideoWriter_fourcc(*"mp4v"), 12.5, (w, h))
+            if not writer.isOpened():
+                raise ConfigError(f"{out}: this OpenCV build cannot write MP4")
+            for f in frames:
+                writer.write(cv2.cvtColor(f, cv2.COLOR_RGB2BGR))
+            writer.release()

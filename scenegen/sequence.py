@@ -1,0 +1,147 @@
+"""The in-memory (or lazily read) result of generation: frames, labels and ground truth."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from scenegen.config import SceneConfig
+
+__all__ = ["GT_FIELDS", "Entities", "GroundTruth", "Sequence"]
+
+# HDF5 name -> dtype of every ground-truth array (CONTRACT, schema scenegen/1).
+GT_FIELDS: dict[str, Any] = {
+    "box": np.float32,
+    "visible_box": np.float32,
+    "center": np.float32,
+    "visibility": np.float32,
+    "present": np.bool_,
+    "depth": np.int16,
+}
+
+
+@dataclass
+class Entities:
+    """The K entities of a sequence.
+
+    Attributes
+    ----------
+    id : ndarray of shape (K,), int32
+        Ids as used in ``labels`` (>= 1).
+    role : ndarray of shape (K,), str
+        ``target``, ``distractor``, ``occluder`` or ``clutter``.
+    name : ndarray of shape (K,), str
+    """
+
+    id: NDArray[np.int32]
+    role: NDArray[np.str_]
+    name: NDArray[np.str_]
+
+    def __len__(self) -> int:
+        return int(self.id.shape[0])
+
+    def index_of(self, name: str) -> int:
+        """Index (into K) of the entity called ``name``."""
+        hits = np.flatnonzero(self.name == name)
+        if hits.size == 0:
+            raise KeyError(f"no entity named {name!r}")
+        return int(hits[0])
+
+
+@dataclass
+class GroundTruth:
+    """Per-frame ground truth (CONTRACT field names).
+
+    Attributes
+    ----------
+    box : ndarray of shape (T, K, 4), float32
+        Amodal box [x, y, w, h] of the whole entity as drawn; NaN where absent.
+    visible_box : ndarray of shape (T, K, 4), float32
+        Box of the entity's pixels in ``labels``; NaN where none is visible.
+    center : ndarray of shape (T, K, 2), float32
+        Amodal centre (x, y); NaN where absent.
+    visibility : ndarray of shape (T, K), float32
+        Visible pixels / amodal pixels (pixels outside the frame count as not visible);
+        0 where absent.
+    present : ndarray of shape (T, K), bool
+        The entity exists at that frame and part of its amodal extent is inside the frame.
+    depth : ndarray of shape (T, K), int16
+        Depth rank, 0 = nearest the camera.
+    """
+
+    box: NDArray[np.float32]
+    visible_box: NDArray[np.float32]
+    center: NDArray[np.float32]
+    visibility: NDArray[np.float32]
+    present: NDArray[np.bool_]
+    depth: NDArray[np.int16]
+
+    def as_dict(self) -> dict[str, NDArray[Any]]:
+        return {name: getattr(self, name) for name in GT_FIELDS}
+
+
+@dataclass
+class Sequence:
+    """A generated (or read) sequence.
+
+    Attributes
+    ----------
+    name : str
+    seed : int
+    config : SceneConfig
+        The fully resolved configuration.
+    preset : str
+        The preset name, "" if none.
+    frames : array-like of shape (T, H, W, 3), uint8
+        RGB frames (a numpy array, or a lazy array when read from a file).
+    labels : array-like of shape (T, H, W), uint16
+        Entity id of the visible surface; 0 is the background.
+    entities : Entities
+    gt : GroundTruth
+    templates : dict of int to ndarray of shape (h, w, 4)
+        Each entity drawn alone (RGBA), keyed by entity id.
+    """
+
+    name: str
+    seed: int
+    config: SceneConfig
+    preset: str
+    frames: Any
+    labels: Any
+    entities: Entities
+    gt: GroundTruth
+    templates: dict[int, NDArray[np.uint8]] = field(default_factory=dict)
+
+    @property
+    def n_frames(self) -> int:
+        return int(self.frames.shape[0])
+
+    @property
+    def height(self) -> int:
+        return int(self.frames.shape[1])
+
+    @property
+    def width(self) -> int:
+        return int(self.frames.shape[2])
+
+    def target_indices(self) -> NDArray[np.intp]:
+        """Indices (into K) of the entities whose role is ``target``, in id order."""
+        return np.flatnonzero(self.entities.role == "target")
+
+    def target_ids(self) -> NDArray[np.int32]:
+        """Ids of the targets, shape (M,)."""
+        return self.entities.id[self.target_indices()]
+
+    def init_boxes(self, frame: int = 0) -> NDArray[np.float64]:
+        """Amodal boxes (M, 4) of the targets at ``frame``: what trackers start from."""
+        return np.asarray(self.gt.box[frame, self.target_indices()], dtype=np.float64)
+
+    def __repr__(self) -> str:
+        t, h, w = self.n_frames, self.height, self.width
+        return (
+            f"Sequence(name={self.name!r}, seed={self.seed}, preset={self.preset!r}, "
+            f"frames={t}x{h}x{w}, entities={len(self.entities)})"
+        )
