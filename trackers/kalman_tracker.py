@@ -1,0 +1,155 @@
+"""Plain Kalman tracker: template matching per object, no occlusion reasoning.
+
+The baseline of the SHM paper (§5): every object is measured independently by template
+matching (mean squared difference, ``trackers.layered``) on the unmasked frame, and its
+position is filtered by a Kalman filter (``trackers.kalman``). Under heavy occlusion the
+occluded object's template matches the occluder or the clutter, and the filter follows.
+
+Shared with the SHM trackers (``trackers.shm``):
+
+- Motion (``motion``): ``"cv"`` constant velocity with white acceleration noise of std
+  ``process_std`` px/frame², or ``"ar2"`` (``a1``, ``a2``, noise std ``process_std``).
+- Measurement noise (**open**; the paper says only "proportional to the squared
+  difference mean", §3.1): ``R_m = (r_floor + r_gain · e_m) I₂`` px², with ``e_m`` the
+  match's mean squared difference per channel (intensity²). The floor keeps a perfect
+  match (e = 0) from freezing the filter.
+- A missed measurement (the object left the frame or is hidden) is ``update(None)`` for
+  that object: the filter keeps predicting.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from trackers.base import Estimate, RngLike, Tracker
+from trackers.kalman import KalmanFilter, MotionModel
+from trackers.layered import LayeredMatcher, check_matcher_params
+
+__all__ = ["MOTIONS", "KalmanTracker"]
+
+MOTIONS = ("cv", "ar2")
+
+
+def motion_model(
+    motion: str, process_std: float, a1: float, a2: float, velocity_std: float
+) -> MotionModel:
+    """The per-object model named by ``motion`` (``"cv"`` or ``"ar2"``).
+
+    Raises
+    ------
+    ValueError
+        For an unknown ``motion`` or a bad parameter value.
+    """
+    if motion == "cv":
+        return MotionModel.constant_velocity(accel_std=process_std, velocity_std=velocity_std)
+    if motion == "ar2":
+        return MotionModel.ar2(a1=a1, a2=a2, noise_std=process_std, velocity_std=velocity_std)
+    raise ValueError(f"unknown motion {motion!r}; valid: {', '.join(MOTIONS)}")
+
+
+def check_noise(r_gain: float, r_floor: float) -> None:
+    """Validate the measurement-noise parameters."""
+    if not (np.isfinite(r_gain) and r_gain >= 0):
+        raise ValueError(f"r_gain must be finite and >= 0, got {r_gain!r}")
+    if not (np.isfinite(r_floor) and r_floor > 0):
+        raise ValueError(f"r_floor must be finite and > 0, got {r_floor!r}")
+
+
+def measurement_cov(mse: NDArray[np.float64], r_gain: float, r_floor: float) -> NDArray[np.float64]:
+    """``R = (r_floor + r_gain e) I₂`` for every match, shape (..., 2, 2) from (...,).
+
+    A missed match (NaN) gets ``r_floor``; its measurement is skipped anyway.
+    """
+    var = r_floor + r_gain * np.nan_to_num(mse, nan=0.0)
+    return var[..., None, None] * np.eye(2)
+
+
+def boxes_at(centres: NDArray[np.float64], sizes: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Boxes (K, 4) of sizes (K, 2) = (w, h) centred at ``centres`` (K, 2)."""
+    return np.concatenate([centres - sizes / 2, sizes], axis=1)
+
+
+class KalmanTracker(Tracker):
+    """One Kalman filter per object on plain (unmasked) template-matching measurements.
+
+    Parameters
+    ----------
+    motion : {"cv", "ar2"}
+        Motion model (see the module docstring).
+    process_std : float
+        Process noise std: acceleration (cv) or AR2 noise, px/frame².
+    a1, a2 : float
+        AR2 coefficients (``motion="ar2"`` only).
+    velocity_std : float
+        Initial velocity std, px/frame (objects start at rest).
+    r_gain : float
+        Measurement variance per unit of mean squared difference, px²/intensity².
+    r_floor : float
+        Smallest measurement variance, px².
+    search_radius : int
+        Search window half-size around the predicted position, px.
+    step : int
+        Coarse-to-fine search stride; 1 is exhaustive.
+    min_visible : float
+        Fraction of the template that must be compared for a match to count.
+    support : {"box", "ellipse"}
+        Template support (``trackers.layered``).
+    rng : Generator, int or None
+        Unused by this deterministic tracker; accepted like every tracker's.
+
+    Example
+    -------
+    >>> import trackers
+    >>> tracker = trackers.make("kalman", search_radius=12)
+    """
+
+    name = "kalman"
+
+    def __init__(
+        self,
+        *,
+        motion: str = "cv",
+        process_std: float = 1.5,
+        a1: float = 2.0,
+        a2: float = -1.0,
+        velocity_std: float = 5.0,
+        r_gain: float = 0.01,
+        r_floor: float = 0.5,
+        search_radius: int = 12,
+        step: int = 1,
+        min_visible: float = 0.25,
+        support: str = "box",
+        rng: RngLike = None,
+    ) -> None:
+        super().__init__(rng=rng)
+        self.model = motion_model(motion, process_std, a1, a2, velocity_std)
+        check_noise(r_gain, r_floor)
+        check_matcher_params(search_radius, step, min_visible, support)
+        self.r_gain = float(r_gain)
+        self.r_floor = float(r_floor)
+        self._matcher_params = dict(
+            search_radius=search_radius, step=step, min_visible=min_visible, support=support
+        )
+
+    def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
+        self.matcher = LayeredMatcher(frame, boxes, **self._matcher_params)
+        self._sizes = boxes[:, 2:].copy()
+        self._origin = boxes[:, :2] + boxes[:, 2:] / 2
+        k = boxes.shape[0]
+        m = self.model
+        # The state is the displacement from the first centre (the AR2 mean, §1.1).
+        self.kf = KalmanFilter(
+            np.zeros((k, m.dim)), m.P0, m.F, m.Q, m.H, np.eye(2) * self.r_floor
+        )
+        self._identity = np.arange(k, dtype=np.int64)[None, :]
+
+    def _step(self, frame: NDArray[np.uint8]) -> Estimate:
+        self.kf.predict()
+        predicted = self._origin + self.kf.x[:, :2]
+        meas = self.matcher.measure(frame, predicted, self._identity, masking=False)
+        z = meas.centres[0] - self._origin
+        r = measurement_cov(meas.mse[0], self.r_gain, self.r_floor)
+        self.kf.update(z, R=r)
+        centres = self._origin + self.kf.x[:, :2]
+        return Estimate(boxes=boxes_at(centres, self._sizes), extras={"mse": meas.mse[0].copy()})

@@ -1,0 +1,298 @@
+"""Masked template matching by mean squared difference, for all objects and orderings.
+
+One compiled call measures every object of a frame under every depth ordering (the
+layered hypothesized measurements of the SHM paper, §3.1): for ordering ``j`` the objects
+are matched front to back, each one ignoring the pixels covered by the supports of the
+objects already matched in front of it. With ``masking=False`` and a single ordering the
+same call is plain, independent template matching of every object.
+
+Matching an object (top-left corner ``(x, y)`` of its template, integer pixels):
+
+    e(x, y) = Σ_{p ∈ V(x, y)} ||I(x + p) − T(p)||² / (3 |V(x, y)|)
+
+where ``V(x, y)`` are the support pixels ``p`` of the template whose image pixel lies in
+the frame and is not masked. A candidate is valid only if ``|V| ≥ min_visible · |support|``
+(so a few stray pixels cannot win); the measurement is the valid candidate of smallest
+``e`` in the search window ``[ox − r, ox + r] × [oy − r, oy + r]``. No valid candidate
+(the object left the frame, or is hidden by the objects in front) is a missed measurement.
+
+Search: candidates are visited nearest the window centre (the prediction) first; a
+candidate whose partial sum already exceeds the best score times the largest possible
+pixel count is abandoned after that template row (its mean can only be larger), which
+never changes the result but skips most of the work once a good match is found. With
+``step`` > 1 a coarse pass first scores the candidates on a grid of stride ``step`` with
+the template subsampled by ``step``, then a full-resolution pass scores the
+``(2 step − 1)²`` candidates around the coarse winner: faster, but it can miss the optimum
+of fine, high-frequency textures; ``step`` = 1 is exhaustive.
+
+Orderings that cannot differ are not recomputed: the match of object ``m`` depends only on
+the front objects whose footprint intersects ``m``'s search region and on where they were
+matched, so results are memoised on (``m``, those objects, their positions). Objects that
+never come close are matched once per frame whatever the number of orderings.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+__all__ = ["layered_match"]
+
+
+@njit(cache=True)
+def _fill_valid(h, w, rx, ry, valid, support, sizes, front, n_front, front_pos):  # pragma: no cover
+    """valid[i, j]: region pixel (ry + i, rx + j) lies in the frame and is not masked."""
+    rh, rw = valid.shape
+    for i in range(rh):
+        r = ry + i
+        for j in range(rw):
+            c = rx + j
+            valid[i, j] = r >= 0 and r < h and c >= 0 and c < w
+    for k in range(n_front):
+        f = front[k]
+        fx = front_pos[k, 0]
+        fy = front_pos[k, 1]
+        for a in range(sizes[f, 0]):
+            i = fy + a - ry
+            if i < 0 or i >= rh:
+                continue
+            for b in range(sizes[f, 1]):
+                j = fx + b - rx
+                if j >= 0 and j < rw and support[f, a, b]:
+                    valid[i, j] = False
+
+
+@njit(cache=True)
+def _score(
+    frame, rx, ry, valid, tpl, sup, th, tw, dx, dy, s, n_max, min_count, best
+):  # pragma: no cover
+    """Mean squared difference of one candidate, or inf if invalid or worse than ``best``."""
+    acc = np.int64(0)
+    cnt = 0
+    # A partial sum above this bound can never beat ``best``: the mean divides by at most
+    # 3 n_max.
+    bound = best * 3.0 * n_max
+    for a in range(0, th, s):
+        i = dy + a
+        r = ry + i
+        for b in range(0, tw, s):
+            j = dx + b
+            if sup[a, b] and valid[i, j]:
+                c = rx + j
+                d0 = np.int64(frame[r, c, 0]) - np.int64(tpl[a, b, 0])
+                d1 = np.int64(frame[r, c, 1]) - np.int64(tpl[a, b, 1])
+                d2 = np.int64(frame[r, c, 2]) - np.int64(tpl[a, b, 2])
+                acc += d0 * d0 + d1 * d1 + d2 * d2
+                cnt += 1
+        if acc > bound:
+            return np.inf
+    if cnt < min_count or cnt == 0:
+        return np.inf
+    return acc / (3.0 * cnt)
+
+
+@njit(cache=True)
+def _centre_out(radius):  # pragma: no cover - compiled
+    """Window offsets (dx, dy) in [0, 2 radius]², nearest the window centre first."""
+    span = 2 * radius + 1
+    d2 = np.empty(span * span, dtype=np.int64)
+    for dy in range(span):
+        for dx in range(span):
+            d2[dy * span + dx] = (dx - radius) ** 2 + (dy - radius) ** 2
+    idx = np.argsort(d2, kind="mergesort")
+    out = np.empty((span * span, 2), dtype=np.int64)
+    for k in range(span * span):
+        out[k, 0] = idx[k] % span
+        out[k, 1] = idx[k] // span
+    return out
+
+
+@njit(cache=True)
+def _match(
+    frame, tpl, sup, th, tw, radius, step, min_visible, valid, rx, ry, offsets
+):  # pragma: no cover - compiled
+    """Best top-left (x, y) and its score for one object; score inf if none is valid.
+
+    Candidates are visited nearest the predicted position first, so that a good score is
+    found early and most other candidates are abandoned after a few template rows.
+    """
+    span = 2 * radius
+    n_full = 0
+    n_sub = 0
+    for a in range(th):
+        for b in range(tw):
+            if sup[a, b]:
+                n_full += 1
+                if a % step == 0 and b % step == 0:
+                    n_sub += 1
+    bx = -1
+    by = -1
+    lo_x = 0
+    hi_x = span
+    lo_y = 0
+    hi_y = span
+    if step > 1:
+        best = np.inf
+        min_sub = min_visible * n_sub
+        for k in range(offsets.shape[0]):
+            dx = offsets[k, 0]
+            dy = offsets[k, 1]
+            if dx % step != 0 or dy % step != 0:
+                continue
+            e = _score(frame, rx, ry, valid, tpl, sup, th, tw, dx, dy, step, n_sub, min_sub,
+                       best)
+            if e < best:
+                best = e
+                bx = dx
+                by = dy
+        if bx < 0:
+            return 0, 0, np.inf
+        lo_x = max(bx - step + 1, 0)
+        hi_x = min(bx + step - 1, span)
+        lo_y = max(by - step + 1, 0)
+        hi_y = min(by + step - 1, span)
+    best = np.inf
+    bx = -1
+    by = -1
+    min_full = min_visible * n_full
+    for k in range(offsets.shape[0]):
+        dx = offsets[k, 0]
+        dy = offsets[k, 1]
+        if dx < lo_x or dx > hi_x or dy < lo_y or dy > hi_y:
+            continue
+        e = _score(frame, rx, ry, valid, tpl, sup, th, tw, dx, dy, 1, n_full, min_full, best)
+        if e < best:
+            best = e
+            bx = dx
+            by = dy
+    if bx < 0:
+        return 0, 0, np.inf
+    return rx + bx, ry + by, best
+
+
+@njit(cache=True)
+def layered_match(
+    frame, templates, support, sizes, origins, radius, step, orderings, masking, min_visible,
+    out_pos, out_mse,
+):  # pragma: no cover - compiled
+    """Match every object under every depth ordering, front to back.
+
+    Parameters
+    ----------
+    frame : ndarray of shape (H, W, 3), uint8
+    templates : ndarray of shape (M, TH, TW, 3), uint8
+        Reference images, padded to the largest template size.
+    support : ndarray of shape (M, TH, TW), bool
+        Template pixels that are matched and, once matched, mask the objects behind.
+    sizes : ndarray of shape (M, 2), int64
+        Template (height, width) of each object.
+    origins : ndarray of shape (M, 2), int64
+        Centre (x, y) of each search window, as a template top-left corner.
+    radius, step : int
+        Search window half-size in pixels; coarse-to-fine stride (1 = exhaustive).
+    orderings : ndarray of shape (L, M), int64
+        Each row lists object indices nearest first.
+    masking : bool
+        Mask the pixels of objects matched in front (False: independent matching).
+    min_visible : float
+        Smallest fraction of a template's support that must be compared.
+    out_pos : ndarray of shape (L, M, 2), int64
+        Written: matched top-left (x, y) of object m under ordering l (0 if missed).
+    out_mse : ndarray of shape (L, M), float64
+        Written: mean squared difference per channel, NaN for a missed measurement.
+
+    Returns
+    -------
+    int
+        Number of template searches actually run (memoised repeats excluded).
+    """
+    h = frame.shape[0]
+    w = frame.shape[1]
+    n_order, m_obj = orderings.shape
+    n_memo_max = n_order * m_obj
+    memo_obj = np.empty(n_memo_max, dtype=np.int64)
+    memo_bits = np.empty(n_memo_max, dtype=np.int64)
+    memo_fpos = np.zeros((n_memo_max, m_obj, 2), dtype=np.int64)
+    memo_pos = np.empty((n_memo_max, 2), dtype=np.int64)
+    memo_mse = np.empty(n_memo_max, dtype=np.float64)
+    n_memo = 0
+    front = np.empty(m_obj, dtype=np.int64)
+    front_pos = np.empty((m_obj, 2), dtype=np.int64)
+    matched = np.zeros(m_obj, dtype=np.bool_)
+    pos = np.zeros((m_obj, 2), dtype=np.int64)
+    th_max = templates.shape[1]
+    tw_max = templates.shape[2]
+    valid = np.empty((th_max + 2 * radius, tw_max + 2 * radius), dtype=np.bool_)
+    offsets = _centre_out(radius)
+    n_run = 0
+    for l in range(n_order):
+        matched[:] = False
+        for d in range(m_obj):
+            m = orderings[l, d]
+            th = sizes[m, 0]
+            tw = sizes[m, 1]
+            rx = origins[m, 0] - radius
+            ry = origins[m, 1] - radius
+            rw = tw + 2 * radius
+            rh = th + 2 * radius
+            # Front objects that can mask this object's search region.
+            n_front = 0
+            bits = np.int64(0)
+            if masking:
+                for dd in range(d):
+                    f = orderings[l, dd]
+                    if not matched[f]:
+                        continue
+                    fx = pos[f, 0]
+                    fy = pos[f, 1]
+                    overlap_x = fx < rx + rw and fx + sizes[f, 1] > rx
+                    if overlap_x and fy < ry + rh and fy + sizes[f, 0] > ry:
+                        front[n_front] = f
+                        front_pos[n_front, 0] = fx
+                        front_pos[n_front, 1] = fy
+                        n_front += 1
+                        bits |= np.int64(1) << f
+            hit = -1
+            for k in range(n_memo):
+                if memo_obj[k] != m or memo_bits[k] != bits:
+                    continue
+                same = True
+                for q in range(n_front):
+                    f = front[q]
+                    if (memo_fpos[k, f, 0] != front_pos[q, 0]
+                            or memo_fpos[k, f, 1] != front_pos[q, 1]):
+                        same = False
+                        break
+                if same:
+                    hit = k
+                    break
+            if hit < 0:
+                sub = valid[:rh, :rw]
+                _fill_valid(h, w, rx, ry, sub, support, sizes, front, n_front, front_pos)
+                x, y, e = _match(frame, templates[m], support[m], th, tw, radius, step,
+                                 min_visible, sub, rx, ry, offsets)
+                n_run += 1
+                hit = n_memo
+                memo_obj[hit] = m
+                memo_bits[hit] = bits
+                for q in range(n_front):
+                    memo_fpos[hit, front[q], 0] = front_pos[q, 0]
+                    memo_fpos[hit, front[q], 1] = front_pos[q, 1]
+                memo_pos[hit, 0] = x
+                memo_pos[hit, 1] = y
+                memo_mse[hit] = e
+                n_memo += 1
+            e = memo_mse[hit]
+            if np.isfinite(e):
+                matched[m] = True
+                pos[m, 0] = memo_pos[hit, 0]
+                pos[m, 1] = memo_pos[hit, 1]
+                out_pos[l, m, 0] = pos[m, 0]
+                out_pos[l, m, 1] = pos[m, 1]
+                out_mse[l, m] = e
+            else:
+                out_pos[l, m, 0] = 0
+                out_pos[l, m, 1] = 0
+                out_mse[l, m] = np.nan
+    return n_run
+

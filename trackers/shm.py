@@ -1,0 +1,384 @@
+"""Switching hypothesized measurements (SHM) trackers: positions and depth order.
+
+Wang, Tan & Loe, "Switching hypothesized measurements: a dynamic model with applications
+to occlusion adaptive joint tracking" (IJCAI 2007); ALGORITHMS.md §5.
+
+Model (§2.2). ``M`` objects, ``L = M!`` depth orderings ``s_t`` (``self.orderings``, each
+row nearest first). ``s_t`` is a first-order Markov chain (eq. 1) that stays with
+probability ``p_stay`` and otherwise moves uniformly to another ordering (**open**). The
+joint state ``x_t`` stacks the objects' motion states (``trackers.kalman.MotionModel``,
+constant velocity or AR2), linear Gaussian (eq. 2). Every frame gives ``L`` hypothesized
+measurements ``y^j`` with squared-difference means ``e^{j,m}`` (§3.1,
+``trackers.layered``): under the true ordering ``j``, ``y^j = H x + v`` with
+``v ~ N(0, R^j)``, ``R^{j,m} = (r_floor + r_gain e^{j,m}) I₂`` (proportional to ``e``, §3.1,
+plus a floor); the other orderings' measurements are uniform (eq. 3), so they cancel.
+
+Evidence of the squared-difference means (§3.3, the "generalised measurement"): under the
+true ordering ``e^{j,m}`` follows an exponential density with mean ``ē_m``, giving the
+factor ``exp(−lam Σ_m e^{j,m} / ē_m)`` (**open**: ``ē_m`` is estimated online as an
+exponential moving average, rate ``mse_rate``, of the smallest ``e`` over orderings,
+floored at ``mse_floor``; ``lam`` sharpens or flattens it). An object missed under an
+ordering (hidden behind the objects in front, or outside the frame) counts as ``e = ē``,
+i.e. as expected; its position measurement is uniform over the frame.
+
+Because non-overlapping objects give identical measurements under every ordering, the
+ordering probabilities then only follow the (symmetric) Markov chain towards equality.
+
+``SHMTracker`` ("shm", §3.2): a Gaussian-sum filter with one Gaussian per ordering. Each
+step predicts every Gaussian ``i``, updates it with every ordering's measurement ``j``
+(``L²`` Kalman updates, objects processed sequentially as independent blocks), weights
+the pair by ``Π_ij P(i) N(y^j; H x̂_i, S_ij)`` (times the ``e`` evidence if ``use_mse``),
+and collapses the pairs into one Gaussian per ``j`` by moment matching (GPB2, Murphy
+1998). The estimate is the mixture mean.
+
+``FastSHMTracker`` ("shm-fast", §3.3): the measurement noise under the true ordering is
+taken as small, so the ordering posterior comes from the ``e`` evidence and the Markov
+prior only, and the measurements become a mixture over orderings which is moment-matched
+into one measurement per object, ``ŷ_m = Σ_j P(j) y^{j,m}`` with covariance
+``Σ_j P(j) (R^{j,m} + (y^{j,m} − ŷ_m)(y^{j,m} − ŷ_m)')`` (``r_gain = 0`` and a small
+``r_floor`` give the paper's zero-noise limit), fed to one Kalman filter per object; no
+collapsing stage. Approximations (chosen here): the mixture's cross-object covariance is
+dropped, and an object whose measurement is missing under orderings of total probability
+≥ 1/2 is a missed measurement; otherwise the orderings where it was measured are used.
+
+Cost: ``L`` orderings need up to ``M L`` template searches per frame (``M`` when no objects
+are close) and the Gaussian-sum filter ``M L²`` Kalman updates of dimension ``4 M``; more
+than 4 objects (24 orderings) is refused.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from trackers.base import Estimate, RngLike, Tracker
+from trackers.kalman import KalmanFilter
+from trackers.kalman_tracker import (
+    boxes_at,
+    check_noise,
+    measurement_cov,
+    motion_model,
+)
+from trackers.layered import LayeredMatcher, check_matcher_params, orderings
+
+__all__ = ["FastSHMTracker", "SHMTracker", "transition_matrix"]
+
+
+def transition_matrix(n_orderings: int, p_stay: float) -> NDArray[np.float64]:
+    """Markov transition Π (L, L) of the ordering: stay ``p_stay``, else uniform (eq. 1)."""
+    if n_orderings == 1:
+        return np.ones((1, 1))
+    pi = np.full((n_orderings, n_orderings), (1.0 - p_stay) / (n_orderings - 1))
+    np.fill_diagonal(pi, p_stay)
+    return pi
+
+
+def _softmax(logw: NDArray[np.float64], axis: int = -1) -> NDArray[np.float64]:
+    w = np.exp(logw - np.max(logw, axis=axis, keepdims=True))
+    return w / np.sum(w, axis=axis, keepdims=True)
+
+
+class _OrderingEvidence:
+    """Markov prior and squared-difference evidence of the orderings (§2.2, §3.3)."""
+
+    def __init__(self, n_orderings: int, p_stay: float, lam: float, rate: float, floor: float):
+        self.log_pi = np.log(np.maximum(transition_matrix(n_orderings, p_stay), 1e-300))
+        self.pi = transition_matrix(n_orderings, p_stay)
+        self.lam = lam
+        self.rate = rate
+        self.floor = floor
+        self.scale: NDArray[np.float64] | None = None
+
+    def log_evidence(self, mse: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Σ_m −lam e^{j,m} / ē_m per ordering, shape (L,), from ``mse`` (L, M).
+
+        Updates ``ē`` afterwards, so a frame's own matches do not rescale its evidence.
+        """
+        valid = np.isfinite(mse)
+        best = np.min(np.where(valid, mse, np.inf), axis=0)
+        seen = np.isfinite(best)
+        if self.scale is None:
+            self.scale = np.full(mse.shape[1], self.floor)
+            self.scale[seen] = np.maximum(best[seen], self.floor)
+        ratio = np.where(valid, mse, self.scale[None, :]) / self.scale[None, :]
+        out = -self.lam * ratio.sum(axis=1)
+        # ē_m: moving average of the best match, the mean of e under the true ordering.
+        upd = (1 - self.rate) * self.scale + self.rate * np.where(seen, best, self.scale)
+        self.scale = np.maximum(upd, self.floor)
+        return out
+
+
+def _check_shm(p_stay: float, lam: float, mse_rate: float, mse_floor: float) -> None:
+    if not (np.isfinite(p_stay) and 0 < p_stay <= 1):
+        raise ValueError(f"p_stay must be in (0, 1], got {p_stay!r}")
+    if not (np.isfinite(lam) and lam >= 0):
+        raise ValueError(f"lam must be finite and >= 0, got {lam!r}")
+    if not (np.isfinite(mse_rate) and 0 < mse_rate <= 1):
+        raise ValueError(f"mse_rate must be in (0, 1], got {mse_rate!r}")
+    if not (np.isfinite(mse_floor) and mse_floor > 0):
+        raise ValueError(f"mse_floor must be finite and > 0, got {mse_floor!r}")
+
+
+class _SHMBase(Tracker):
+    """Parameter handling and measurement shared by the two SHM trackers."""
+
+    def _configure(
+        self,
+        motion: str,
+        process_std: float,
+        a1: float,
+        a2: float,
+        velocity_std: float,
+        r_gain: float,
+        r_floor: float,
+        search_radius: int,
+        step: int,
+        min_visible: float,
+        support: str,
+        p_stay: float,
+        lam: float,
+        mse_rate: float,
+        mse_floor: float,
+    ) -> None:
+        self.model = motion_model(motion, process_std, a1, a2, velocity_std)
+        check_noise(r_gain, r_floor)
+        check_matcher_params(search_radius, step, min_visible, support)
+        _check_shm(p_stay, lam, mse_rate, mse_floor)
+        self.r_gain = float(r_gain)
+        self.r_floor = float(r_floor)
+        self.p_stay = float(p_stay)
+        self.lam = float(lam)
+        self.mse_rate = float(mse_rate)
+        self.mse_floor = float(mse_floor)
+        self._matcher_params = dict(
+            search_radius=search_radius, step=step, min_visible=min_visible, support=support
+        )
+
+    def _init_common(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
+        # orderings() refuses more than 4 objects with a message saying what to do.
+        self.orderings = orderings(boxes.shape[0])
+        self._rows = self.orderings.astype(np.int64)
+        self.matcher = LayeredMatcher(frame, boxes, **self._matcher_params)
+        self._sizes = boxes[:, 2:].copy()
+        self._origin = boxes[:, :2] + boxes[:, 2:] / 2
+        n_order = self.orderings.shape[0]
+        self.order_prob = np.full(n_order, 1.0 / n_order)
+        self._evidence = _OrderingEvidence(
+            n_order, self.p_stay, self.lam, self.mse_rate, self.mse_floor
+        )
+        self._log_u = -np.log(float(frame.shape[0] * frame.shape[1]))
+
+
+class SHMTracker(_SHMBase):
+    """SHM filter (§3.2): Gaussian sum over depth orderings with GPB2 collapsing.
+
+    Parameters
+    ----------
+    motion, process_std, a1, a2, velocity_std, r_gain, r_floor, search_radius, step, \
+min_visible, support
+        As for ``trackers.kalman_tracker.KalmanTracker``.
+    p_stay : float
+        Probability that the depth ordering stays the same from one frame to the next.
+    lam : float
+        Sharpness of the squared-difference evidence ``exp(−lam e / ē)``.
+    mse_rate : float
+        Rate of the moving average ``ē`` of the best squared-difference mean, in (0, 1].
+    mse_floor : float
+        Smallest ``ē``, intensity² (so exact synthetic matches do not give ē = 0).
+    use_mse : bool
+        Include the squared-difference evidence in the hypothesis weights (§3.3's
+        generalised measurement); False is the plain §3.2 filter on positions only.
+    rng : Generator, int or None
+        Unused (the filter is deterministic); accepted like every tracker's.
+
+    Attributes
+    ----------
+    orderings : ndarray of shape (L, M), int16
+        Depth orderings after ``init``, each row nearest first.
+    order_prob : ndarray of shape (L,)
+        P(ordering) after the last step (also ``Estimate.extras["order_prob"]``).
+
+    Example
+    -------
+    >>> import trackers
+    >>> tracker = trackers.make("shm", p_stay=0.9)
+    """
+
+    name = "shm"
+
+    def __init__(
+        self,
+        *,
+        motion: str = "cv",
+        process_std: float = 1.5,
+        a1: float = 2.0,
+        a2: float = -1.0,
+        velocity_std: float = 5.0,
+        r_gain: float = 0.01,
+        r_floor: float = 0.5,
+        search_radius: int = 12,
+        step: int = 1,
+        min_visible: float = 0.25,
+        support: str = "box",
+        p_stay: float = 0.9,
+        lam: float = 1.0,
+        mse_rate: float = 0.1,
+        mse_floor: float = 25.0,
+        use_mse: bool = True,
+        rng: RngLike = None,
+    ) -> None:
+        super().__init__(rng=rng)
+        self._configure(
+            motion, process_std, a1, a2, velocity_std, r_gain, r_floor, search_radius, step,
+            min_visible, support, p_stay, lam, mse_rate, mse_floor,
+        )
+        self.use_mse = bool(use_mse)
+
+    def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
+        self._init_common(frame, boxes)
+        n_obj = boxes.shape[0]
+        n_order = self.orderings.shape[0]
+        self.joint = self.model.joint(n_obj)
+        d = self.model.dim
+        self._pos = np.array([[m * d, m * d + 1] for m in range(n_obj)])  # (M, 2) indices
+        # One Gaussian per ordering; the state is the displacement from the first centres.
+        self.kf = KalmanFilter(
+            np.zeros((n_order, self.joint.dim)), self.joint.P0, self.joint.F, self.joint.Q,
+            self.joint.H, np.eye(2 * n_obj) * self.r_floor,
+        )
+        ii, jj = np.divmod(np.arange(n_order * n_order), n_order)
+        self._ii, self._jj = ii, jj
+        self._blocks = [self.joint.H[2 * m : 2 * m + 2] for m in range(n_obj)]
+
+    def _step(self, frame: NDArray[np.uint8]) -> Estimate:
+        n_order = self.orderings.shape[0]
+        kf = self.kf
+        kf.predict()
+        mean = self.order_prob @ kf.x
+        meas = self.matcher.measure(frame, self._origin + mean[self._pos], self._rows)
+        z = meas.centres - self._origin[None]
+        r = measurement_cov(meas.mse, self.r_gain, self.r_floor)
+        ii, jj = self._ii, self._jj
+        # Prediction i updated with measurement j, for every pair (i, j).
+        pairs = KalmanFilter(kf.x[ii], kf.P[ii], kf.F, kf.Q, kf.H, kf.R[ii])
+        loglik = np.zeros(ii.size)
+        for m, h in enumerate(self._blocks):
+            zm = z[jj, m]
+            pairs.update(zm, R=r[jj, m], H=h)
+            missed = np.isnan(zm).any(axis=1)
+            # A missed object contributes the uniform density of an improper measurement.
+            loglik += np.where(missed, self._log_u, pairs.log_likelihood)
+        log_ev = self._evidence.log_evidence(meas.mse)
+        logw = (
+            self._evidence.log_pi[ii, jj]
+            + np.log(np.maximum(self.order_prob, 1e-300))[ii]
+            + loglik
+        )
+        if self.use_mse:
+            logw = logw + log_ev[jj]
+        logw = logw.reshape(n_order, n_order)  # [i, j]
+        top = logw.max()
+        log_pj = top + np.log(np.exp(logw - top).sum(axis=0))
+        self.order_prob = _softmax(log_pj)
+        # Collapse (moment matching) over the previous ordering i, per ordering j.
+        w = _softmax(logw, axis=0)  # P(i | j)
+        mu = pairs.x.reshape(n_order, n_order, -1)
+        cov = pairs.P.reshape(n_order, n_order, *pairs.P.shape[1:])
+        new_mu = np.einsum("ij,ijn->jn", w, mu)
+        dev = mu - new_mu[None]
+        new_cov = np.einsum("ij,ijab->jab", w, cov + dev[..., :, None] * dev[..., None, :])
+        kf.x = new_mu
+        kf.P = new_cov
+        kf.x_post, kf.P_post = new_mu.copy(), new_cov.copy()
+        centres = self._origin + (self.order_prob @ new_mu)[self._pos]
+        return Estimate(
+            boxes=boxes_at(centres, self._sizes),
+            extras={"order_prob": self.order_prob.copy()},
+        )
+
+
+class FastSHMTracker(_SHMBase):
+    """Fast SHM filter (§3.3): ordering posterior from the matches, one Kalman filter.
+
+    Parameters
+    ----------
+    motion, process_std, a1, a2, velocity_std, r_gain, r_floor, search_radius, step, \
+min_visible, support, p_stay, lam, mse_rate, mse_floor
+        As for ``SHMTracker``.
+    rng : Generator, int or None
+        Unused (the filter is deterministic); accepted like every tracker's.
+
+    Attributes
+    ----------
+    orderings : ndarray of shape (L, M), int16
+        Depth orderings after ``init``, each row nearest first.
+    order_prob : ndarray of shape (L,)
+        P(ordering) after the last step (also ``Estimate.extras["order_prob"]``).
+
+    Example
+    -------
+    >>> import trackers
+    >>> tracker = trackers.make("shm-fast", search_radius=12)
+    """
+
+    name = "shm-fast"
+
+    def __init__(
+        self,
+        *,
+        motion: str = "cv",
+        process_std: float = 1.5,
+        a1: float = 2.0,
+        a2: float = -1.0,
+        velocity_std: float = 5.0,
+        r_gain: float = 0.01,
+        r_floor: float = 0.5,
+        search_radius: int = 12,
+        step: int = 1,
+        min_visible: float = 0.25,
+        support: str = "box",
+        p_stay: float = 0.9,
+        lam: float = 1.0,
+        mse_rate: float = 0.1,
+        mse_floor: float = 25.0,
+        rng: RngLike = None,
+    ) -> None:
+        super().__init__(rng=rng)
+        self._configure(
+            motion, process_std, a1, a2, velocity_std, r_gain, r_floor, search_radius, step,
+            min_visible, support, p_stay, lam, mse_rate, mse_floor,
+        )
+
+    def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
+        self._init_common(frame, boxes)
+        m = self.model
+        self.kf = KalmanFilter(
+            np.zeros((boxes.shape[0], m.dim)), m.P0, m.F, m.Q, m.H, np.eye(2) * self.r_floor
+        )
+
+    def _step(self, frame: NDArray[np.uint8]) -> Estimate:
+        kf = self.kf
+        kf.predict()
+        meas = self.matcher.measure(frame, self._origin + kf.x[:, :2], self._rows)
+        # P(s_t = j | Y_t) ∝ exp(−lam Σ_m e^{j,m}/ē_m) Σ_i Π_ij P(s_{t−1} = i)  (§3.3)
+        prior = self.order_prob @ self._evidence.pi
+        logp = np.log(np.maximum(prior, 1e-300)) + self._evidence.log_evidence(meas.mse)
+        self.order_prob = _softmax(logp)
+        valid = np.isfinite(meas.mse)  # (L, M)
+        q = self.order_prob[:, None] * valid
+        mass = q.sum(axis=0)  # (M,)
+        seen = mass >= 0.5
+        q = q / np.where(mass > 0, mass, 1.0)
+        y = np.nan_to_num(meas.centres - self._origin[None])  # (L, M, 2)
+        r = measurement_cov(meas.mse, self.r_gain, self.r_floor)  # (L, M, 2, 2)
+        # Moment-matched mixture of the hypothesized measurements, per object.
+        y_hat = np.einsum("lm,lmc->mc", q, y)
+        dev = y - y_hat[None]
+        r_hat = np.einsum("lm,lmab->mab", q, r + dev[..., :, None] * dev[..., None, :])
+        y_hat[~seen] = np.nan
+        kf.update(y_hat, R=r_hat)
+        centres = self._origin + kf.x[:, :2]
+        return Estimate(
+            boxes=boxes_at(centres, self._sizes),
+            extras={"order_prob": self.order_prob.copy()},
+        )
