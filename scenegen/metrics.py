@@ -43,6 +43,9 @@ __all__ = [
     "mcnemar",
     "mcnemar_counts",
     "mean_over_tracked",
+    "depth_order_accuracy",
+    "ordering_index",
+    "overlap_fraction",
     "otb_curves",
     "precision_recall",
     "recovery_rate",
@@ -616,3 +619,99 @@ def idf1(gt: ArrayLike, est: ArrayLike, *, iou_threshold: float = 0.5) -> float:
     rows, cols = linear_sum_assignment(-idtp_pair)
     idtp = float(idtp_pair[rows, cols].sum())
     return 2.0 * idtp / (n_g + n_e)
+
+
+def ordering_index(depth: ArrayLike, orderings: ArrayLike) -> NDArray[np.intp]:
+    """Index of the true depth ordering per frame, for SHM's ordering probabilities.
+
+    Parameters
+    ----------
+    depth : array_like of int, shape (T, M)
+        Depth rank of each target per frame (0 = nearest), e.g. ``gt.depth`` of the targets.
+    orderings : array_like of int, shape (L, M)
+        Each row lists target positions (indices into M), nearest first.
+
+    Returns
+    -------
+    ndarray of int, shape (T,)
+        Row of ``orderings`` equal to the targets sorted nearest first (ties keep target
+        order), or -1 where no row matches.
+    """
+    d = np.asarray(depth)
+    o = np.asarray(orderings)
+    if d.ndim != 2 or o.ndim != 2 or o.shape[1] != d.shape[1]:
+        raise ValueError(f"depth (T, M) and orderings (L, M) disagree: {d.shape}, {o.shape}")
+    true = np.argsort(d, axis=1, kind="stable")
+    eq = np.all(true[:, None, :] == o[None, :, :], axis=2)
+    return np.where(eq.any(axis=1), np.argmax(eq, axis=1), -1)
+
+
+def overlap_fraction(a: ArrayLike, b: ArrayLike) -> FloatArray:
+    """Intersection area over the smaller box's area (broadcast, (..., 4) each); 0 if none."""
+    inter = np.nan_to_num(intersection_area(a, b), nan=0.0)
+    small = np.nan_to_num(np.minimum(box_area(a), box_area(b)), nan=0.0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(small > 0, inter / np.where(small > 0, small, 1.0), 0.0)
+
+
+def depth_order_accuracy(
+    order_prob: ArrayLike,
+    orderings: ArrayLike,
+    depth: ArrayLike,
+    boxes: ArrayLike,
+    *,
+    min_overlap: float = 0.1,
+) -> float:
+    """Percentage of overlapping target pairs whose depth order the MAP ordering gets right.
+
+    Depth order is only observable where targets overlap (SHM §5: non-overlapping objects
+    give identical measurements under every ordering), so the score counts, over frames
+    and unordered target pairs whose ground-truth boxes overlap, how often the most
+    probable ordering puts the pair in the true front/back order. (open) "Overlap" means
+    the intersection covers at least ``min_overlap`` of the smaller box: a grazing contact
+    of a few pixels says nothing about depth. Frames whose probabilities are NaN (frame 0)
+    are skipped.
+
+    Parameters
+    ----------
+    order_prob : array_like of shape (T, L)
+        P(ordering) per frame.
+    orderings : array_like of int, shape (L, M)
+        Target positions, nearest first.
+    depth : array_like of int, shape (T, M)
+        True depth rank per target (0 = nearest).
+    boxes : array_like of shape (T, M, 4)
+        Ground-truth boxes of the targets (NaN where absent).
+    min_overlap : float
+        Smallest intersection / smaller-box area of a pair that counts, in (0, 1].
+
+    Returns
+    -------
+    float
+        Accuracy in percent; NaN if no pair ever overlaps.
+    """
+    p = np.asarray(order_prob, dtype=np.float64)
+    o = np.asarray(orderings)
+    d = np.asarray(depth)
+    b = _boxes(boxes)
+    t_n, m_n = d.shape
+    if p.shape[0] != t_n or b.shape[:2] != (t_n, m_n) or o.shape[1] != m_n:
+        raise ValueError(
+            f"shapes disagree: order_prob {p.shape}, orderings {o.shape}, depth {d.shape}, "
+            f"boxes {b.shape}"
+        )
+    rank = np.argsort(o, axis=1)  # rank[l, m]: position of target m in ordering l
+    if not 0.0 < min_overlap <= 1.0:
+        raise ValueError(f"min_overlap must be in (0, 1], got {min_overlap}")
+    over = overlap_fraction(b[:, :, None, :], b[:, None, :, :])
+    right = total = 0
+    for t in range(t_n):
+        if not np.all(np.isfinite(p[t])):
+            continue
+        best = rank[int(np.argmax(p[t]))]
+        for i in range(m_n):
+            for j in range(i + 1, m_n):
+                if over[t, i, j] >= min_overlap and d[t, i] != d[t, j]:
+                    total += 1
+                    right += int((best[i] < best[j]) == (d[t, i] < d[t, j]))
+    return 100.0 * right / total if total else float("nan")

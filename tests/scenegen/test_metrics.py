@@ -193,3 +193,35 @@ def test_idf1_hand_worked():
     assert m.idf1(gt, np.full((4, 1, 4), np.nan)) == 0.0
     with pytest.raises(ValueError, match="shapes"):
         m.idf1(gt, est[:2])
+
+
+def test_ordering_index_and_depth_order_accuracy():
+    orderings = np.array([[0, 1], [1, 0]])
+    depth = np.array([[0, 1], [1, 0], [0, 1]])
+    np.testing.assert_array_equal(m.ordering_index(depth, orderings), [0, 1, 0])
+    np.testing.assert_array_equal(m.ordering_index(depth, orderings[:1]), [0, -1, 0])
+    boxes = np.array(
+        [
+            [[0, 0, 10, 10], [5, 0, 10, 10]],  # overlap half of the smaller box
+            [[0, 0, 10, 10], [5, 0, 10, 10]],
+            [[0, 0, 10, 10], [9.5, 0, 10, 10]],  # 5% overlap: below min_overlap
+        ],
+        dtype=float,
+    )
+    assert m.overlap_fraction(boxes[0, 0], boxes[0, 1]) == pytest.approx(0.5)
+    prob = np.array([[0.9, 0.1], [0.3, 0.7], [0.0, 1.0]])
+    # frames 0 and 1 right, frame 2 does not count
+    assert m.depth_order_accuracy(prob, orderings, depth, boxes) == 100.0
+    wrong = prob[:, ::-1]
+    assert m.depth_order_accuracy(wrong, orderings, depth, boxes) == 0.0
+    # with a lower bar, frame 2 counts too and is wrong: 2 right out of 3
+    assert m.depth_order_accuracy(prob, orderings, depth, boxes, min_overlap=0.01) == (
+        pytest.approx(200 / 3)
+    )
+    # NaN probabilities (frame 0 of a tracker) are skipped
+    prob_nan = prob.copy()
+    prob_nan[0] = np.nan
+    assert m.depth_order_accuracy(prob_nan, orderings, depth, boxes) == 100.0
+    far = boxes.copy()
+    far[:, 1, 0] = 50
+    assert math.isnan(m.depth_order_accuracy(prob, orderings, depth, far))
