@@ -1,0 +1,113 @@
+"""The CLI: verbs, exit codes (0 ok, 1 invalid data, 2 usage/config) and one-line errors."""
+
+from __future__ import annotations
+
+import json
+
+import h5py
+import numpy as np
+import pytest
+
+from scenegen.cli import main
+from scenegen.io import read
+
+
+def run(capsys, *argv):
+    code = main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_presets_json(capsys):
+    code, out, _ = run(capsys, "presets", "--json")
+    assert code == 0
+    names = [p["name"] for p in json.loads(out)]
+    assert names == ["dps-synthetic", "dps-occlusion", "kams-a", "kams-b", "kams-c", "kams-d",
+                     "shm-crossing"]  # fmt: skip
+
+
+def test_generate_inspect_validate_preview_export(tmp_path, capsys):
+    out_h5 = tmp_path / "s.h5"
+    code, out, _ = run(capsys, "generate", "--preset", "kams-b", "--seed", "2", "-o", out_h5,
+                       "--frames", "6", "--compression", "lzf")  # fmt: skip
+    assert code == 0 and out_h5.exists()
+    seq = read(out_h5)
+    assert seq.n_frames == 6 and seq.seed == 2
+    code, out, _ = run(capsys, "inspect", out_h5, "--json")
+    info = json.loads(out)
+    assert code == 0 and info["sequences"][0]["compression"] == "lzf"
+    assert info["sequences"][0]["entities"] == {"clutter": 300, "target": 1}
+    assert run(capsys, "validate", out_h5)[0] == 0
+    for ext in ("png", "gif"):
+        code, _, _ = run(capsys, "preview", out_h5, "-o", tmp_path / f"p.{ext}")
+        assert code == 0 and (tmp_path / f"p.{ext}").stat().st_size > 1000
+    code, _, _ = run(capsys, "export", out_h5, "--format", "mot", "-o", tmp_path / "mot")
+    assert code == 0
+    rows = np.loadtxt(tmp_path / "mot" / "gt" / "gt.txt", delimiter=",", ndmin=2)
+    assert rows.shape == (6, 9)
+    assert rows[:, 0].tolist() == [1, 2, 3, 4, 5, 6] and set(rows[:, 1]) == {1}
+    np.testing.assert_allclose(rows[:, 2:6], seq.gt.box[:, 0])
+    np.testing.assert_allclose(rows[:, 8], seq.gt.visibility[:, 0], atol=1e-6)
+    ini = (tmp_path / "mot" / "seqinfo.ini").read_text()
+    assert "seqLength=6" in ini and "imWidth=320" in ini
+    assert len(list((tmp_path / "mot" / "img1").glob("*.png"))) == 6
+
+
+def test_generate_from_yaml_config(tmp_path, capsys):
+    cfg = tmp_path / "c.yaml"
+    cfg.write_text(
+        "width: 40\nheight: 30\nn_frames: 4\nentities:\n"
+        "  - {name: a, role: target, position: [20, 15], appearance: {size: [5, 5]}}\n"
+    )
+    code, _, _ = run(capsys, "generate", "--config", cfg, "-o", tmp_path / "c.h5")
+    assert code == 0 and read(tmp_path / "c.h5").config.width == 40
+
+
+@pytest.mark.parametrize(
+    ("config", "field"),
+    [
+        ({"width": -3, "height": 10, "n_frames": 5}, "width"),
+        ({"width": 30, "height": 10, "n_frames": 5,
+          "entities": [{"name": "a", "role": "hero", "position": [1, 1]}]}, "entities[0].role"),
+        ({"width": 30, "height": 10, "n_frames": 5,
+          "entities": [{"name": "a", "role": "target", "position": [1, 1]},
+                       {"name": "b", "role": "target", "position": [1, 1]}]}, "entities[1].depth"),
+        ({"width": 30, "height": 10, "n_frames": 5,
+          "entities": [{"name": "a", "role": "target", "position": [1, 1],
+                        "motion": {"x": {"sigma": 1}, "y": {"sigma": 1, "boundary": "free"}}}]},
+         "entities[0].motion.x.boundary"),
+    ],
+)  # fmt: skip
+def test_bad_config_exits_2_with_one_line(tmp_path, capsys, config, field):
+    path = tmp_path / "bad.json"
+    path.write_text(json.dumps(config))
+    code, out, err = run(capsys, "generate", "--config", path, "-o", tmp_path / "x.h5")
+    assert code == 2 and out == ""
+    assert len(err.strip().splitlines()) == 1 and field in err and "Traceback" not in err
+    assert not (tmp_path / "x.h5").exists()
+
+
+def test_usage_errors_exit_2(tmp_path, capsys):
+    assert run(capsys, "generate", "--preset", "nope", "-o", tmp_path / "x.h5")[0] == 2
+    assert run(capsys, "generate", "-o", tmp_path / "x.h5")[0] == 2
+    assert run(capsys, "frobnicate")[0] == 2
+    code, _, err = run(capsys, "generate", "--preset", "kams-a", "-o", tmp_path / "x.h5",
+                       "--compression", "zstd")  # fmt: skip
+    assert code == 2 and "--compression" in err
+    code, _, err = run(capsys, "generate", "--preset", "kams-a", "-o", tmp_path / "no/dir/x.h5")
+    assert code == 2 and "does not exist" in err
+
+
+@pytest.mark.parametrize("verb", ["inspect", "validate"])
+def test_bad_files_exit_1(tmp_path, capsys, verb):
+    junk = tmp_path / "junk.h5"
+    junk.write_bytes(b"not hdf5 at all")
+    code, _, err = run(capsys, verb, junk)
+    assert code == 1 and len(err.strip().splitlines()) == 1 and "not an HDF5 file" in err
+    other = tmp_path / "other.h5"
+    with h5py.File(other, "w") as f:
+        f.attrs["schema"] = "other/9"
+    code, _, err = run(capsys, verb, other)
+    assert code == 1 and "schema is 'other/9'" in err and "Traceback" not in err
+    code, _, err = run(capsys, verb, tmp_path / "missing.h5")
+    assert code == 1 and "no such file" in err

@@ -1,0 +1,142 @@
+"""Config validation: every invalid config raises ConfigError naming the field and value."""
+
+from __future__ import annotations
+
+import copy
+import json
+
+import pytest
+import yaml
+
+import scenegen
+from scenegen.config import from_dict, load_config, to_dict
+from scenegen.errors import ConfigError
+
+
+def base() -> dict:
+    return {
+        "width": 64,
+        "height": 48,
+        "n_frames": 5,
+        "entities": [
+            {
+                "name": "a",
+                "role": "target",
+                "position": [20, 20],
+                "appearance": {"shape": "ellipse", "size": [9, 9]},
+                "motion": {
+                    "x": {"sigma": 1, "boundary": "reflect"},
+                    "y": {"sigma": 1, "boundary": "clamp"},
+                },  # fmt: skip
+                "depth": 1,
+            },
+            {"name": "b", "role": "occluder", "position": [30, 30], "depth": 2},
+        ],
+    }
+
+
+def mutate(path: list, value=None, delete: bool = False) -> dict:
+    d = copy.deepcopy(base())
+    node = d
+    for key in path[:-1]:
+        node = node[key]
+    if delete:
+        del node[path[-1]]
+    else:
+        node[path[-1]] = value
+    return d
+
+
+@pytest.mark.parametrize(
+    ("data", "match"),
+    [
+        (mutate(["width"], -3), r"^width: must be >= 1, got -3"),
+        (mutate(["height"], 0), r"^height: must be >= 1, got 0"),
+        (mutate(["n_frames"], 2.5), r"^n_frames: must be an integer, got 2.5"),
+        (mutate(["entities", 0, "role"], "hero"), r"^entities\[0\]\.role: must be one of .*'hero'"),
+        (mutate(["entities", 1, "depth"], 1), r"^entities\[1\]\.depth: depth tie: 'b' and 'a'"),
+        (mutate(["entities", 0, "motion", "x", "boundary"], delete=True),
+         r"^entities\[0\]\.motion\.x\.boundary: is required"),
+        (mutate(["entities", 0, "motion", "y", "boundary"], "bounce"),
+         r"^entities\[0\]\.motion\.y\.boundary: must be one of reflect, clamp, free; got 'bounce'"),
+        (mutate(["entities", 0, "motion", "x", "sigma"], -1),
+         r"^entities\[0\]\.motion\.x\.sigma: must be >= 0, got -1"),
+        (mutate(["entities", 0, "appearance", "size"], [0, 4]),
+         r"^entities\[0\]\.appearance\.size: width and height must be >= 1"),
+        (mutate(["entities", 0, "appearance", "colors"], [[300, 0, 0]]),
+         r"^entities\[0\]\.appearance\.colors\[0\]: colour must be three integers in 0\.\.255"),
+        (mutate(["entities", 0, "speed"], 3), r"^entities\[0\]\.speed: unknown field"),
+        (mutate(["entities", 1, "name"], "a"), r"^entities\[1\]\.name: duplicate name 'a'"),
+        (mutate(["entities", 1, "mimic"], "zed"), r"^entities\[1\]\.mimic: no entity named 'zed'"),
+        (mutate(["entities", 1, "position"], delete=True),
+         r"^entities\[1\]\.position: is required"),
+        (mutate(["entities", 0, "disappear"], 0), r"^entities\[0\]\.disappear: must be > appear"),
+        (mutate(["entities", 0, "depth"], [[2, 1]]), r"^entities\[0\]\.depth: the first keyframe"),
+        (mutate(["background"], {"kind": "plaid"}), r"^background\.kind: must be one of"),
+        (mutate(["clutter"], [{"count": -1}]), r"^clutter\[0\]\.count: must be >= 0, got -1"),
+        (mutate(["sensor_noise"], float("nan")), r"^sensor_noise: must be finite"),
+        (mutate(["entities"], "many"), r"^entities: must be a list, got 'many'"),
+        ([1, 2], r"must be a mapping"),
+    ],
+)  # fmt: skip
+def test_invalid_configs_name_the_field(data, match):
+    with pytest.raises(ConfigError, match=match):
+        from_dict(data)
+
+
+def test_depth_tie_after_a_keyframe():
+    d = base()
+    d["entities"][1]["depth"] = [[0, 2], [3, 1]]
+    with pytest.raises(ConfigError, match=r"depth tie: .* at frame 3"):
+        from_dict(d)
+
+
+def test_depth_shorthand_and_defaults():
+    cfg = from_dict(base())
+    assert cfg.entities[0].depth == ((0, 1),)
+    assert cfg.entities[0].motion.x.a1 == 2.0 and cfg.entities[0].motion.x.a2 == -1.0
+
+
+@pytest.mark.parametrize("name", scenegen.presets.names())
+def test_presets_round_trip_through_plain_data(name):
+    cfg = scenegen.presets.get(name)
+    data = json.loads(json.dumps(to_dict(cfg)))
+    assert from_dict(data) == cfg
+
+
+def test_unknown_preset_lists_valid_ones():
+    with pytest.raises(ConfigError, match="unknown preset 'nope'; valid presets: dps-synthetic"):
+        scenegen.presets.get("nope")
+
+
+def test_every_preset_has_a_paper_docstring():
+    for name in scenegen.presets.names():
+        text = scenegen.presets.describe(name)
+        assert "paper" in text, name
+        doc = scenegen.presets._PRESETS[name].__doc__
+        assert "Differs from the paper" in doc, name
+
+
+@pytest.mark.parametrize("suffix", [".yaml", ".json"])
+def test_load_config_files(tmp_path, suffix):
+    path = tmp_path / f"scene{suffix}"
+    text = yaml.safe_dump(base()) if suffix == ".yaml" else json.dumps(base())
+    path.write_text(text)
+    assert load_config(path) == from_dict(base())
+
+
+def test_load_config_errors_name_the_file(tmp_path):
+    bad = tmp_path / "bad.json"
+    bad.write_text("{not json")
+    with pytest.raises(ConfigError, match=r"bad\.json: not valid JSON"):
+        load_config(bad)
+    wrong = tmp_path / "scene.txt"
+    wrong.write_text("{}")
+    with pytest.raises(ConfigError, match=r"scene\.txt: config must be \.yaml"):
+        load_config(wrong)
+    with pytest.raises(ConfigError, match="cannot read config"):
+        load_config(tmp_path / "missing.yaml")
+    inv = tmp_path / "inv.yaml"
+    inv.write_text(yaml.safe_dump(mutate(["width"], -1)))
+    with pytest.raises(ConfigError, match=r"inv\.yaml: width: must be >= 1"):
+        load_config(inv)
