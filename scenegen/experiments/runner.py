@@ -41,7 +41,7 @@ __all__ = [
     "write_json_atomic",
 ]
 
-SCHEDULER_TIMEOUT = 8.0
+SCHEDULER_TIMEOUT = 5.0
 """Seconds to wait for a Dask scheduler before giving up (the contract allows 10)."""
 
 _DECIMALS = 6
@@ -403,7 +403,7 @@ def _run_dask(
                 pure=False,
             )
             futures[fut.key] = (fut, t)
-        for fut in dask_completed([f for f, _ in futures.values()]):
+        for fut in dask_completed([f for f, _ in futures.values()], loop=client.loop):
             store(futures[fut.key][1], fut.result())
     finally:
         client.close()

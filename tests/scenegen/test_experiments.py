@@ -1,0 +1,157 @@
+"""Experiments: identical results whatever the executor, resumable runs, bad input."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shutil
+import signal
+import time
+
+import pytest
+
+from scenegen.cli import experiment as cli_experiment
+from scenegen.errors import ConfigError
+from scenegen.experiments import derive_seed, get, names, run_experiment
+from scenegen.experiments.runner import Task, execute, plan_tasks
+
+# A small stochastic sweep: two runs of two methods on a shortened sequence.
+NAME = "shm-depth"
+KW = {"runs": 2, "quick": True, "progress": False, "figures": False}
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory):
+    out = tmp_path_factory.mktemp("ref")
+    run_experiment(NAME, out, jobs=1, **KW)
+    return out
+
+
+def test_seed_derivation_is_stable():
+    # A fixed value: a change of hashing would silently change every published result.
+    assert derive_seed(0, "dps-synthetic", "dps", "dps-synthetic", "lam=20", 3) == (
+        derive_seed(0, "dps-synthetic", "dps", "dps-synthetic", "lam=20", 3)
+    )
+    assert derive_seed("a") == 6023598183589259276
+    assert derive_seed(0, "x", 1) != derive_seed(0, "x", 2)
+    t = Task(NAME, "shm", "shm-crossing", "", None, 0, 0, True)
+    other_run = Task(NAME, "shm", "shm-crossing", "", None, 1, 0, True)
+    assert t.tracker_seed() != other_run.tracker_seed()
+
+
+def test_same_bytes_with_two_local_processes(reference, tmp_path):
+    run_experiment(NAME, tmp_path, jobs=2, **KW)
+    assert (tmp_path / "results.json").read_bytes() == (reference / "results.json").read_bytes()
+    assert (tmp_path / "table.md").read_bytes() == (reference / "table.md").read_bytes()
+
+
+def test_same_bytes_on_a_dask_cluster(reference, tmp_path):
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(
+        n_workers=2, processes=True, threads_per_worker=1, dashboard_address=None
+    ) as cluster:
+        run_experiment(NAME, tmp_path, scheduler=cluster.scheduler_address, **KW)
+    assert (tmp_path / "results.json").read_bytes() == (reference / "results.json").read_bytes()
+
+
+def test_lost_dask_worker_loses_no_results(reference, tmp_path):
+    distributed = pytest.importorskip("distributed")
+    tasks = plan_tasks(get(NAME), runs=2, seed=0, quick=True)
+    killed: list[int] = []
+    with distributed.LocalCluster(
+        n_workers=2, processes=True, threads_per_worker=1, dashboard_address=None
+    ) as cluster:
+        pids = [w.process.pid for w in cluster.workers.values()]
+
+        def kill_a_worker(task):
+            if not killed:  # SIGKILL one worker as soon as the first run is stored
+                os.kill(pids[0], signal.SIGKILL)
+                killed.append(pids[0])
+
+        execute(tasks, tmp_path / "runs", scheduler=cluster.scheduler_address,
+                progress=False, on_done=kill_a_worker)
+    assert killed
+    assert len(list((tmp_path / "runs").glob("*.json"))) == len(tasks)
+    run_experiment(NAME, tmp_path, jobs=1, **KW)
+    assert (tmp_path / "results.json").read_bytes() == (reference / "results.json").read_bytes()
+
+
+def test_resume_skips_stored_runs_and_gives_same_results(reference, tmp_path):
+    shutil.copytree(reference / "runs", tmp_path / "runs")
+    stored = sorted((tmp_path / "runs").glob("*.json"))
+    assert len(stored) == 6
+    # An interrupted sweep: half the runs are missing.
+    for p in stored[::2]:
+        p.unlink()
+    # Mark a surviving run: if it were recomputed, the marker would be gone.
+    kept = stored[1]
+    rec = json.loads(kept.read_text())
+    rec["marker"] = "stored before the interruption"
+    kept.write_text(json.dumps(rec))
+    run_experiment(NAME, tmp_path, jobs=1, **KW)
+    assert json.loads(kept.read_text())["marker"] == "stored before the interruption"
+    assert (tmp_path / "results.json").read_bytes() == (reference / "results.json").read_bytes()
+    assert len(list((tmp_path / "runs").glob("*.json"))) == 6
+    assert not list((tmp_path / "runs").glob(".*"))  # no temporary files left behind
+
+
+def test_stale_or_damaged_run_files_are_redone(reference, tmp_path):
+    shutil.copytree(reference / "runs", tmp_path / "runs")
+    stored = sorted((tmp_path / "runs").glob("*.json"))
+    stored[0].write_text("{not json")
+    rec = json.loads(stored[1].read_text())
+    rec["key"]["seed"] = 99  # a run of another base seed: not this sweep's
+    stored[1].write_text(json.dumps(rec))
+    run_experiment(NAME, tmp_path, jobs=1, **KW)
+    assert (tmp_path / "results.json").read_bytes() == (reference / "results.json").read_bytes()
+
+
+def test_results_json_is_deterministic_and_complete(reference):
+    doc = json.loads((reference / "results.json").read_text())
+    assert doc["experiment"] == NAME and doc["runs"] == 2 and doc["quick"] is True
+    assert {m["slug"] for m in doc["methods"]} == {"kalman", "shm", "shm-fast"}
+    assert "fidelity" in doc and "summary" in doc
+    text = (reference / "results.json").read_text()
+    assert "NaN" not in text and "Infinity" not in text
+
+
+def test_unknown_names_list_the_valid_ones(tmp_path):
+    with pytest.raises(ConfigError, match="valid experiments: dps-synthetic, dps-occlusion"):
+        run_experiment("nope", tmp_path)
+    with pytest.raises(ConfigError, match="valid methods: kalman, shm, shm-fast"):
+        run_experiment(NAME, tmp_path, methods=["dps"], **KW)
+    with pytest.raises(ConfigError, match="runs must be >= 1"):
+        run_experiment(NAME, tmp_path, runs=0, quick=True)
+    assert names() == [
+        "dps-synthetic", "dps-occlusion", "kams-accuracy", "kams-robustness", "shm-depth"
+    ]
+
+
+def test_unreachable_scheduler_fails_within_10_s(tmp_path):
+    address = "tcp://127.0.0.1:9"
+    t0 = time.monotonic()
+    with pytest.raises(ConfigError, match="tcp://127.0.0.1:9"):
+        run_experiment(NAME, tmp_path, scheduler=address, **KW)
+    assert time.monotonic() - t0 < 10.0
+
+
+def _cli(argv):
+    parser = argparse.ArgumentParser()
+    sub = parser.add_subparsers()
+    cli_experiment.register(sub)
+    args = parser.parse_args(argv)
+    return args.func(args)
+
+
+def test_experiment_verb(reference, tmp_path, capsys):
+    shutil.copytree(reference / "runs", tmp_path / "runs")
+    assert _cli(["experiment", NAME, "--runs", "2", "--quick", "--jobs", "1",
+                 "-o", str(tmp_path)]) == 0
+    assert capsys.readouterr().out.strip().endswith("results.json")
+    for f in ("results.json", "table.md", "ordering_probability.png"):
+        assert (tmp_path / f).stat().st_size > 0
+    with pytest.raises(ConfigError, match="valid experiments"):
+        _cli(["experiment", "bogus", "-o", str(tmp_path)])
+    with pytest.raises(ConfigError, match="valid methods"):
+        _cli(["experiment", NAME, "--method", "bogus", "-o", str(tmp_path)])
