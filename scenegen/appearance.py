@@ -83,28 +83,76 @@ def draw_template(
     Returns
     -------
     ndarray of shape (h, w, 4), uint8
-        RGB colours and alpha 255 inside the silhouette, 0 outside.
+        RGB colours and alpha 255 inside the silhouette, 0 outside, cropped to the
+        silhouette's box.
     """
     w, h = size if size is not None else app.size
-    mask = shape_mask(app.shape, w, h)
-    colors = np.asarray(app.colors, dtype=np.float64)
-    idx = _pattern_index(app.pattern, w, h, len(colors), app.stripe_width)
-    rgb = colors[idx]
-    if app.pattern == "texture":
-        if rng is None:
-            raise ValueError("the texture pattern needs an rng")
-        # Smooth noise keyed to the entity's stream; colour cycles over the palette.
-        noise = rng.standard_normal((h, w, 3)) * app.texture_sigma
-        if len(colors) > 1:
-            tint = rng.integers(0, len(colors), size=(max(h // 4, 1), max(w // 4, 1)))
-            tint = cv2.resize(tint.astype(np.float32), (w, h), interpolation=cv2.INTER_NEAREST)
-            rgb = colors[tint.astype(np.intp)]
-        rgb = rgb + noise
+    colors = np.asarray(app.colors, dtype=np.uint8)
+    return paint_template(
+        app.shape, app.pattern, w, h, colors,
+        stripe_width=app.stripe_width, texture_sigma=app.texture_sigma, rng=rng,
+    )  # fmt: skip
+
+
+def paint_template(
+    shape: str,
+    pattern: str,
+    w: int,
+    h: int,
+    colors: NDArray[np.uint8],
+    *,
+    stripe_width: int = 4,
+    texture_sigma: float = 20.0,
+    rng: np.random.Generator | None = None,
+) -> NDArray[np.uint8]:
+    """:func:`draw_template` without an :class:`Appearance` (validated inputs, fast path
+    for hundreds of clutter items): ``colors`` is (n, 3) uint8."""
+    if pattern != "texture":
+        # One gather through a cached index map (n = transparent) does the whole template.
+        lut = np.zeros((len(colors) + 1, 4), dtype=np.uint8)
+        lut[:-1, :3] = colors
+        lut[:-1, 3] = 255
+        return lut[_masked_index(shape, pattern, w, h, len(colors), stripe_width)]
+    if rng is None:
+        raise ValueError("the texture pattern needs an rng")
+    mask, crop = _mask_and_crop(shape, w, h)
+    # Smooth noise keyed to the entity's stream; colour cycles over the palette.
+    noise = rng.standard_normal((h, w, 3)) * texture_sigma
+    idx = _pattern_index(pattern, w, h, len(colors), stripe_width)
+    if len(colors) > 1:
+        tint = rng.integers(0, len(colors), size=(max(h // 4, 1), max(w // 4, 1)))
+        tint = cv2.resize(tint.astype(np.float32), (w, h), interpolation=cv2.INTER_NEAREST)
+        idx = tint.astype(np.intp)
+    rgb = np.clip(np.rint(colors[idx] + noise), 0, 255).astype(np.uint8)
     out = np.zeros((h, w, 4), dtype=np.uint8)
-    out[..., :3] = np.clip(np.rint(rgb), 0, 255).astype(np.uint8)
-    out[..., 3] = np.where(mask, 255, 0).astype(np.uint8)
-    out[~mask, :3] = 0
-    return _tight(out)
+    out[mask, :3] = rgb[mask]
+    out[mask, 3] = 255
+    return out if crop is None else np.ascontiguousarray(out[crop])
+
+
+@lru_cache(maxsize=2048)
+def _masked_index(
+    shape: str, pattern: str, w: int, h: int, n: int, stripe: int
+) -> NDArray[np.intp]:
+    """Colour index per pixel of the tight silhouette box; ``n`` marks transparent pixels."""
+    mask, crop = _mask_and_crop(shape, w, h)
+    idx = np.where(mask, _pattern_index(pattern, w, h, n, stripe), n)
+    if crop is not None:
+        idx = np.ascontiguousarray(idx[crop])
+    idx.setflags(write=False)
+    return idx
+
+
+@lru_cache(maxsize=512)
+def _mask_and_crop(
+    shape: str, w: int, h: int
+) -> tuple[NDArray[np.bool_], tuple[slice, slice] | None]:
+    """The silhouette and, if it does not fill its (h, w) box, the slices of its tight box."""
+    mask = shape_mask(shape, w, h)
+    rows, cols = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
+    if rows[0] == 0 and cols[0] == 0 and rows[-1] == h - 1 and cols[-1] == w - 1:
+        return mask, None
+    return mask, (slice(rows[0], rows[-1] + 1), slice(cols[0], cols[-1] + 1))
 
 
 def _tight(tpl: NDArray[np.uint8]) -> NDArray[np.uint8]:
@@ -113,13 +161,6 @@ def _tight(tpl: NDArray[np.uint8]) -> NDArray[np.uint8]:
     if not alpha.any():
         return tpl
     rows, cols = np.flatnonzero(alpha.any(axis=1)), np.flatnonzero(alpha.any(axis=0))
-    if (
-        rows[0] == 0
-        and cols[0] == 0
-        and rows[-1] == tpl.shape[0] - 1
-        and cols[-1] == tpl.shape[1] - 1
-    ):
-        return tpl
     return np.ascontiguousarray(tpl[rows[0] : rows[-1] + 1, cols[0] : cols[-1] + 1])
 
 
@@ -158,4 +199,4 @@ def transform_template(
         out[..., :3] = np.clip(out[..., :3].astype(np.float64) * shade, 0, 255).astype(np.uint8)
     if not (out[..., 3] > 0).any():
         return tpl.copy()
-    return np.ascontiguousarray(_tight(out))
+    return _tight(out)

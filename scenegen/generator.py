@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from scenegen import kernels
-from scenegen.appearance import draw_template, jitter_colors, transform_template
+from scenegen.appearance import draw_template, jitter_colors, paint_template, transform_template
 from scenegen.config import Background, EntitySpec, SceneConfig
 from scenegen.errors import ConfigError
 from scenegen.motion import ar2_path
@@ -221,6 +221,8 @@ class Scenario:
 
         out_rgb = np.empty((f_n, h, w, 3), dtype=np.uint8)
         out_lab = np.empty((f_n, h, w), dtype=np.uint16)
+        out_rgb[:] = s_rgb
+        out_lab[:] = s_lab
         out_box = np.zeros((f_n, k_n, 4), dtype=np.int64)
         out_count = np.zeros((f_n, k_n), dtype=np.int64)
         kernels.render_chunk(
@@ -363,7 +365,7 @@ def _clutter(cfg: SceneConfig, seed: int) -> list[tuple[str, NDArray[np.uint8], 
         bw, bh = spec.appearance.size
         lo = spec.min_size if spec.min_size > 0 else min(bw, bh)
         frac = rng.uniform(lo / min(bw, bh), 1.0, size=n)
-        pal = np.asarray(spec.palette)
+        pal = np.asarray(spec.palette, dtype=np.uint8)
         cols = rng.integers(0, len(pal), size=(n, spec.n_colors))
         if spec.placement == "grid":
             g = int(np.ceil(np.sqrt(n))) if n else 1
@@ -374,12 +376,13 @@ def _clutter(cfg: SceneConfig, seed: int) -> list[tuple[str, NDArray[np.uint8], 
         else:
             cx = rx + rng.uniform(0, rw, n)
             cy = ry + rng.uniform(0, rh, n)
+        app = spec.appearance
         for j in range(n):
             size = (max(1, int(round(bw * frac[j]))), max(1, int(round(bh * frac[j]))))
-            app = replace(
-                spec.appearance, colors=tuple(tuple(int(v) for v in pal[c]) for c in cols[j])
-            )
-            tpl = draw_template(app, rng=rng, size=size)
+            tpl = paint_template(
+                app.shape, app.pattern, size[0], size[1], pal[cols[j]],
+                stripe_width=app.stripe_width, texture_sigma=app.texture_sigma, rng=rng,
+            )  # fmt: skip
             items.append((f"{spec.name}-{j}", tpl, float(cx[j]), float(cy[j])))
     return items
 

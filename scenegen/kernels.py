@@ -100,7 +100,10 @@ def render_chunk(
     out_box,
     out_count,
 ):  # pragma: no cover - compiled
-    """Render F frames: static layer, then per-frame entities back to front, then stats.
+    """Render F frames: per-frame entities back to front over the static layer, then stats.
+
+    ``out_rgb`` and ``out_lab`` must already hold the static layer (a broadcast copy in
+    numpy is a plain memcpy, much faster than an element loop here).
 
     Parameters
     ----------
@@ -131,8 +134,6 @@ def render_chunk(
     for f in range(n_f):
         rgb = out_rgb[f]
         lab = out_lab[f]
-        rgb[:] = static_rgb
-        lab[:] = static_lab
         n_drawn = 0
         for j in range(order.shape[1]):
             k = order[f, j]
