@@ -61,26 +61,33 @@ def frame_measures(est: ArrayLike, gt: ArrayLike) -> dict[str, NDArray[Any]]:
     }
 
 
-def failure_threshold(gt: ArrayLike) -> NDArray[np.float64]:
-    """Centre error beyond which a target counts as lost: its radius, per target.
+def failure_threshold(gt: ArrayLike, *, fraction: float = 1.0) -> NDArray[np.float64]:
+    """Centre error beyond which a target counts as lost, per target.
 
-    (open) KAMS uses "e.g. the target radius"; for a box target we take half the mean of
-    width and height of its ground-truth box over the frames where it is present.
+    (open) KAMS says a run fails when the error stays above a threshold, "e.g. the target
+    radius", yet reports mean errors of 15–18 px for runs that track throughout. We take
+    ``fraction`` times the target's size (the mean of its ground-truth box width and
+    height over the frames where it is present); with the default 1.0 that is the
+    diameter of a disc target: beyond it, estimate and target no longer overlap.
 
     Parameters
     ----------
     gt : array_like of shape (T, M, 4)
+    fraction : float
+        Multiple of the target size (> 0); 0.5 gives the radius.
 
     Returns
     -------
     ndarray of shape (M,)
         Threshold in pixels (NaN for a target never present).
     """
+    if not fraction > 0:
+        raise ValueError(f"fraction must be > 0, got {fraction}")
     g = np.asarray(gt, dtype=np.float64)
-    half = (g[..., 2] + g[..., 3]) / 4.0
-    finite = np.isfinite(half)
+    size = fraction * (g[..., 2] + g[..., 3]) / 2.0
+    finite = np.isfinite(size)
     n = finite.sum(axis=0)
-    s = np.where(finite, half, 0.0).sum(axis=0)
+    s = np.where(finite, size, 0.0).sum(axis=0)
     return np.where(n > 0, s / np.maximum(n, 1), np.nan)
 
 

@@ -82,6 +82,7 @@ def run_experiment(
     seed: int = 0,
     quick: bool = False,
     methods: Iterable[str] | None = None,
+    values: Iterable[float] | None = None,
     progress: bool = True,
     figures: bool = True,
 ) -> dict[str, Any]:
@@ -106,6 +107,8 @@ def run_experiment(
         Scaled-down settings (fewer frames, particles and swept values) for tests and demos.
     methods : iterable of str, optional
         Method slugs or labels to run (default all).
+    values : iterable of float, optional
+        Values of the swept parameter to run (default all; in quick mode the quick ones).
     progress : bool
         Show a progress bar.
     figures : bool
@@ -126,7 +129,8 @@ def run_experiment(
     if jobs is not None and jobs < 1:
         raise ConfigError(f"jobs must be >= 1, got {jobs}")
     r = exp.runs if runs is None else int(runs)
-    tasks = plan_tasks(exp, runs=r, seed=int(seed), quick=quick, methods=methods)
+    tasks = plan_tasks(exp, runs=r, seed=int(seed), quick=quick, methods=methods,
+                       values=values)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     records = execute(tasks, out / "runs", jobs=jobs, scheduler=scheduler, progress=progress)

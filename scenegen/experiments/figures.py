@@ -132,14 +132,14 @@ def _kams_accuracy(res: dict[str, Any], out: Path) -> list[str]:
     fig = Figure(figsize=(11, 7))
     axes = fig.subplots(2, 2, squeeze=False).ravel()
     for ax, preset in zip(axes, presets, strict=False):
-        radius = None
+        threshold = None
         for label, per in methods.items():
             if preset in per:
                 e = np.array([np.nan if x is None else x for x in per[preset]["error_per_frame"]])
                 ax.plot(np.arange(e.size), e, label=label, lw=1.2)
-                radius = per[preset]["radius"]
-        if radius is not None:
-            ax.axhline(radius, color="k", ls=":", lw=1, label="failure threshold")
+                threshold = per[preset]["failure_threshold"]
+        if threshold is not None:
+            ax.axhline(threshold, color="k", ls=":", lw=1, label="failure threshold")
         ax.set_title(preset)
         ax.set_xlabel("frame")
         ax.set_ylabel("centre error px (mean over runs)")

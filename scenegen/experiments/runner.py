@@ -122,22 +122,38 @@ def plan_tasks(
     seed: int,
     quick: bool,
     methods: Iterable[str] | None = None,
+    values: Iterable[float] | None = None,
 ) -> list[Task]:
     """Every task of an experiment, in a fixed order.
+
+    ``methods`` (slugs or labels) and ``values`` (of the swept parameter) restrict the
+    sweep; by default every method runs at every value.
 
     Raises
     ------
     ConfigError
-        For runs < 1, a negative seed or an unknown method (listing the valid ones).
+        For runs < 1, a negative seed, an unknown method or a value outside the sweep
+        (listing the valid ones).
     """
     if runs < 1:
         raise ConfigError(f"runs must be >= 1, got {runs}")
     if seed < 0:
         raise ConfigError(f"seed must be a non-negative integer, got {seed}")
     chosen = [exp.method(m) for m in methods] if methods else list(exp.methods)
+    sweep = exp.sweep_values(quick)
+    if values is not None:
+        wanted = [float(v) for v in values]
+        valid = [v for _, v in exp.sweep_values(False) if v is not None]
+        for v in wanted:
+            if v not in valid:
+                raise ConfigError(
+                    f"value {v:g} is not in the sweep of experiment {exp.name!r}; valid "
+                    f"values: {', '.join(f'{x:g}' for x in valid) or 'none (no sweep)'}"
+                )
+        sweep = [(p, v) for p, v in exp.sweep_values(False) if v in wanted]
     tasks = []
     for m in chosen:
-        for param, value in exp.sweep_values(quick):
+        for param, value in sweep:
             for r in range(runs):
                 presets = [exp.presets[r % len(exp.presets)]] if exp.scene_per_run else list(
                     exp.presets
@@ -237,7 +253,7 @@ def run_task(task: Task) -> dict[str, Any]:
         "scene_seed": task.scene_seed(exp),
         "tracker_seed": task.tracker_seed(),
         "n_frames": int(gt.shape[0]),
-        "radius": failure_threshold(gt),
+        "failure_threshold": failure_threshold(gt),
         "targets": targets,
     }
     extras = result.extras

@@ -27,7 +27,8 @@ AGREE_POINTS = 10.0
 AGREE_PX = 3.0
 Z_995 = 2.576
 FAILURE_PERSIST = 5
-"""Frames the centre error must stay above the target radius for a KAMS-style failure."""
+"""Frames the centre error must stay above the target size for a KAMS-style failure
+(:func:`scenegen.evaluate.failure_threshold`)."""
 
 Records = list[dict[str, Any]]
 
@@ -374,10 +375,10 @@ def _table_dps_occlusion(res: dict[str, Any]) -> list[str]:
 # kams-accuracy
 
 
-def _kams_case(rec: dict[str, Any], radius: float) -> tuple[float, int]:
+def _kams_case(rec: dict[str, Any], threshold: float) -> tuple[float, int]:
     err = _arr(rec["targets"][0]["centre_error"])
     return (float(np.nanmean(err)) if np.any(np.isfinite(err)) else float("nan"),
-            metrics.failure_frame(np.nan_to_num(err, nan=np.inf), radius,
+            metrics.failure_frame(np.nan_to_num(err, nan=np.inf), threshold,
                                   persist=FAILURE_PERSIST))
 
 
@@ -394,8 +395,8 @@ def _kams_accuracy(exp: Experiment, records: Records) -> dict[str, Any]:
             recs = groups.get((m.slug, preset, None))
             if not recs:
                 continue
-            radius = recs[0]["radius"][0]
-            cases = [_kams_case(r, radius) for r in recs]
+            threshold = recs[0]["failure_threshold"][0]
+            cases = [_kams_case(r, threshold) for r in recs]
             errs = np.array([c[0] for c in cases])
             fails = [c[1] for c in cases]
             per_frame = np.nanmean(
@@ -412,7 +413,7 @@ def _kams_accuracy(exp: Experiment, records: Records) -> dict[str, Any]:
                     if any(f >= 0 for f in fails) else None
                 ),
                 "error_per_frame": per_frame.tolist(),
-                "radius": radius,
+                "failure_threshold": threshold,
             }
             majority = (_pct(done) or 0.0) > 50.0
             completes.setdefault(m.label, []).append(majority)
@@ -426,7 +427,8 @@ def _kams_accuracy(exp: Experiment, records: Records) -> dict[str, Any]:
                 comparisons.append({"what": f"{preset} {m.label} completes the sequence",
                                     "paper": _claim_done, "ours": ours,
                                     "agree": _claim_done == ours})
-        rows[m.label] = per_preset
+        if per_preset:
+            rows[m.label] = per_preset
     if "KAMS" in completes:
         _claim(fidelity, "KAMS tracks all four sequences a–d",
                f"completes {sum(completes['KAMS'])} of {len(completes['KAMS'])}",
@@ -473,7 +475,7 @@ def _kams_robustness(exp: Experiment, records: Records) -> dict[str, Any]:
         k = r["key"]
         err = _arr(r["targets"][0]["centre_error"])
         by_method[k["method"]][k["run"]] = metrics.tracked_fraction(
-            np.nan_to_num(err, nan=np.inf), r["radius"][0], persist=FAILURE_PERSIST
+            np.nan_to_num(err, nan=np.inf), r["failure_threshold"][0], persist=FAILURE_PERSIST
         )
     rows: dict[str, Any] = {}
     comparisons: list[dict[str, Any]] = []

@@ -155,3 +155,21 @@ def test_experiment_verb(reference, tmp_path, capsys):
         _cli(["experiment", "bogus", "-o", str(tmp_path)])
     with pytest.raises(ConfigError, match="valid methods"):
         _cli(["experiment", NAME, "--method", "bogus", "-o", str(tmp_path)])
+
+
+def test_sweep_values_can_be_restricted(tmp_path):
+    tasks = plan_tasks(get("dps-synthetic"), runs=2, seed=0, quick=False, values=[30])
+    assert {t.value for t in tasks} == {30.0} and len(tasks) == 9 * 2
+    with pytest.raises(ConfigError, match="valid values: 20, 30, 40, 50"):
+        plan_tasks(get("dps-synthetic"), runs=2, seed=0, quick=False, values=[25])
+
+
+@pytest.mark.slow
+def test_dps_synthetic_fidelity(tmp_path):
+    """Issue 6 item 6: 50 runs at λ = 20 reproduce the DPS paper's orderings."""
+    res = run_experiment("dps-synthetic", tmp_path, runs=50, values=[20], progress=False)
+    row = res["summary"]["by_value"]["20"]
+    nonps, dps, ps = row["methods"]["nonps"], row["methods"]["dps"], row["ps_mean"]
+    assert dps["hard"]["recovery"] > ps["hard"]["recovery"] > nonps["hard"]["recovery"]
+    assert ps["others"]["precision"] > nonps["others"]["precision"]
+    assert dps["others"]["precision"] > nonps["others"]["precision"]
