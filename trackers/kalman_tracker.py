@@ -94,7 +94,10 @@ class KalmanTracker(Tracker):
     min_visible : float
         Fraction of the template that must be compared for a match to count.
     support : {"box", "ellipse"}
-        Template support (``trackers.layered``).
+        Template support (``trackers.layered``); the ellipse inscribed in the box fits
+        round objects and keeps the background corners out of the match.
+    blur : float
+        Gaussian pre-smoothing of frames and templates, std in px (0 = none).
     rng : Generator, int or None
         Unused by this deterministic tracker; accepted like every tracker's.
 
@@ -119,17 +122,22 @@ class KalmanTracker(Tracker):
         search_radius: int = 12,
         step: int = 1,
         min_visible: float = 0.25,
-        support: str = "box",
+        support: str = "ellipse",
+        blur: float = 2.0,
         rng: RngLike = None,
     ) -> None:
         super().__init__(rng=rng)
         self.model = motion_model(motion, process_std, a1, a2, velocity_std)
         check_noise(r_gain, r_floor)
-        check_matcher_params(search_radius, step, min_visible, support)
+        check_matcher_params(search_radius, step, min_visible, support, blur)
         self.r_gain = float(r_gain)
         self.r_floor = float(r_floor)
         self._matcher_params = dict(
-            search_radius=search_radius, step=step, min_visible=min_visible, support=support
+            search_radius=search_radius,
+            step=step,
+            min_visible=min_visible,
+            support=support,
+            blur=blur,
         )
 
     def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:

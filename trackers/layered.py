@@ -17,6 +17,11 @@ Templates and supports (**open** in the paper, chosen here): the reference of ob
 - ``"ellipse"``: the ellipse inscribed in the box (tested at pixel centres), which drops
   the background corners of round objects.
 
+Pre-smoothing (**open**): the frame (and so the templates) can be blurred with a Gaussian
+of std ``blur`` pixels before matching. A small blur makes the squared difference tolerant
+of the small rotations and of fine periodic textures (checkers, stripes) that otherwise
+give several near-equal minima.
+
 Cost: each search compares ``(2 r + 1)²`` candidates (about ``((2 r) / step + 1)²`` plus
 ``(2 step − 1)²`` with the coarse-to-fine search) of ``|support|`` pixels; the number of
 searches per frame is ``M`` when no objects are close and at most ``M · M!`` (96 for
@@ -29,6 +34,7 @@ import itertools
 import math
 from dataclasses import dataclass
 
+import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -80,12 +86,15 @@ class LayeredMeasurement:
     mse : ndarray of shape (L, M)
         Mean squared difference per channel (intensity², 0..255²) of each match; NaN if
         missed.
+    counts : ndarray of shape (L, M)
+        Pixels compared by each match (unmasked, inside the frame); 0 if missed.
     n_searches : int
         Template searches run (orderings that cannot differ share their searches).
     """
 
     centres: NDArray[np.float64]
     mse: NDArray[np.float64]
+    counts: NDArray[np.int64]
     n_searches: int
 
 
@@ -108,6 +117,8 @@ class LayeredMatcher:
         (inside the frame and unmasked); fewer is a missed measurement.
     support : {"box", "ellipse"}
         Template support, see the module docstring.
+    blur : float
+        Std in pixels of the Gaussian pre-smoothing of frames and templates (0 = none).
     """
 
     def __init__(
@@ -119,8 +130,11 @@ class LayeredMatcher:
         step: int = 2,
         min_visible: float = 0.25,
         support: str = "box",
+        blur: float = 0.0,
     ) -> None:
-        check_matcher_params(search_radius, step, min_visible, support)
+        check_matcher_params(search_radius, step, min_visible, support, blur)
+        self.blur = float(blur)
+        frame = self._smooth(frame)
         b = np.asarray(boxes, dtype=np.float64).reshape(-1, 4)
         m = b.shape[0]
         h, w = frame.shape[:2]
@@ -145,6 +159,7 @@ class LayeredMatcher:
             cc = np.clip(cols, 0, w - 1)
             self.templates[k, :th, :tw] = frame[rr[:, None], cc[None, :]]
             self.support[k, :th, :tw] = sup
+        self._n_support = self.support.sum(axis=(1, 2))
         # Measured centre = initial box centre + displacement of the matched top-left.
         self._tl0 = tl
         self._centre0 = b[:, :2] + b[:, 2:] / 2
@@ -164,6 +179,10 @@ class LayeredMatcher:
     ) -> LayeredMeasurement:
         """Match every object under every ordering of ``order`` in one kernel call.
 
+        An object predicted to have less than ``min_visible`` of its support inside the
+        frame is not searched (it has left): its measurement is missed under every
+        ordering, so a window at the border cannot lock onto the background there.
+
         Parameters
         ----------
         frame : ndarray of shape (H, W, 3), uint8
@@ -175,6 +194,7 @@ class LayeredMatcher:
             Mask the pixels of the objects matched in front (False: every object is
             matched on the unmasked frame).
         """
+        frame = self._smooth(frame)
         c = np.asarray(centres, dtype=np.float64).reshape(self.n_objects, 2)
         h, w = self._frame_hw
         shift = np.round(c - self._centre0)
@@ -185,20 +205,41 @@ class LayeredMatcher:
         lim = self.search_radius + 1
         origin[:, 0] = np.clip(origin[:, 0], -self.sizes[:, 1] - lim, w + lim)
         origin[:, 1] = np.clip(origin[:, 1], -self.sizes[:, 0] - lim, h + lim)
+        active = self._inside_fraction(origin) >= self.min_visible
         rows = np.ascontiguousarray(order, dtype=np.int64)
         n_order = rows.shape[0]
         pos = np.zeros((n_order, self.n_objects, 2), dtype=np.int64)
         mse = np.empty((n_order, self.n_objects), dtype=np.float64)
+        counts = np.zeros((n_order, self.n_objects), dtype=np.int64)
         n = layered_match(
-            frame, self.templates, self.support, self.sizes, origin, self.search_radius,
-            self.step, rows, masking, self.min_visible, pos, mse,
+            frame, self.templates, self.support, self.sizes, origin, active,
+            self.search_radius, self.step, rows, masking, self.min_visible, pos, mse, counts,
         )
         out = self._centre0[None] + (pos - self._tl0[None]).astype(np.float64)
         out[np.isnan(mse)] = np.nan
-        return LayeredMeasurement(centres=out, mse=mse, n_searches=int(n))
+        return LayeredMeasurement(centres=out, mse=mse, counts=counts, n_searches=int(n))
+
+    def _inside_fraction(self, origin: NDArray[np.int64]) -> NDArray[np.float64]:
+        """Fraction of each support inside the frame with its top-left at ``origin``."""
+        h, w = self._frame_hw
+        out = np.zeros(self.n_objects)
+        for k in range(self.n_objects):
+            x, y = int(origin[k, 0]), int(origin[k, 1])
+            th, tw = int(self.sizes[k, 0]), int(self.sizes[k, 1])
+            r0, r1 = max(0, -y), max(0, min(th, h - y))
+            c0, c1 = max(0, -x), max(0, min(tw, w - x))
+            out[k] = self.support[k, r0:r1, c0:c1].sum() / self._n_support[k]
+        return out
+
+    def _smooth(self, frame: NDArray[np.uint8]) -> NDArray[np.uint8]:
+        if self.blur <= 0:
+            return frame
+        return cv2.GaussianBlur(frame, (0, 0), self.blur, borderType=cv2.BORDER_REPLICATE)
 
 
-def check_matcher_params(search_radius: int, step: int, min_visible: float, support: str) -> None:
+def check_matcher_params(
+    search_radius: int, step: int, min_visible: float, support: str, blur: float
+) -> None:
     """Validate the matcher's parameters (shared by the trackers' constructors).
 
     Raises
@@ -214,6 +255,8 @@ def check_matcher_params(search_radius: int, step: int, min_visible: float, supp
         raise ValueError(f"min_visible must be in (0, 1], got {min_visible!r}")
     if support not in SUPPORTS:
         raise ValueError(f"unknown support {support!r}; valid: {', '.join(SUPPORTS)}")
+    if not (np.isfinite(blur) and 0 <= blur <= 20):
+        raise ValueError(f"blur must be in [0, 20] pixels, got {blur!r}")
 
 
 def _support_mask(kind: str, th: int, tw: int) -> NDArray[np.bool_]:

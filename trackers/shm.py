@@ -14,12 +14,25 @@ measurements ``y^j`` with squared-difference means ``e^{j,m}`` (§3.1,
 plus a floor); the other orderings' measurements are uniform (eq. 3), so they cancel.
 
 Evidence of the squared-difference means (§3.3, the "generalised measurement"): under the
-true ordering ``e^{j,m}`` follows an exponential density with mean ``ē_m``, giving the
-factor ``exp(−lam Σ_m e^{j,m} / ē_m)`` (**open**: ``ē_m`` is estimated online as an
-exponential moving average, rate ``mse_rate``, of the smallest ``e`` over orderings,
-floored at ``mse_floor``; ``lam`` sharpens or flattens it). An object missed under an
-ordering (hidden behind the objects in front, or outside the frame) counts as ``e = ē``,
-i.e. as expected; its position measurement is uniform over the frame.
+true ordering the squared-difference mean follows an exponential density, giving the factor
+``exp(−lam E_j / ē)``. Which mean (**open**, parameter ``evidence``):
+
+- ``"union"`` (default): ``E_j = Σ_m n^{j,m} e^{j,m} / Σ_m n^{j,m}``, the mean squared
+  difference of the composed layers over every pixel they cover, ``n^{j,m}`` being the
+  pixels compared for object m under ordering j. Every covered pixel is scored once under
+  each ordering, by the object the ordering puts in front there. With ``ē`` a single
+  scale: the moving average of ``min_j E_j``.
+- ``"objects"``: the paper's per-object exponentials, ``Σ_m e^{j,m} / ē_m`` with one scale
+  per object. Masking removes pixels from the mean of the object behind, so these means
+  are taken over different pixel sets under different orderings; on objects whose
+  appearance varies (rotation, shading) this is a weaker test than ``"union"``.
+
+The scales are exponential moving averages (rate ``mse_rate``) of the smallest mean over
+orderings — the exponential density's mean under the true ordering — floored at
+``mse_floor``; ``lam`` sharpens or flattens the evidence. An object missed under an
+ordering (hidden behind the objects in front, or outside the frame) covers no pixel
+(``"union"``) or counts as ``e = ē_m`` (``"objects"``); its position measurement is
+uniform over the frame.
 
 Because non-overlapping objects give identical measurements under every ordering, the
 ordering probabilities then only follow the (symmetric) Markov chain towards equality.
@@ -61,7 +74,7 @@ from trackers.kalman_tracker import (
 )
 from trackers.layered import LayeredMatcher, check_matcher_params, orderings
 
-__all__ = ["FastSHMTracker", "SHMTracker", "transition_matrix"]
+__all__ = ["EVIDENCES", "FastSHMTracker", "SHMTracker", "transition_matrix"]
 
 
 def transition_matrix(n_orderings: int, p_stay: float) -> NDArray[np.float64]:
@@ -78,37 +91,56 @@ def _softmax(logw: NDArray[np.float64], axis: int = -1) -> NDArray[np.float64]:
     return w / np.sum(w, axis=axis, keepdims=True)
 
 
+EVIDENCES = ("union", "objects")
+
+
 class _OrderingEvidence:
     """Markov prior and squared-difference evidence of the orderings (§2.2, §3.3)."""
 
-    def __init__(self, n_orderings: int, p_stay: float, lam: float, rate: float, floor: float):
-        self.log_pi = np.log(np.maximum(transition_matrix(n_orderings, p_stay), 1e-300))
+    def __init__(
+        self, n_orderings: int, p_stay: float, lam: float, rate: float, floor: float, kind: str
+    ) -> None:
         self.pi = transition_matrix(n_orderings, p_stay)
+        self.log_pi = np.log(np.maximum(self.pi, 1e-300))
         self.lam = lam
         self.rate = rate
         self.floor = floor
+        self.kind = kind
         self.scale: NDArray[np.float64] | None = None
 
-    def log_evidence(self, mse: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Σ_m −lam e^{j,m} / ē_m per ordering, shape (L,), from ``mse`` (L, M).
+    def log_evidence(
+        self, mse: NDArray[np.float64], counts: NDArray[np.int64]
+    ) -> NDArray[np.float64]:
+        """log evidence per ordering, shape (L,), from ``mse`` and ``counts`` (L, M).
 
-        Updates ``ē`` afterwards, so a frame's own matches do not rescale its evidence.
+        Updates the scales afterwards, so a frame's own matches do not rescale its
+        evidence.
         """
-        valid = np.isfinite(mse)
-        best = np.min(np.where(valid, mse, np.inf), axis=0)
+        if self.kind == "union":
+            n = counts.sum(axis=1)
+            sse = (np.nan_to_num(mse) * counts).sum(axis=1)
+            e = np.where(n > 0, sse / np.maximum(n, 1), np.nan)[:, None]  # (L, 1)
+        else:
+            e = mse
+        valid = np.isfinite(e)
+        best = np.min(np.where(valid, e, np.inf), axis=0)
         seen = np.isfinite(best)
         if self.scale is None:
-            self.scale = np.full(mse.shape[1], self.floor)
+            self.scale = np.full(e.shape[1], self.floor)
             self.scale[seen] = np.maximum(best[seen], self.floor)
-        ratio = np.where(valid, mse, self.scale[None, :]) / self.scale[None, :]
+        ratio = np.where(valid, e, self.scale[None, :]) / self.scale[None, :]
         out = -self.lam * ratio.sum(axis=1)
-        # ē_m: moving average of the best match, the mean of e under the true ordering.
+        # The scale is the mean of e under the true ordering: average the best ordering's.
         upd = (1 - self.rate) * self.scale + self.rate * np.where(seen, best, self.scale)
         self.scale = np.maximum(upd, self.floor)
         return out
 
 
-def _check_shm(p_stay: float, lam: float, mse_rate: float, mse_floor: float) -> None:
+def _check_shm(
+    p_stay: float, lam: float, mse_rate: float, mse_floor: float, evidence: str
+) -> None:
+    if evidence not in EVIDENCES:
+        raise ValueError(f"unknown evidence {evidence!r}; valid: {', '.join(EVIDENCES)}")
     if not (np.isfinite(p_stay) and 0 < p_stay <= 1):
         raise ValueError(f"p_stay must be in (0, 1], got {p_stay!r}")
     if not (np.isfinite(lam) and lam >= 0):
@@ -135,15 +167,18 @@ class _SHMBase(Tracker):
         step: int,
         min_visible: float,
         support: str,
+        blur: float,
         p_stay: float,
         lam: float,
         mse_rate: float,
         mse_floor: float,
+        evidence: str,
     ) -> None:
         self.model = motion_model(motion, process_std, a1, a2, velocity_std)
         check_noise(r_gain, r_floor)
-        check_matcher_params(search_radius, step, min_visible, support)
-        _check_shm(p_stay, lam, mse_rate, mse_floor)
+        check_matcher_params(search_radius, step, min_visible, support, blur)
+        _check_shm(p_stay, lam, mse_rate, mse_floor, evidence)
+        self.evidence = evidence
         self.r_gain = float(r_gain)
         self.r_floor = float(r_floor)
         self.p_stay = float(p_stay)
@@ -151,7 +186,11 @@ class _SHMBase(Tracker):
         self.mse_rate = float(mse_rate)
         self.mse_floor = float(mse_floor)
         self._matcher_params = dict(
-            search_radius=search_radius, step=step, min_visible=min_visible, support=support
+            search_radius=search_radius,
+            step=step,
+            min_visible=min_visible,
+            support=support,
+            blur=blur,
         )
 
     def _init_common(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
@@ -164,7 +203,7 @@ class _SHMBase(Tracker):
         n_order = self.orderings.shape[0]
         self.order_prob = np.full(n_order, 1.0 / n_order)
         self._evidence = _OrderingEvidence(
-            n_order, self.p_stay, self.lam, self.mse_rate, self.mse_floor
+            n_order, self.p_stay, self.lam, self.mse_rate, self.mse_floor, self.evidence
         )
         self._log_u = -np.log(float(frame.shape[0] * frame.shape[1]))
 
@@ -175,7 +214,7 @@ class SHMTracker(_SHMBase):
     Parameters
     ----------
     motion, process_std, a1, a2, velocity_std, r_gain, r_floor, search_radius, step, \
-min_visible, support
+min_visible, support, blur
         As for ``trackers.kalman_tracker.KalmanTracker``.
     p_stay : float
         Probability that the depth ordering stays the same from one frame to the next.
@@ -185,6 +224,8 @@ min_visible, support
         Rate of the moving average ``ē`` of the best squared-difference mean, in (0, 1].
     mse_floor : float
         Smallest ``ē``, intensity² (so exact synthetic matches do not give ē = 0).
+    evidence : {"union", "objects"}
+        Which squared-difference mean is scored (module docstring).
     use_mse : bool
         Include the squared-difference evidence in the hypothesis weights (§3.3's
         generalised measurement); False is the plain §3.2 filter on positions only.
@@ -219,18 +260,20 @@ min_visible, support
         search_radius: int = 12,
         step: int = 1,
         min_visible: float = 0.25,
-        support: str = "box",
+        support: str = "ellipse",
+        blur: float = 2.0,
         p_stay: float = 0.9,
         lam: float = 1.0,
         mse_rate: float = 0.1,
         mse_floor: float = 25.0,
+        evidence: str = "union",
         use_mse: bool = True,
         rng: RngLike = None,
     ) -> None:
         super().__init__(rng=rng)
         self._configure(
             motion, process_std, a1, a2, velocity_std, r_gain, r_floor, search_radius, step,
-            min_visible, support, p_stay, lam, mse_rate, mse_floor,
+            min_visible, support, blur, p_stay, lam, mse_rate, mse_floor, evidence,
         )
         self.use_mse = bool(use_mse)
 
@@ -268,7 +311,7 @@ min_visible, support
             missed = np.isnan(zm).any(axis=1)
             # A missed object contributes the uniform density of an improper measurement.
             loglik += np.where(missed, self._log_u, pairs.log_likelihood)
-        log_ev = self._evidence.log_evidence(meas.mse)
+        log_ev = self._evidence.log_evidence(meas.mse, meas.counts)
         logw = (
             self._evidence.log_pi[ii, jj]
             + np.log(np.maximum(self.order_prob, 1e-300))[ii]
@@ -303,7 +346,7 @@ class FastSHMTracker(_SHMBase):
     Parameters
     ----------
     motion, process_std, a1, a2, velocity_std, r_gain, r_floor, search_radius, step, \
-min_visible, support, p_stay, lam, mse_rate, mse_floor
+min_visible, support, blur, p_stay, lam, mse_rate, mse_floor, evidence
         As for ``SHMTracker``.
     rng : Generator, int or None
         Unused (the filter is deterministic); accepted like every tracker's.
@@ -336,17 +379,19 @@ min_visible, support, p_stay, lam, mse_rate, mse_floor
         search_radius: int = 12,
         step: int = 1,
         min_visible: float = 0.25,
-        support: str = "box",
+        support: str = "ellipse",
+        blur: float = 2.0,
         p_stay: float = 0.9,
         lam: float = 1.0,
         mse_rate: float = 0.1,
         mse_floor: float = 25.0,
+        evidence: str = "union",
         rng: RngLike = None,
     ) -> None:
         super().__init__(rng=rng)
         self._configure(
             motion, process_std, a1, a2, velocity_std, r_gain, r_floor, search_radius, step,
-            min_visible, support, p_stay, lam, mse_rate, mse_floor,
+            min_visible, support, blur, p_stay, lam, mse_rate, mse_floor, evidence,
         )
 
     def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
@@ -360,9 +405,10 @@ min_visible, support, p_stay, lam, mse_rate, mse_floor
         kf = self.kf
         kf.predict()
         meas = self.matcher.measure(frame, self._origin + kf.x[:, :2], self._rows)
-        # P(s_t = j | Y_t) ∝ exp(−lam Σ_m e^{j,m}/ē_m) Σ_i Π_ij P(s_{t−1} = i)  (§3.3)
+        # P(s_t = j | Y_t) ∝ exp(−lam E_j / ē) Σ_i Π_ij P(s_{t−1} = i)  (§3.3)
         prior = self.order_prob @ self._evidence.pi
-        logp = np.log(np.maximum(prior, 1e-300)) + self._evidence.log_evidence(meas.mse)
+        log_ev = self._evidence.log_evidence(meas.mse, meas.counts)
+        logp = np.log(np.maximum(prior, 1e-300)) + log_ev
         self.order_prob = _softmax(logp)
         valid = np.isfinite(meas.mse)  # (L, M)
         q = self.order_prob[:, None] * valid

@@ -66,7 +66,10 @@ def _fill_valid(h, w, rx, ry, valid, support, sizes, front, n_front, front_pos):
 def _score(
     frame, rx, ry, valid, tpl, sup, th, tw, dx, dy, s, n_max, min_count, best
 ):  # pragma: no cover
-    """Mean squared difference of one candidate, or inf if invalid or worse than ``best``."""
+    """(mean squared difference, pixels compared) of one candidate.
+
+    The score is inf if too few pixels are compared or the candidate cannot beat ``best``.
+    """
     acc = np.int64(0)
     cnt = 0
     # A partial sum above this bound can never beat ``best``: the mean divides by at most
@@ -85,10 +88,10 @@ def _score(
                 acc += d0 * d0 + d1 * d1 + d2 * d2
                 cnt += 1
         if acc > bound:
-            return np.inf
+            return np.inf, cnt
     if cnt < min_count or cnt == 0:
-        return np.inf
-    return acc / (3.0 * cnt)
+        return np.inf, cnt
+    return acc / (3.0 * cnt), cnt
 
 
 @njit(cache=True)
@@ -111,7 +114,7 @@ def _centre_out(radius):  # pragma: no cover - compiled
 def _match(
     frame, tpl, sup, th, tw, radius, step, min_visible, valid, rx, ry, offsets
 ):  # pragma: no cover - compiled
-    """Best top-left (x, y) and its score for one object; score inf if none is valid.
+    """Best top-left (x, y), its score and pixel count; score inf if none is valid.
 
     Candidates are visited nearest the predicted position first, so that a good score is
     found early and most other candidates are abandoned after a few template rows.
@@ -139,19 +142,20 @@ def _match(
             dy = offsets[k, 1]
             if dx % step != 0 or dy % step != 0:
                 continue
-            e = _score(frame, rx, ry, valid, tpl, sup, th, tw, dx, dy, step, n_sub, min_sub,
-                       best)
+            e, _ = _score(frame, rx, ry, valid, tpl, sup, th, tw, dx, dy, step, n_sub,
+                          min_sub, best)
             if e < best:
                 best = e
                 bx = dx
                 by = dy
         if bx < 0:
-            return 0, 0, np.inf
+            return 0, 0, np.inf, 0
         lo_x = max(bx - step + 1, 0)
         hi_x = min(bx + step - 1, span)
         lo_y = max(by - step + 1, 0)
         hi_y = min(by + step - 1, span)
     best = np.inf
+    best_n = 0
     bx = -1
     by = -1
     min_full = min_visible * n_full
@@ -160,20 +164,21 @@ def _match(
         dy = offsets[k, 1]
         if dx < lo_x or dx > hi_x or dy < lo_y or dy > hi_y:
             continue
-        e = _score(frame, rx, ry, valid, tpl, sup, th, tw, dx, dy, 1, n_full, min_full, best)
+        e, n = _score(frame, rx, ry, valid, tpl, sup, th, tw, dx, dy, 1, n_full, min_full, best)
         if e < best:
             best = e
+            best_n = n
             bx = dx
             by = dy
     if bx < 0:
-        return 0, 0, np.inf
-    return rx + bx, ry + by, best
+        return 0, 0, np.inf, 0
+    return rx + bx, ry + by, best, best_n
 
 
 @njit(cache=True)
 def layered_match(
-    frame, templates, support, sizes, origins, radius, step, orderings, masking, min_visible,
-    out_pos, out_mse,
+    frame, templates, support, sizes, origins, active, radius, step, orderings, masking,
+    min_visible, out_pos, out_mse, out_count,
 ):  # pragma: no cover - compiled
     """Match every object under every depth ordering, front to back.
 
@@ -188,6 +193,8 @@ def layered_match(
         Template (height, width) of each object.
     origins : ndarray of shape (M, 2), int64
         Centre (x, y) of each search window, as a template top-left corner.
+    active : ndarray of shape (M,), bool
+        Objects to measure; the others are missed under every ordering (and mask nothing).
     radius, step : int
         Search window half-size in pixels; coarse-to-fine stride (1 = exhaustive).
     orderings : ndarray of shape (L, M), int64
@@ -200,6 +207,8 @@ def layered_match(
         Written: matched top-left (x, y) of object m under ordering l (0 if missed).
     out_mse : ndarray of shape (L, M), float64
         Written: mean squared difference per channel, NaN for a missed measurement.
+    out_count : ndarray of shape (L, M), int64
+        Written: number of pixels compared by each match (0 if missed).
 
     Returns
     -------
@@ -215,6 +224,7 @@ def layered_match(
     memo_fpos = np.zeros((n_memo_max, m_obj, 2), dtype=np.int64)
     memo_pos = np.empty((n_memo_max, 2), dtype=np.int64)
     memo_mse = np.empty(n_memo_max, dtype=np.float64)
+    memo_cnt = np.empty(n_memo_max, dtype=np.int64)
     n_memo = 0
     front = np.empty(m_obj, dtype=np.int64)
     front_pos = np.empty((m_obj, 2), dtype=np.int64)
@@ -253,6 +263,12 @@ def layered_match(
                         n_front += 1
                         bits |= np.int64(1) << f
             hit = -1
+            if not active[m]:
+                out_pos[l, m, 0] = 0
+                out_pos[l, m, 1] = 0
+                out_mse[l, m] = np.nan
+                out_count[l, m] = 0
+                continue
             for k in range(n_memo):
                 if memo_obj[k] != m or memo_bits[k] != bits:
                     continue
@@ -269,7 +285,7 @@ def layered_match(
             if hit < 0:
                 sub = valid[:rh, :rw]
                 _fill_valid(h, w, rx, ry, sub, support, sizes, front, n_front, front_pos)
-                x, y, e = _match(frame, templates[m], support[m], th, tw, radius, step,
+                x, y, e, cnt = _match(frame, templates[m], support[m], th, tw, radius, step,
                                  min_visible, sub, rx, ry, offsets)
                 n_run += 1
                 hit = n_memo
@@ -281,6 +297,7 @@ def layered_match(
                 memo_pos[hit, 0] = x
                 memo_pos[hit, 1] = y
                 memo_mse[hit] = e
+                memo_cnt[hit] = cnt
                 n_memo += 1
             e = memo_mse[hit]
             if np.isfinite(e):
@@ -290,9 +307,11 @@ def layered_match(
                 out_pos[l, m, 0] = pos[m, 0]
                 out_pos[l, m, 1] = pos[m, 1]
                 out_mse[l, m] = e
+                out_count[l, m] = memo_cnt[hit]
             else:
                 out_pos[l, m, 0] = 0
                 out_pos[l, m, 1] = 0
                 out_mse[l, m] = np.nan
+                out_count[l, m] = 0
     return n_run
 
