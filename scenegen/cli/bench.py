@@ -24,8 +24,22 @@ def cmd_bench(args: argparse.Namespace) -> int:
     if args.repeats < 1:
         raise ConfigError(f"--repeats must be >= 1, got {args.repeats}")
     rows = run_all(args.repeats, only=args.only, log=lambda m: print(m, file=sys.stderr))
+    sizes = []
+    if args.only is None or args.only in "scenegen.bench.generation":
+        from scenegen.bench.generation import sizes as measure_sizes
+
+        sizes = measure_sizes()
     if args.json:
-        print(json.dumps({"repeats": args.repeats, "rows": [r.to_dict() for r in rows]}, indent=2))
-    else:
-        print(format_table(rows))
+        doc = {"repeats": args.repeats, "rows": [r.to_dict() for r in rows], "compression": sizes}
+        print(json.dumps(doc, indent=2))
+        return 0
+    print(format_table(rows))
+    if sizes:
+        print("\n| preset | filter | frames: raw/stored | labels: raw/stored |")
+        print("|---|---|---:|---:|")
+        for s in sizes:
+            print(
+                f"| {s['preset']} | {s['compression']} | {s['frames_ratio']:.2f}x "
+                f"| {s['labels_ratio']:.1f}x |"
+            )
     return 0
