@@ -1,11 +1,33 @@
 """HDF5 reading and writing (schema ``scenegen/1``, CONTRACT.md). The only module that
 touches files.
 
-Every write goes to a temporary file in the target's folder and is renamed into place only
-when complete, so a crash or a kill never leaves a half-written file at the target path
-and never damages an earlier file there. Frames and labels are stored one frame per chunk,
-so reading a frame range costs in proportion to the range; :func:`read` returns lazy arrays
-that read only what is indexed.
+Atomic writes
+    Every write goes to a temporary file in the target's folder, named
+    ``.NAME.tmp-PID@HOST-XXXXXXXX``, which is flushed to disk and renamed onto the target
+    only when complete. A crash or a SIGKILL therefore never leaves a half-written file at
+    the target path and never damages an earlier file there; a reader sees either the old
+    complete file or the new complete one. Concurrent writers never collide: every write
+    has its own temporary name, and when several processes write the same target the last
+    rename wins with a complete file.
+
+Leftover temporary files
+    A killed writer leaves its temporary file behind. Such files start with a dot, so
+    shell globs such as ``*.h5`` skip them, and :func:`clean_temp_files` removes those
+    whose writing process (on this host) no longer runs. Every atomic write first cleans
+    the stale leftovers of its own target, so rerunning a killed command tidies up after
+    it. Files written by other hosts (shared folders) are left alone.
+
+Integrity
+    Frames, labels, ground truth and templates are stored with the Fletcher-32 checksum
+    filter (besides the chosen compression), so a flipped byte in any chunk makes reading
+    it fail instead of returning silently wrong pixels; :mod:`scenegen.validate` reports
+    such chunks. Read errors of damaged files surface as :class:`DataError` with one line.
+
+Lazy reads
+    Frames and labels are stored one frame per chunk, so reading a frame range costs in
+    proportion to the range; :func:`read` returns lazy arrays that read only what is
+    indexed. Writing streams a chunk of frames at a time, so memory stays bounded
+    whatever the sequence length.
 """
 
 from __future__ import annotations
@@ -13,6 +35,9 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import re
+import shutil
+import socket
 import tempfile
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
@@ -28,16 +53,22 @@ from scenegen.errors import ConfigError, DataError
 from scenegen.sequence import GT_FIELDS, Entities, GroundTruth, Sequence
 
 __all__ = [
+    "BLOCK_BYTES",
     "COMPRESSIONS",
     "SCHEMA",
     "LazyArray",
     "TrackerResult",
     "atomic_path",
+    "clean_temp_files",
+    "describe_open_error",
     "filter_options",
+    "frames_per_block",
     "open_checked",
     "read",
     "read_result",
     "sequence_names",
+    "temp_file_owner",
+    "temp_prefix",
     "write",
     "write_result",
     "write_scenario",
@@ -45,8 +76,13 @@ __all__ = [
 
 SCHEMA = "scenegen/1"
 COMPRESSIONS = ("gzip", "lzf", "none")
+BLOCK_BYTES = 128 * 2**20
+"""Upper bound on the pixel bytes (frames + labels) of one block rendered and written at
+once: long or large sequences are written a block at a time in bounded memory."""
+
 _STR = h5py.string_dtype("utf-8")
-_BLOCK = 64  # frames per write call
+_BLOCK = 64  # frames per write call, at most
+_TEMP_NAME = re.compile(r"^\.(?P<target>.+)\.(?P<kind>tmp|old)-(?P<pid>\d+)@(?P<host>[\w.]*)-")
 
 
 def _version() -> str:
@@ -55,17 +91,165 @@ def _version() -> str:
     return __version__
 
 
+# ---------------------------------------------------------------------------------------
+# Temporary files and atomic replacement
+
+
+def _host() -> str:
+    return re.sub(r"[^\w.]", "_", socket.gethostname(), flags=re.ASCII)
+
+
+def temp_prefix(name: str, kind: str = "tmp") -> str:
+    """The prefix of this process's temporary files for a target called ``name``.
+
+    Parameters
+    ----------
+    name : str
+        The target's file or folder name (no directory).
+    kind : {'tmp', 'old'}
+        ``tmp`` for a file or folder being written, ``old`` for a folder being replaced.
+
+    Returns
+    -------
+    str
+        ``.NAME.KIND-PID@HOST-``; a random part follows it in the actual name.
+
+    Example
+    -------
+    >>> temp_prefix("a.h5").startswith(".a.h5.tmp-")
+    True
+    """
+    return f".{name}.{kind}-{os.getpid()}@{_host()}-"
+
+
+def temp_file_owner(path: str | Path) -> tuple[str, int, str] | None:
+    """Parse the name of a temporary file written by :func:`atomic_path`.
+
+    Parameters
+    ----------
+    path : str or Path
+
+    Returns
+    -------
+    (target, pid, host) or None
+        The target's name, and the process and host that write(s) it; None if ``path``
+        is not named like a temporary file.
+
+    Example
+    -------
+    >>> temp_file_owner(".a.h5.tmp-123@box-x1y2z3")
+    ('a.h5', 123, 'box')
+    """
+    m = _TEMP_NAME.match(Path(path).name)
+    if m is None:
+        return None
+    return m["target"], int(m["pid"]), m["host"]
+
+
+def _running(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # someone else's live process
+        return True
+    return True
+
+
+def _stale(path: Path) -> bool:
+    owner = temp_file_owner(path)
+    if owner is None:
+        return False
+    _, pid, host = owner
+    return host == _host() and pid != os.getpid() and not _running(pid)
+
+
+def clean_temp_files(folder: str | Path, name: str | None = None) -> list[Path]:
+    """Remove stale temporary files and folders left in ``folder`` by killed writers.
+
+    A temporary file is stale when it was written on this host by a process that no
+    longer runs. Files of running processes and of other hosts are never touched.
+
+    Parameters
+    ----------
+    folder : str or Path
+    name : str, optional
+        Only the leftovers of this target name (default: of every target).
+
+    Returns
+    -------
+    list of Path
+        What was removed.
+    """
+    d = Path(folder)
+    pattern = f".{_glob_escape(name)}.*-*@*-*" if name is not None else ".*.*-*@*-*"
+    removed = []
+    for p in sorted(d.glob(pattern)):
+        if not _stale(p):
+            continue
+        with contextlib.suppress(OSError):
+            if p.is_dir() and not p.is_symlink():
+                shutil.rmtree(p)
+            else:
+                p.unlink()
+            removed.append(p)
+    return removed
+
+
+def _glob_escape(text: str) -> str:
+    # Path.glob treats *, ? and [ specially.
+    return re.sub(r"([*?\[])", r"[\1]", text)
+
+
+def _fsync(path: Path) -> None:
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
+def _fsync_dir(folder: Path) -> None:
+    # Makes the rename itself durable; not every file system allows it.
+    with contextlib.suppress(OSError):
+        _fsync(folder)
+
+
+def _target_folder(target: Path) -> Path:
+    folder = target.parent if str(target.parent) else Path(".")
+    if not folder.is_dir():
+        raise ConfigError(f"{target}: folder {folder} does not exist")
+    if target.is_dir():
+        raise ConfigError(f"{target}: is a folder, expected a file name")
+    return folder
+
+
 @contextlib.contextmanager
 def atomic_path(path: str | Path, suffix: str = "") -> Iterator[Path]:
     """Yield a temporary path beside ``path``; rename it onto ``path`` on success.
 
-    On any exception the temporary file is removed and ``path`` is left untouched.
+    The temporary file is named ``.NAME.tmp-PID@HOST-XXXXXXXX`` + ``suffix`` (unique per
+    call, so concurrent writers never collide) and is flushed to disk before the rename.
+    On any exception it is removed and ``path`` is left untouched; if the process is
+    killed it stays behind, and the next atomic write of the same target (or
+    :func:`clean_temp_files`) removes it.
+
+    Parameters
+    ----------
+    path : str or Path
+        The target file; its folder must exist.
+    suffix : str
+        Ending of the temporary name (lets writers that pick a format by extension work).
+
+    Raises
+    ------
+    ConfigError
+        If the folder does not exist or the target is a folder.
     """
     target = Path(path)
-    folder = target.parent if str(target.parent) else Path(".")
-    if not folder.is_dir():
-        raise ConfigError(f"{target}: folder {folder} does not exist")
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.tmp-", suffix=suffix, dir=folder)
+    folder = _target_folder(target)
+    clean_temp_files(folder, target.name)
+    fd, tmp = tempfile.mkstemp(prefix=temp_prefix(target.name), suffix=suffix, dir=folder)
     os.close(fd)
     tmp_path = Path(tmp)
     # mkstemp makes the file private; give it the permissions a plain open() would.
@@ -74,23 +258,64 @@ def atomic_path(path: str | Path, suffix: str = "") -> Iterator[Path]:
     os.chmod(tmp_path, 0o666 & ~umask)
     try:
         yield tmp_path
+        _fsync(tmp_path)
         os.replace(tmp_path, target)
     except BaseException:
         with contextlib.suppress(OSError):
             tmp_path.unlink()
         raise
+    _fsync_dir(folder)
+
+
+# ---------------------------------------------------------------------------------------
+# Writing
 
 
 def filter_options(compression: str) -> dict[str, Any]:
+    """h5py dataset options for ``compression``, always with the Fletcher-32 checksum.
+
+    Parameters
+    ----------
+    compression : {'gzip', 'lzf', 'none'}
+
+    Returns
+    -------
+    dict
+        Keyword arguments for ``create_dataset``.
+
+    Raises
+    ------
+    ConfigError
+        For another compression name.
+    """
     if compression not in COMPRESSIONS:
         raise ConfigError(
             f"compression must be one of {', '.join(COMPRESSIONS)}; got {compression!r}"
         )
     if compression == "gzip":
-        return {"compression": "gzip", "compression_opts": 4}
+        return {"compression": "gzip", "compression_opts": 4, "fletcher32": True}
     if compression == "lzf":
-        return {"compression": "lzf"}
-    return {}
+        return {"compression": "lzf", "fletcher32": True}
+    return {"fletcher32": True}
+
+
+def frames_per_block(height: int, width: int, limit: int = _BLOCK) -> int:
+    """Frames rendered and written at once: at most ``limit`` and :data:`BLOCK_BYTES`.
+
+    Parameters
+    ----------
+    height, width : int
+        Frame size in pixels.
+    limit : int
+        Upper bound on the block length.
+
+    Returns
+    -------
+    int
+        At least 1.
+    """
+    per_frame = height * width * 5  # RGB uint8 + uint16 label
+    return max(1, min(limit, BLOCK_BYTES // max(per_frame, 1)))
 
 
 def _write_header(f: h5py.File) -> None:
@@ -122,16 +347,39 @@ def _create_sequence_group(
     return g, frames, labels
 
 
-def _write_gt(g: h5py.Group, gt: dict[str, NDArray[Any]]) -> None:
+def _gt_shape(key: str, t: int, k: int) -> tuple[int, ...]:
+    return {"box": (t, k, 4), "visible_box": (t, k, 4), "center": (t, k, 2)}.get(key, (t, k))
+
+
+def _create_gt(g: h5py.Group, t: int, k: int, rows: int) -> dict[str, h5py.Dataset]:
+    """Empty ground-truth datasets, chunked by ``rows`` frames, checksummed."""
     grp = g.create_group("gt")
+    out = {}
     for key, dtype in GT_FIELDS.items():
-        grp.create_dataset(key, data=np.asarray(gt[key], dtype=dtype))
+        shape = _gt_shape(key, t, k)
+        if k == 0:  # nothing to checksum; HDF5 chunks cannot have a zero side
+            out[key] = grp.create_dataset(key, shape, dtype)
+        else:
+            chunks = (max(1, min(rows, t)), *shape[1:])
+            out[key] = grp.create_dataset(key, shape, dtype, chunks=chunks, fletcher32=True)
+    return out
+
+
+def _write_gt(g: h5py.Group, gt: dict[str, NDArray[Any]]) -> None:
+    t, k = np.shape(gt["present"])[:2]
+    for key, ds in _create_gt(g, t, k, _BLOCK).items():
+        if ds.size:
+            ds[...] = np.asarray(gt[key], dtype=GT_FIELDS[key])
 
 
 def _write_templates(g: h5py.Group, templates: dict[int, NDArray[np.uint8]]) -> None:
     grp = g.create_group("templates")
     for eid, tpl in templates.items():
-        grp.create_dataset(str(int(eid)), data=np.asarray(tpl, dtype=np.uint8))
+        arr = np.asarray(tpl, dtype=np.uint8)
+        if arr.size:
+            grp.create_dataset(str(int(eid)), data=arr, chunks=arr.shape, fletcher32=True)
+        else:
+            grp.create_dataset(str(int(eid)), data=arr)
 
 
 def _meta(seq: Sequence) -> dict[str, Any]:
@@ -153,9 +401,15 @@ def write(path: str | Path, *sequences: Sequence, compression: str = "gzip") -> 
     ----------
     path : str or Path
     *sequences : Sequence
-        At least one; names must be unique.
+        At least one; names must be unique. Lazy frames (from :func:`read`) are copied a
+        block at a time, so memory stays bounded.
     compression : {'gzip', 'lzf', 'none'}
         Filter for frames and labels (one frame per chunk).
+
+    Raises
+    ------
+    ConfigError
+        No sequence, duplicate names, a bad compression or a missing folder.
     """
     if not sequences:
         raise ConfigError("write needs at least one sequence")
@@ -165,8 +419,9 @@ def write(path: str | Path, *sequences: Sequence, compression: str = "gzip") -> 
         for seq in sequences:
             g, frames, labels = _create_sequence_group(f, _meta(seq), seq.entities, compression)
             # Blocks of whole chunks: bounded memory for lazy inputs, few h5py calls.
-            for t in range(0, seq.n_frames, _BLOCK):
-                stop = min(t + _BLOCK, seq.n_frames)
+            block = frames_per_block(seq.height, seq.width)
+            for t in range(0, seq.n_frames, block):
+                stop = min(t + block, seq.n_frames)
                 frames[t:stop] = np.asarray(seq.frames[t:stop])
                 labels[t:stop] = np.asarray(seq.labels[t:stop])
             _write_gt(g, seq.gt.as_dict())
@@ -178,13 +433,24 @@ def write_scenario(
     scenario: Any,
     *,
     compression: str = "gzip",
-    chunk: int = 64,
+    chunk: int = _BLOCK,
     progress: Callable[[int], None] | None = None,
 ) -> None:
     """Render ``scenario`` (:class:`scenegen.generator.Scenario`) straight into a file.
 
-    Frames are rendered and written ``chunk`` at a time, so memory stays bounded whatever
-    the sequence length. ``progress`` is called with the number of frames written so far.
+    Frames and their ground truth are rendered and written a block at a time (at most
+    ``chunk`` frames and :data:`BLOCK_BYTES` of pixels), so memory stays bounded whatever
+    the sequence length; the file appears at ``path`` only when complete.
+
+    Parameters
+    ----------
+    path : str or Path
+    scenario : Scenario
+    compression : {'gzip', 'lzf', 'none'}
+    chunk : int
+        Upper bound on the frames rendered at once.
+    progress : callable, optional
+        Called with the number of frames written so far.
     """
     cfg = scenario.config
     meta = {
@@ -196,30 +462,77 @@ def write_scenario(
         "height": cfg.height,
         "width": cfg.width,
     }
-    k = scenario.n_entities
-    t_n = cfg.n_frames
+    filter_options(compression)
+    block = frames_per_block(cfg.height, cfg.width, max(1, int(chunk)))
     with atomic_path(path) as tmp, h5py.File(tmp, "w") as f:
         _write_header(f)
         g, frames, labels = _create_sequence_group(f, meta, scenario.entities(), compression)
-        gt = {
-            "box": np.empty((t_n, k, 4), np.float32),
-            "visible_box": np.empty((t_n, k, 4), np.float32),
-            "center": np.empty((t_n, k, 2), np.float32),
-            "visibility": np.empty((t_n, k), np.float32),
-            "present": np.empty((t_n, k), bool),
-            "depth": np.empty((t_n, k), np.int16),
-        }
-        for c in scenario.chunks(chunk):
+        gt = _create_gt(g, cfg.n_frames, scenario.n_entities, block)
+        for c in scenario.chunks(block):
             stop = c.start + c.frames.shape[0]
             # Chunk-aligned writes: h5py writes whole chunks without reading them back.
             frames[c.start : stop] = c.frames
             labels[c.start : stop] = c.labels
-            for key in gt:
-                gt[key][c.start : stop] = c.gt[key]
+            for key, ds in gt.items():
+                if ds.size:
+                    ds[c.start : stop] = c.gt[key]
             if progress is not None:
                 progress(stop)
-        _write_gt(g, gt)
         _write_templates(g, scenario.template_images())
+
+
+# ---------------------------------------------------------------------------------------
+# Reading
+
+
+def describe_open_error(path: str | Path, err: OSError) -> str:
+    """One line saying why HDF5 could not open ``path``.
+
+    Parameters
+    ----------
+    path : str or Path
+    err : OSError
+        What ``h5py.File`` raised.
+
+    Returns
+    -------
+    str
+        ``"PATH: ..."``: truncated (with the byte counts), being written by another
+        process, not HDF5 at all, or otherwise damaged.
+    """
+    p = Path(path)
+    text = str(err)
+    owner = temp_file_owner(p)
+    if owner is not None:
+        state = "running" if owner[2] == _host() and _running(owner[1]) else "gone"
+        return (
+            f"{p}: an unfinished temporary file of a write to {owner[0]!r} "
+            f"(process {owner[1]} on {owner[2] or '?'}, {state})"
+        )
+    if "unable to lock file" in text:
+        return f"{p}: is being written by another process (the HDF5 file is locked)"
+    m = re.search(r"truncated file: eof = (\d+).*stored_eof = (\d+)", text)
+    if m:
+        return f"{p}: truncated HDF5 file ({m[1]} of {m[2]} bytes)"
+    if "file signature not found" in text:
+        return f"{p}: not an HDF5 file"
+    if "errno = 13" in text or isinstance(err, PermissionError):
+        return f"{p}: cannot read the file (permission denied)"
+    first = text.strip().splitlines()[0] if text.strip() else type(err).__name__
+    return f"{p}: not a readable HDF5 file (truncated or corrupted: {first})"
+
+
+def _stamp(path: str) -> tuple[int, int, int]:
+    st = os.stat(path)
+    return st.st_ino, st.st_size, st.st_mtime_ns
+
+
+def _key_text(key: Any) -> str:
+    if isinstance(key, slice):
+        return f"{'' if key.start is None else key.start}:{'' if key.stop is None else key.stop}"
+    if isinstance(key, tuple):
+        return ", ".join(_key_text(k) for k in key)
+    return "..." if key is Ellipsis else str(key)
 
 
 class LazyArray:
@@ -227,20 +540,42 @@ class LazyArray:
 
     Supports ``shape``, ``dtype``, ``len()``, integer/slice indexing and ``np.asarray``.
     The file is opened on first access and reopened after pickling, so lazy arrays can be
-    sent to worker processes.
+    sent to worker processes. Reopening checks that the file is still the one first
+    opened (atomic writers replace files whole), and a damaged chunk raises
+    :class:`DataError` naming the file, dataset and index.
+
+    Parameters
+    ----------
+    path : str or Path
+    dataset : str
+        Path of the dataset inside the file.
     """
 
     def __init__(self, path: str | Path, dataset: str) -> None:
         self.path = str(path)
         self.dataset = dataset
         self._file: h5py.File | None = None
+        self._stamp: tuple[int, int, int] | None = None
         ds = self._ds()
         self.shape: tuple[int, ...] = tuple(ds.shape)
         self.dtype = ds.dtype
 
     def _ds(self) -> h5py.Dataset:
         if self._file is None or not self._file.id.valid:
-            self._file = h5py.File(self.path, "r")
+            try:
+                stamp = _stamp(self.path)
+            except OSError:
+                raise DataError(f"{self.path}: no longer exists") from None
+            if self._stamp is not None and stamp != self._stamp:
+                raise DataError(
+                    f"{self.path}: the file was replaced or changed since it was read; "
+                    "read it again"
+                )
+            try:
+                self._file = h5py.File(self.path, "r")
+            except OSError as err:
+                raise DataError(describe_open_error(self.path, err)) from None
+            self._stamp = stamp
         return self._file[self.dataset]
 
     def __getstate__(self) -> dict[str, Any]:
@@ -255,11 +590,21 @@ class LazyArray:
     def ndim(self) -> int:
         return len(self.shape)
 
+    def _get(self, key: Any) -> NDArray[Any]:
+        try:
+            return self._ds()[key]
+        except (OSError, RuntimeError) as err:
+            first = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
+            raise DataError(
+                f"{self.path}: {self.dataset}[{_key_text(key)}] is unreadable "
+                f"(damaged file: {first})"
+            ) from None
+
     def __getitem__(self, key: Any) -> NDArray[Any]:
-        return self._ds()[key]
+        return self._get(key)
 
     def __array__(self, dtype: Any = None, copy: Any = None) -> NDArray[Any]:
-        arr = self._ds()[()]
+        arr = self._get(())
         return arr if dtype is None else arr.astype(dtype)
 
     def __iter__(self) -> Iterator[NDArray[Any]]:
@@ -278,29 +623,56 @@ class LazyArray:
 def open_checked(path: str | Path) -> h5py.File:
     """Open an HDF5 file for reading and check its schema.
 
+    Parameters
+    ----------
+    path : str or Path
+
+    Returns
+    -------
+    h5py.File
+        Open for reading; the caller closes it.
+
     Raises
     ------
     DataError
-        If the file is missing, not HDF5, or of another schema.
+        If the file is missing, a folder, not HDF5, truncated, being written by another
+        process, or of another schema.
     """
     p = Path(path)
     if not p.exists():
         raise DataError(f"{p}: no such file")
+    if p.is_dir():
+        raise DataError(f"{p}: is a folder, not a scenegen file")
     try:
         f = h5py.File(p, "r")
-    except OSError:
-        raise DataError(f"{p}: not an HDF5 file (or truncated/corrupted)") from None
-    schema = f.attrs.get("schema")
+    except OSError as err:
+        raise DataError(describe_open_error(p, err)) from None
+    try:
+        schema = f.attrs.get("schema")
+    except (OSError, RuntimeError, KeyError):
+        f.close()
+        raise DataError(f"{p}: damaged HDF5 file (unreadable attributes)") from None
     if isinstance(schema, bytes):
-        schema = schema.decode()
+        schema = schema.decode(errors="replace")
     if schema != SCHEMA:
         f.close()
+        if schema is None:
+            raise DataError(f"{p}: missing schema attribute (expected {SCHEMA!r})")
         raise DataError(f"{p}: schema is {schema!r}, expected {SCHEMA!r}")
     return f
 
 
 def sequence_names(path: str | Path) -> list[str]:
-    """Names of the sequences in a file."""
+    """Names of the sequences in a file.
+
+    Parameters
+    ----------
+    path : str or Path
+
+    Returns
+    -------
+    list of str
+    """
     with open_checked(path) as f:
         return list(f.get("sequences", {}).keys())
 
@@ -318,10 +690,15 @@ def read(path: str | Path, name: str | None = None) -> Sequence:
     name : str, optional
         The sequence to read; required when the file holds several.
 
+    Returns
+    -------
+    Sequence
+        Ground truth, entities and templates in memory (O(T K)); pixels lazy.
+
     Raises
     ------
     DataError
-        If the file is not a valid scenegen file or has no such sequence.
+        If the file is not a valid scenegen file, is damaged, or has no such sequence.
     """
     p = Path(path)
     with open_checked(p) as f:
@@ -345,15 +722,18 @@ def read(path: str | Path, name: str | None = None) -> Sequence:
             gt = GroundTruth(**{k: g[f"gt/{k}"][()].astype(dt) for k, dt in GT_FIELDS.items()})
             templates = {int(k): v[()] for k, v in g["templates"].items()}
             seed, preset = int(g.attrs["seed"]), str(g.attrs["preset"])
-        except (KeyError, ValueError, ConfigError) as err:
-            raise DataError(f"{p}: sequence {name!r} is damaged: {err}") from None
+            frames = LazyArray(p, f"sequences/{name}/frames")
+            labels = LazyArray(p, f"sequences/{name}/labels")
+        except (KeyError, ValueError, TypeError, OSError, RuntimeError, ConfigError) as err:
+            first = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
+            raise DataError(f"{p}: sequence {name!r} is damaged: {first}") from None
     return Sequence(
         name=name,
         seed=seed,
         config=config,
         preset=preset,
-        frames=LazyArray(p, f"sequences/{name}/frames"),
-        labels=LazyArray(p, f"sequences/{name}/labels"),
+        frames=frames,
+        labels=labels,
         entities=entities,
         gt=gt,
         templates=templates,
@@ -393,7 +773,19 @@ class TrackerResult:
 
 
 def write_result(path: str | Path, *results: TrackerResult) -> None:
-    """Write tracker results to a result file (atomically), one group per tracker."""
+    """Write tracker results to a result file (atomically), one group per tracker.
+
+    Parameters
+    ----------
+    path : str or Path
+    *results : TrackerResult
+        At least one; at most one per tracker name.
+
+    Raises
+    ------
+    ConfigError
+        No result, two results of one tracker, or a missing folder.
+    """
     if not results:
         raise ConfigError("write_result needs at least one result")
     with atomic_path(path) as tmp, h5py.File(tmp, "w") as f:
@@ -417,10 +809,20 @@ def write_result(path: str | Path, *results: TrackerResult) -> None:
 def read_result(path: str | Path, tracker: str | None = None) -> TrackerResult:
     """Read one tracker's result (the only one if ``tracker`` is None).
 
+    Parameters
+    ----------
+    path : str or Path
+    tracker : str, optional
+
+    Returns
+    -------
+    TrackerResult
+
     Raises
     ------
     DataError
-        If the file is not a result file, or has no (or several, unnamed) results.
+        If the file is not a result file, is damaged, or has no (or several, unnamed)
+        results.
     """
     p = Path(path)
     with open_checked(p) as f:
@@ -445,5 +847,6 @@ def read_result(path: str | Path, tracker: str | None = None) -> TrackerResult:
                 orderings=g["orderings"][()] if "orderings" in g else None,
                 order_prob=g["order_prob"][()] if "order_prob" in g else None,
             )
-        except (KeyError, ValueError) as err:
-            raise DataError(f"{p}: result {tracker!r} is damaged: {err}") from None
+        except (KeyError, ValueError, TypeError, OSError, RuntimeError) as err:
+            first = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
+            raise DataError(f"{p}: result {tracker!r} is damaged: {first}") from None
