@@ -18,7 +18,7 @@ __all__ = ["main"]
 
 def _parser() -> argparse.ArgumentParser:
     from scenegen import __version__
-    from scenegen.cli import bench, data, demo, evaluate, experiment, track
+    from scenegen.cli import bench, data, demo, evaluate, experiment, fixtures, track
 
     parser = argparse.ArgumentParser(
         prog="scenegen",
@@ -28,7 +28,7 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--debug", action="store_true", help="show tracebacks on errors")
     sub = parser.add_subparsers(dest="verb", metavar="VERB")
     sub.required = True
-    for module in (data, track, evaluate, experiment, bench, demo):
+    for module in (data, track, evaluate, experiment, bench, demo, fixtures):
         module.register(sub)
     return parser
 
