@@ -266,6 +266,7 @@ def mean_shift(
     max_iter: int = 20,
     eps: float = 0.5,
     min_distance: float = 0.0,
+    check_bins: bool = True,
 ) -> MeanShiftResult:
     """Run kernel mean shift from every start point of a frame in one compiled call.
 
@@ -290,6 +291,9 @@ def mean_shift(
         Stop when one shift moves the centre by less than ``eps`` pixels (>= 0).
     min_distance : float, optional
         Stop when the Bhattacharyya distance falls to this value or below (>= 0).
+    check_bins : bool, optional
+        Check that every bin index lies in [0, B); callers passing a bin image from the
+        matching quantiser skip this full-frame scan.
 
     Returns
     -------
@@ -341,7 +345,7 @@ def mean_shift(
         raise ValueError("centres must be finite")
     if not np.all(np.isfinite(hw) & (hw > 0)):
         raise ValueError(f"sizes must be finite and positive, got min {hw.min()}")
-    if img.size and (img.min() < 0 or img.max() >= q.shape[1]):
+    if check_bins and img.size and (img.min() < 0 or img.max() >= q.shape[1]):
         raise ValueError(f"bin_img values must lie in [0, {q.shape[1]}), got "
                          f"[{img.min()}, {img.max()}]")
     if kernel not in MEAN_SHIFT_KERNELS.values():
