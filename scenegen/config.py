@@ -339,8 +339,6 @@ class SceneConfig:
                     _fail(f"entities[{i}].mimic", f"no entity named {e.mimic!r}")
                 if self.entities[names[e.mimic]].mimic is not None:
                     _fail(f"entities[{i}].mimic", f"{e.mimic!r} itself mimics another entity")
-            if e.disappear is not None and e.appear >= self.n_frames:
-                _fail(f"entities[{i}].appear", f"{e.appear} is past the last frame")
         cnames = [c.name for c in self.clutter]
         for j, c in enumerate(self.clutter):
             if c.name in names or cnames.index(c.name) != j:
