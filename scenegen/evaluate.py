@@ -108,7 +108,7 @@ def evaluate(
     order_prob: ArrayLike | None = None,
     orderings: ArrayLike | None = None,
     recover_frames: int = DEFAULT_RECOVER_FRAMES,
-    persist: int = 5,
+    persist: int = 10,
     iou_threshold: float = 0.5,
 ) -> dict[str, Any]:
     """Metrics of one tracker result on one sequence.

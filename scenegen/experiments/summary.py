@@ -26,7 +26,7 @@ __all__ = ["AGREE_PX", "AGREE_POINTS", "FAILURE_PERSIST", "Z_995", "render_table
 AGREE_POINTS = 10.0
 AGREE_PX = 3.0
 Z_995 = 2.576
-FAILURE_PERSIST = 5
+FAILURE_PERSIST = 10
 """Frames the centre error must stay above the target size for a KAMS-style failure
 (:func:`scenegen.evaluate.failure_threshold`)."""
 
@@ -375,8 +375,14 @@ def _table_dps_occlusion(res: dict[str, Any]) -> list[str]:
 # kams-accuracy
 
 
+def _present_error(target: dict[str, Any]) -> np.ndarray:
+    """Centre error over the frames where the target is present (NaN: no estimate)."""
+    err = _arr(target["centre_error"])
+    return err[np.array([s is not None for s in target["state"]], dtype=bool)]
+
+
 def _kams_case(rec: dict[str, Any], threshold: float) -> tuple[float, int]:
-    err = _arr(rec["targets"][0]["centre_error"])
+    err = _present_error(rec["targets"][0])
     return (float(np.nanmean(err)) if np.any(np.isfinite(err)) else float("nan"),
             metrics.failure_frame(np.nan_to_num(err, nan=np.inf), threshold,
                                   persist=FAILURE_PERSIST))
@@ -473,7 +479,7 @@ def _kams_robustness(exp: Experiment, records: Records) -> dict[str, Any]:
     by_method: dict[str, dict[int, float]] = defaultdict(dict)
     for r in records:
         k = r["key"]
-        err = _arr(r["targets"][0]["centre_error"])
+        err = _present_error(r["targets"][0])
         by_method[k["method"]][k["run"]] = metrics.tracked_fraction(
             np.nan_to_num(err, nan=np.inf), r["failure_threshold"][0], persist=FAILURE_PERSIST
         )
