@@ -173,3 +173,27 @@ def test_dps_synthetic_fidelity(tmp_path):
     assert dps["hard"]["recovery"] > ps["hard"]["recovery"] > nonps["hard"]["recovery"]
     assert ps["others"]["precision"] > nonps["others"]["precision"]
     assert dps["others"]["precision"] > nonps["others"]["precision"]
+
+
+def test_report_links_tables_figures_and_previews(reference, tmp_path):
+    from scenegen.report import build_report, markdown_to_html
+
+    shutil.copytree(reference, tmp_path / "experiments" / NAME)
+    run_experiment(NAME, tmp_path / "experiments" / NAME, jobs=1, runs=2, quick=True,
+                   progress=False)
+    (tmp_path / "presets").mkdir()
+    for f in ("kams-a.png", "kams-a.gif", "kams-a.h5"):
+        (tmp_path / "presets" / f).write_bytes(b"x")
+    index = build_report(tmp_path)
+    page = index.read_text()
+    assert "experiments/shm-depth/ordering_probability.png" in page
+    assert "experiments/shm-depth/table.md" in page
+    assert "presets/kams-a.gif" in page and "presets/kams-a.png" in page
+    assert "id='fidelity'" in page and "dps-synthetic" in page  # missing ones are listed
+    doc = json.loads((tmp_path / "results.json").read_text())
+    assert list(doc["experiments"]) == [NAME]
+    assert build_report(tmp_path).read_text() == page  # deterministic
+    assert markdown_to_html("| a | b |\n|---|---|\n| **1** | `x<y` |") == (
+        "<table>\n<tr><th>a</th><th>b</th></tr>\n"
+        "<tr><td><strong>1</strong></td><td><code>x&lt;y</code></td></tr>\n</table>"
+    )
