@@ -1,0 +1,109 @@
+"""The annealed particle filter (trackers.annealed)."""
+
+import numpy as np
+import pytest
+
+import trackers
+from trackers.annealed import survival_beta, survival_rate
+from trackers.observation import ColourModel
+from trackers.resampling import resample_groups
+
+
+def first_frames_and_boxes(scenegen_sequence, n_frames=12):
+    seq = scenegen_sequence("kams-a", seed=3, frames=n_frames)
+    frames = np.asarray(seq.frames)
+    # The target and one clutter disc: two independently tracked objects.
+    boxes = np.asarray(seq.gt.box[0])[[seq.target_indices()[0], 1]].astype(np.float64)
+    return frames, boxes
+
+
+def bootstrap_filter(frames, boxes, *, n_particles, sigma, lam, seed):
+    """Plain SIR with random-walk noise, written out from the shared parts."""
+    rng = np.random.default_rng(seed)
+    model = ColourModel("rgb", bins=10, kernel="cone", lam=lam)
+    model.set_references(frames[0], boxes)
+    k, n = len(boxes), n_particles
+    size = np.repeat(boxes[:, None, 2:], n, axis=1)
+    x = np.repeat((boxes[:, :2] + boxes[:, 2:] / 2)[:, None, :], n, axis=1)
+    w = np.full((k, n), 1.0 / n)
+    out = []
+    h, wd = frames.shape[1:3]
+    for frame in frames[1:]:
+        idx = resample_groups(w.ravel(), np.full(k, n), method="systematic", rng=rng)
+        x = x.reshape(k * n, 2)[idx].reshape(k, n, 2)
+        x = x + sigma * rng.standard_normal(x.shape)
+        x[..., 0] = np.clip(x[..., 0], 0, wd)
+        x[..., 1] = np.clip(x[..., 1], 0, h)
+        cand = np.concatenate([x - size / 2, size], axis=-1).reshape(k * n, 4)
+        ll = model.observe(frame).log_likelihoods(cand, np.repeat(np.arange(k), n))
+        ll = ll.reshape(k, n)
+        w = np.exp(ll - ll.max(axis=1, keepdims=True))
+        w /= w.sum(axis=1, keepdims=True)
+        centre = (w[..., None] * x).sum(axis=1)
+        out.append(np.concatenate([centre - boxes[:, 2:] / 2, boxes[:, 2:]], axis=1))
+    return np.array(out)
+
+
+@pytest.mark.parametrize("schedule", ["adaptive", "geometric"])
+def test_one_layer_with_beta_one_is_the_bootstrap_filter(scenegen_sequence, schedule):
+    frames, boxes = first_frames_and_boxes(scenegen_sequence)
+    tracker = trackers.make("annealed", n_particles=60, n_layers=1, sigma=7.0, lam=50.0,
+                            schedule=schedule, rng=11)
+    result = trackers.track(tracker, frames, boxes)
+    expected = bootstrap_filter(frames, boxes, n_particles=60, sigma=7.0, lam=50.0, seed=11)
+    np.testing.assert_allclose(result.boxes[1:], expected, rtol=0, atol=1e-9)
+    np.testing.assert_array_equal(result.extras["beta"][1:], 1.0)
+
+
+def test_geometric_schedule_and_per_layer_noise(scenegen_sequence):
+    frames, boxes = first_frames_and_boxes(scenegen_sequence, n_frames=4)
+    tracker = trackers.make("annealed", n_layers=4, schedule="geometric", beta_ratio=0.3,
+                            sigma=[9.0, 5.0, 2.0, 1.0], rng=0)
+    np.testing.assert_array_equal(tracker.sigmas, [9.0, 5.0, 2.0, 1.0])
+    result = trackers.track(tracker, frames, boxes)
+    np.testing.assert_allclose(result.extras["beta"][1:], np.broadcast_to(
+        [0.3**3, 0.3**2, 0.3, 1.0], (3, 2, 4)))
+    decayed = trackers.make("annealed", n_layers=3, sigma=12.0, sigma_decay=0.5)
+    np.testing.assert_array_equal(decayed.sigmas, [12.0, 6.0, 3.0])
+
+
+def test_adaptive_beta_keeps_the_survival_rate():
+    rng = np.random.default_rng(4)
+    log_lik = -200.0 * rng.uniform(0.0, 0.5, (6, 80)) ** 2
+    log_lik[0] = -0.001 * rng.uniform(size=80)  # flat: β = 1 keeps it above alpha
+    beta = survival_beta(log_lik, 0.5)
+    assert beta[0] == 1.0
+    rate = survival_rate(beta[:, None] * log_lik)
+    assert np.all(rate >= 0.5)
+    np.testing.assert_allclose(rate[1:], 0.5, atol=1e-6)
+    assert np.all(beta[1:] < 1.0)
+
+
+def test_same_seed_same_result_other_seed_differs(scenegen_sequence):
+    frames, boxes = first_frames_and_boxes(scenegen_sequence, n_frames=6)
+    runs = [trackers.track(trackers.make("annealed", rng=s), frames, boxes).boxes
+            for s in (5, 5, 6)]
+    np.testing.assert_array_equal(runs[0], runs[1])
+    assert not np.array_equal(runs[0], runs[2])
+
+
+@pytest.mark.parametrize(
+    ("params", "message"),
+    [
+        ({"n_particles": 0}, "n_particles"),
+        ({"n_layers": 0}, "n_layers"),
+        ({"lam": 0.0}, "lam"),
+        ({"sigma": [1.0, 2.0]}, "sigma"),
+        ({"sigma": -1.0}, "sigma"),
+        ({"sigma_decay": 0.0}, "sigma_decay"),
+        ({"schedule": "linear"}, "adaptive, geometric"),
+        ({"alpha": 1.0}, "alpha"),
+        ({"beta_ratio": 1.5}, "beta_ratio"),
+        ({"resampler": "best"}, "systematic"),
+        ({"kernel": "gauss"}, "cone"),
+        ({"bins": 0}, "bins"),
+    ],
+)
+def test_bad_parameters_raise_value_error(params, message):
+    with pytest.raises(ValueError, match=message):
+        trackers.make("annealed", **params)
