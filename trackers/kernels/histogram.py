@@ -28,7 +28,6 @@ Conventions shared by every function here (CONTRACT.md "Coordinates"):
 
 from __future__ import annotations
 
-import cv2
 import numpy as np
 from numba import njit
 from numpy.typing import NDArray
@@ -66,7 +65,7 @@ def _check_frame(frame: NDArray[np.uint8]) -> NDArray[np.uint8]:
     return np.ascontiguousarray(arr)
 
 
-def _check_bins(name: str, value: int) -> int:
+def _check_bin_count(name: str, value: int) -> int:
     if int(value) != value or not 1 <= value <= 256:
         raise ValueError(f"{name} must be an integer in [1, 256], got {value!r}")
     return int(value)
@@ -106,27 +105,61 @@ def quantize_rgb(frame: NDArray[np.uint8], bins: int = 10) -> NDArray[np.int32]:
     >>> quantize_rgb(np.array([[[255, 0, 128]]], dtype=np.uint8)).tolist()
     [[905]]
     """
-    return _quantize_rgb(_check_frame(frame), np.int32(_check_bins("bins", bins)))
+    return _quantize_rgb(_check_frame(frame), np.int32(_check_bin_count("bins", bins)))
 
 
 @njit(cache=True)
-def _quantize_hsv(hsv, h_bins, s_bins, v_bins, s_thr, v_thr):
-    rows, cols = hsv.shape[0], hsv.shape[1]
+def _floor_ratio(num, den, inv_den):
+    """floor(num / den) for integers 0 <= num, 0 < den, from an approximate reciprocal.
+
+    A multiplication by a tabulated 1/den is much cheaper than an integer division; the
+    integer checks correct the one-off errors of rounding at exact multiples.
+    """
+    q = np.int64(num * inv_den)
+    if q * den > num:
+        q -= 1
+    elif (q + 1) * den <= num:
+        q += 1
+    return q
+
+
+@njit(cache=True)
+def _quantize_hsv(frame, h_bins, s_bins, v_bins, s_thr, v_thr):
+    # Integer arithmetic throughout: every bin is an exact floor of a ratio of integers,
+    # so the quantisation does not depend on floating-point rounding at bin edges.
+    rows, cols = frame.shape[0], frame.shape[1]
     out = np.empty((rows, cols), dtype=np.int32)
     v_offset = h_bins * s_bins
-    for r in range(rows):
-        for c in range(cols):
-            h = np.int32(hsv[r, c, 0])
-            s = np.int32(hsv[r, c, 1])
-            v = np.int32(hsv[r, c, 2])
-            if s >= s_thr and v >= v_thr:
-                # OpenCV's 8-bit hue lies in [0, 180).
-                hb = h * h_bins // 180
-                if hb >= h_bins:
-                    hb = h_bins - 1
-                out[r, c] = hb * s_bins + s * s_bins // 256
-            else:
-                out[r, c] = v_offset + v * v_bins // 256
+    inv = np.empty(256)
+    inv[0] = 1.0
+    for k in range(1, 256):
+        inv[k] = 1.0 / k
+    for i in range(rows):
+        for j in range(cols):
+            r = np.int64(frame[i, j, 0])
+            g = np.int64(frame[i, j, 1])
+            b = np.int64(frame[i, j, 2])
+            mx = r if r > g else g
+            mx = mx if mx > b else b
+            mn = r if r < g else g
+            mn = mn if mn < b else b
+            d = mx - mn
+            # Every candidate is computed and the right one selected, without branches:
+            # on noisy frames which channel is largest is a coin flip that a branch
+            # predictor loses. Hue in sixths of the colour circle, times d (hexcone).
+            h6r = g - b + (6 * d if g < b else 0)
+            h6g = b - r + 2 * d
+            h6b = r - g + 4 * d
+            h6 = h6r if mx == r else (h6g if mx == g else h6b)
+            dd = d if d > 0 else 1
+            hb = min(_floor_ratio(h6 * h_bins, 6 * dd, inv[dd] / 6.0), h_bins - 1)
+            mxx = mx if mx > 0 else 1
+            sb = min(_floor_ratio(d * s_bins, mxx, inv[mxx]), s_bins - 1)
+            vb = min(mx * v_bins // 255, v_bins - 1)
+            # S >= s_min and V >= v_min, i.e. d / mx >= s_min and mx / 255 >= v_min, with
+            # the thresholds pre-scaled to integers (d * 2**20 >= s_thr * mx).
+            coloured = (d > 0) & (mx >= v_thr) & ((d << 20) >= s_thr * mx)
+            out[i, j] = hb * s_bins + sb if coloured else v_offset + vb
     return out
 
 
@@ -145,9 +178,15 @@ def quantize_hsv(
 ) -> NDArray[np.int32]:
     """Bin index of every pixel in the HSV histogram of Pérez et al. 2002.
 
-    Pixels with saturation ≥ ``s_min`` and value ≥ ``v_min`` (both in [0, 1]) fall in an
-    ``h_bins`` × ``s_bins`` hue–saturation histogram; the others (greyish or dark, where
-    hue is unreliable) fall in a value-only histogram of ``v_bins`` bins placed after it.
+    Pixels with saturation ≥ ``s_min`` and value ≥ ``v_min`` fall in an ``h_bins`` ×
+    ``s_bins`` hue–saturation histogram; the others (greyish or dark, where hue is
+    unreliable) fall in a value-only histogram of ``v_bins`` bins placed after it.
+
+    HSV is the hexcone model of the 8-bit RGB values (as ``skimage.color.rgb2hsv``):
+    V = max / 255, S = (max − min) / max, H in [0, 1) of the colour circle; a bin is
+    floor(x · bins), with the top value in the last bin, computed exactly in integers in
+    one compiled pass (no 8-bit rounding of H and S as in ``cv2.cvtColor``). ``s_min`` is
+    applied with a resolution of 2**-20.
 
     Parameters
     ----------
@@ -156,7 +195,7 @@ def quantize_hsv(
     h_bins, s_bins, v_bins : int, optional
         Bins of hue, saturation and value.
     s_min, v_min : float, optional
-        Saturation and value thresholds, as fractions of the full range.
+        Saturation and value thresholds in [0, 1].
 
     Returns
     -------
@@ -169,18 +208,16 @@ def quantize_hsv(
     >>> quantize_hsv(np.array([[[255, 0, 0], [128, 128, 128]]], dtype=np.uint8)).tolist()
     [[9, 105]]
     """
-    h_bins = _check_bins("h_bins", h_bins)
-    s_bins = _check_bins("s_bins", s_bins)
-    v_bins = _check_bins("v_bins", v_bins)
+    h_bins = _check_bin_count("h_bins", h_bins)
+    s_bins = _check_bin_count("s_bins", s_bins)
+    v_bins = _check_bin_count("v_bins", v_bins)
     for name, val in (("s_min", s_min), ("v_min", v_min)):
         if not 0.0 <= val <= 1.0:
             raise ValueError(f"{name} must lie in [0, 1], got {val!r}")
-    hsv = cv2.cvtColor(_check_frame(frame), cv2.COLOR_RGB2HSV)
-    # Thresholds on the 8-bit scale: x/255 >= t  <=>  x >= ceil(255 t).
-    s_thr = int(np.ceil(255.0 * s_min - 1e-9))
-    v_thr = int(np.ceil(255.0 * v_min - 1e-9))
-    return _quantize_hsv(hsv, np.int32(h_bins), np.int32(s_bins), np.int32(v_bins),
-                         np.int32(s_thr), np.int32(v_thr))
+    s_thr = int(np.ceil(s_min * 2**20))
+    v_thr = int(np.ceil(v_min * 255 - 1e-9))
+    return _quantize_hsv(_check_frame(frame), np.int64(h_bins), np.int64(s_bins),
+                         np.int64(v_bins), np.int64(s_thr), np.int64(v_thr))
 
 
 @njit(cache=True)
@@ -387,14 +424,14 @@ def _region_distances(bin_img, boxes, sqrt_refs, ref_index, n_bins, kernel, n_pa
     return out
 
 
-def _check_region_args(bin_img, boxes, n_bins, kernel, n_parts):
+def _check_region_args(bin_img, boxes, n_bins, kernel, n_parts, check_bins=True):
     img = np.ascontiguousarray(bin_img)
     if img.ndim != 2 or not np.issubdtype(img.dtype, np.integer):
         raise ValueError(f"bin_img must be an integer array of shape (H, W), got "
                          f"{img.dtype} {img.shape}")
     if int(n_bins) != n_bins or n_bins < 1:
         raise ValueError(f"n_bins must be a positive integer, got {n_bins!r}")
-    if img.size and (img.min() < 0 or img.max() >= n_bins):
+    if check_bins and img.size and (img.min() < 0 or img.max() >= n_bins):
         raise ValueError(f"bin_img values must lie in [0, {n_bins}), got "
                          f"[{img.min()}, {img.max()}]")
     if kernel not in KERNELS.values():
@@ -462,6 +499,8 @@ def region_distances(
     ref_index: NDArray[np.integer],
     kernel: int,
     n_parts: int = 1,
+    *,
+    check_bins: bool = True,
 ) -> NDArray[np.float64]:
     """Bhattacharyya distance of every box's histogram to its reference, in one call.
 
@@ -483,6 +522,11 @@ def region_distances(
         Kernel code, as in ``region_histograms``.
     n_parts : int, optional
         Horizontal bands, as in ``region_histograms``.
+    check_bins : bool, optional
+        Verify that every bin index lies in [0, n_bins) (a pass over the image). Callers
+        that score one quantised frame many times (the partitioned samplers, once per
+        object) check it once and pass False; an index out of range would then read
+        out of bounds.
 
     Returns
     -------
@@ -510,7 +554,7 @@ def region_distances(
                          f"{q.shape[1]}, got {n_parts!r}")
     img, bx, n_bins, kernel, n_parts = _check_region_args(bin_img, boxes,
                                                           q.shape[1] // int(n_parts),
-                                                          kernel, n_parts)
+                                                          kernel, n_parts, check_bins)
     idx = np.ascontiguousarray(ref_index, dtype=np.int64)
     if idx.shape != (bx.shape[0],):
         raise ValueError(f"ref_index must have shape ({bx.shape[0]},), got {idx.shape}")

@@ -1,0 +1,80 @@
+"""Impoverishment diagnostics of a particle set (DPS §3.1; ALGORITHMS.md §3.5).
+
+- Uniqueness of object i: the number of distinct hypotheses of its sub-state X_i among
+  the N particles, divided by N. Resampling copies particles; only propagation makes new
+  values, so an object that went through many weighted-resampling stages since it was
+  last propagated (early in a PS ordering) has few distinct values.
+- Effective dynamics of object i and parameter c ∈ (u, v, a): the variance of c over the
+  particle set at the end of a step divided by σ_c² of the tracking dynamics (DPS
+  reports it in %; it may exceed 1 because particles follow the observations).
+  **(open)** The variance is unweighted — the spread of the sample itself, which is what
+  impoverishment shrinks; the weighted variance estimates the posterior's spread, which
+  weighted resampling leaves unchanged by design.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ["effective_dynamics", "uniqueness"]
+
+
+def _check_particles(particles):
+    p = np.asarray(particles, dtype=np.float64)
+    if p.ndim != 3 or p.shape[2] != 3 or p.shape[0] < 1:
+        raise ValueError(f"particles must have shape (N, K, 3) with N >= 1, got {p.shape}")
+    return p
+
+
+def uniqueness(particles: NDArray[np.floating]) -> NDArray[np.float64]:
+    """Distinct sub-states per object over N, shape (K,), in (0, 1].
+
+    Parameters
+    ----------
+    particles : ndarray of shape (N, K, 3)
+        Particle states (u, v, a).
+
+    Example
+    -------
+    >>> p = np.zeros((4, 2, 3)); p[:, 1, 0] = [0.0, 1.0, 1.0, 2.0]
+    >>> uniqueness(p).tolist()
+    [0.25, 0.75]
+    """
+    p = _check_particles(particles)
+    n, k = p.shape[0], p.shape[1]
+    # One lexicographic sort of all sub-states, object first: equal sub-states of an
+    # object become neighbours, and each object's first row starts a new run.
+    flat = p.transpose(1, 0, 2).reshape(n * k, 3)
+    obj = np.repeat(np.arange(k), n)
+    s = flat[np.lexsort((flat[:, 2], flat[:, 1], flat[:, 0], obj))]
+    new = np.ones(n * k, dtype=bool)
+    new[1:] = np.any(s[1:] != s[:-1], axis=1)
+    new[::n] = True
+    return np.add.reduceat(new, np.arange(0, n * k, n)) / n
+
+
+def effective_dynamics(particles: NDArray[np.floating], sigma: NDArray[np.floating]
+                       ) -> NDArray[np.float64]:
+    """Unweighted variance of each parameter over the set divided by σ², shape (K, 3).
+
+    Parameters
+    ----------
+    particles : ndarray of shape (N, K, 3)
+        Particle states (u, v, a).
+    sigma : array_like of shape (3,)
+        σ of the tracking dynamics per parameter; a parameter with σ = 0 gives NaN.
+
+    Example
+    -------
+    >>> p = np.zeros((2, 1, 3)); p[:, 0, 0] = [0.0, 4.0]
+    >>> effective_dynamics(p, [2.0, 2.0, 1.0]).tolist()
+    [[1.0, 0.0, 0.0]]
+    """
+    p = _check_particles(particles)
+    sig2 = np.asarray(sigma, dtype=np.float64) ** 2
+    if sig2.shape != (3,):
+        raise ValueError(f"sigma must have shape (3,), got {np.shape(sigma)}")
+    var = p.var(axis=0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(sig2 > 0, var / np.where(sig2 > 0, sig2, 1.0), np.nan)

@@ -1,0 +1,437 @@
+"""Particle filters for multiple objects: Condensation, joint PF, PS and DPS (DPS paper).
+
+All four share the observation model (``trackers.observation``: colour histograms, one
+compiled call per sampling stage for every particle of every object), the AR2 dynamics of
+(u, v, a) (``trackers.dynamics``) and the resamplers (``trackers.resampling``); they
+differ only in how they sample the joint state (ALGORITHMS.md §3):
+
+- ``Condensation`` ("condensation"): one independent single-object filter per target
+  (Isard & Blake 1998); the M = 1 case of §3.1, run side by side.
+- ``JointPF`` ("joint-pf", the paper's "Non-PS"): one filter over the joint state;
+  resample, propagate every object, weight by the joint likelihood Π_i p(Z | X_i).
+- ``PartitionedSampling`` ("ps", §3.3): objects one at a time in an ``ordering``;
+  weighted resampling by each object's likelihood before the next object moves.
+- ``DistributedPartitionedSampling`` ("dps", §3.4): the set split into ``n_groups``
+  mixture components, each running PS with its own circular-shift ordering.
+
+Every step starts by resampling the set by the previous step's weights, so after a step
+``self.particles`` (N, K, 3) and ``self.weights`` are the weighted set that represents
+the posterior; its weighted mean per object is the estimate. ``Estimate.extras`` carries
+``uniqueness`` (K,) and ``effective_dynamics`` (K,) (``trackers.diagnostics``; the
+latter averages u and v). Initialisation: the reference histograms are taken from the
+frame-0 boxes and every particle starts on its initial box with zero velocity.
+
+Example
+-------
+>>> import numpy as np
+>>> rng = np.random.default_rng(0)
+>>> frame = rng.integers(0, 256, (60, 80, 3), dtype=np.uint8)
+>>> frame[20:40, 30:50] = (255, 40, 40)
+>>> pf = DistributedPartitionedSampling(n_particles=100, rng=1)
+>>> pf.init(frame, np.array([[30.0, 20.0, 20.0, 20.0]]))
+>>> est = pf.step(frame)
+>>> bool(np.all(np.abs(est.boxes - [30.0, 20.0, 20.0, 20.0]) < 3.0))
+True
+"""
+
+from __future__ import annotations
+
+from abc import abstractmethod
+from collections.abc import Sequence
+
+import numpy as np
+from numpy.typing import NDArray
+
+from trackers.base import Estimate, RngLike, Tracker
+from trackers.diagnostics import effective_dynamics, uniqueness
+from trackers.dynamics import AR2, boxes_from_states, states_from_boxes
+from trackers.observation import ColourModel, FrameObservation
+from trackers.resampling import RESAMPLERS, resample, weighted_resample_groups
+
+__all__ = [
+    "ASSIGNMENTS",
+    "Condensation",
+    "DistributedPartitionedSampling",
+    "JointPF",
+    "PartitionedSampling",
+    "circular_shift",
+]
+
+#: Rules that assign particles to the DPS mixture components (``assignment``).
+ASSIGNMENTS: tuple[str, ...] = ("random", "interleaved")
+
+
+def circular_shift(n_objects: int, k: int) -> NDArray[np.int64]:
+    """The k-th circular shift (k, k+1, …, M−1, 0, …, k−1) of the objects 0…M−1."""
+    return (np.arange(n_objects) + k) % n_objects
+
+
+def _normalised_weights(logw: NDArray[np.float64]) -> NDArray[np.float64]:
+    """exp(logw) / Σ exp(logw), computed without overflow."""
+    w = np.exp(logw - logw.max())
+    return w / w.sum()
+
+
+def _log_sum_exp(x: NDArray[np.float64]) -> float:
+    m = x.max()
+    return float(m + np.log(np.exp(x - m).sum()))
+
+
+class _ParticleTracker(Tracker):
+    """Shared parameters, initialisation, estimate and diagnostics of the four filters.
+
+    Parameters
+    ----------
+    n_particles : int, optional
+        N, particles of the whole set (DPS: 300 synthetic, 200 real).
+    lam : float, optional
+        λ of the likelihood exp(−λ d²).
+    model : {"hsv", "rgb"}, optional
+        Observation model (``trackers.observation``).
+    bins : int, optional
+        Histogram bins per colour channel.
+    n_parts : int or None, optional
+        Spatial components (horizontal bands) of a region; None: the model's default.
+    kernel : {"uniform", "epanechnikov", "cone"} or None, optional
+        Kernel weighting the pixels of a region; None: the model's default.
+    sigma : tuple of 3 floats, optional
+        (σ_u, σ_v, σ_a) of the AR2 tracking dynamics (DPS: 2, 2, 0.001).
+    a1, a2 : float, optional
+        AR2 coefficients (2, −1: constant velocity).
+    resampler : {"systematic", "multinomial", "stratified", "residual"}, optional
+        Resampling scheme of every (weighted) resampling step.
+    rng : numpy.random.Generator, int or None, optional
+        Source of randomness; the same seed gives the same track.
+    """
+
+    def __init__(
+        self,
+        *,
+        n_particles: int = 300,
+        lam: float = 20.0,
+        model: str = "hsv",
+        bins: int = 10,
+        n_parts: int | None = None,
+        kernel: str | None = None,
+        sigma: Sequence[float] = (2.0, 2.0, 0.001),
+        a1: float = 2.0,
+        a2: float = -1.0,
+        resampler: str = "systematic",
+        rng: RngLike = None,
+    ) -> None:
+        super().__init__(rng=rng)
+        if isinstance(n_particles, bool) or int(n_particles) != n_particles or n_particles < 1:
+            raise ValueError(f"n_particles must be a positive integer, got {n_particles!r}")
+        if resampler not in RESAMPLERS:
+            raise ValueError(f"unknown resampler {resampler!r}; valid: {', '.join(RESAMPLERS)}")
+        self.n_particles = int(n_particles)
+        self.resampler = resampler
+        self.model = ColourModel(model, bins=bins, n_parts=n_parts, kernel=kernel, lam=lam)
+        self.dynamics = AR2(sigma=tuple(float(s) for s in sigma), a1=float(a1), a2=float(a2))
+        self.particles = np.empty((0, 0, 3))
+        self.weights = np.empty(0)
+
+    def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
+        self.model.set_references(frame, boxes)
+        states, self._sizes = states_from_boxes(boxes)
+        self._mean = states
+        n = self.n_particles
+        self.particles = np.repeat(states[None], n, axis=0)
+        self._prev = self.particles.copy()
+        self.weights = np.full(n, 1.0 / n)
+
+    def _boxes(self, states: NDArray[np.float64], objects: NDArray[np.int64]
+               ) -> NDArray[np.float64]:
+        """Boxes (P, 4) of states (P, 3) of the given objects (P,)."""
+        return boxes_from_states(states, self._sizes[objects])
+
+    def _estimate(self, weights: NDArray[np.float64], extras: dict | None = None
+                  ) -> Estimate:
+        """Weighted mean state per object (weights (N, K)) as boxes, with diagnostics."""
+        mean_state = (weights[:, :, None] * self.particles).sum(axis=0)
+        eff = effective_dynamics(self.particles, self.dynamics.sigma)
+        out = {"uniqueness": uniqueness(self.particles),
+               "effective_dynamics": eff[:, :2].mean(axis=1)}
+        out.update(extras or {})
+        return Estimate(boxes=boxes_from_states(mean_state, self._sizes), extras=out)
+
+
+class Condensation(_ParticleTracker):
+    """Condensation (Isard & Blake 1998): one independent filter of N particles per target.
+
+    Each target's filter resamples by its own weights, propagates by AR2 and weights by
+    its own likelihood; all targets' candidates of a frame are scored in one kernel call.
+    With one target it is PS with one object, draw for draw.
+
+    After a step ``weights`` has shape (N, K): column k weights target k's filter.
+    Parameters: see ``_ParticleTracker``.
+    """
+
+    name = "condensation"
+
+    def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
+        super()._init(frame, boxes)
+        self.weights = np.full((self.n_particles, self.n_targets), 1.0 / self.n_particles)
+
+    def _step(self, frame: NDArray[np.uint8]) -> Estimate:
+        obs = self.model.observe(frame)
+        n, k = self.n_particles, self.n_targets
+        idx = np.column_stack([resample(self.weights[:, i], method=self.resampler,
+                                        rng=self.rng) for i in range(k)])
+        cols = np.arange(k)
+        x = self.particles[idx, cols]
+        prev = self._prev[idx, cols]
+        new = self.dynamics.propagate(x, prev, self._mean, rng=self.rng)
+        objects = np.tile(cols, n)
+        ll = obs.log_likelihoods(self._boxes(new.reshape(-1, 3), objects), objects)
+        ll = ll.reshape(n, k)
+        self._prev = x
+        self.particles = new
+        self.weights = np.column_stack([_normalised_weights(ll[:, i]) for i in range(k)])
+        return self._estimate(self.weights)
+
+
+class JointPF(_ParticleTracker):
+    """Joint particle filter over all targets ("Non-PS", ALGORITHMS.md §3.1).
+
+    Resample the joint set, propagate every object, weight by Π_i p(Z | X_i). The
+    likelihoods of all N × K candidate boxes come from one kernel call.
+    Parameters: see ``_ParticleTracker``.
+    """
+
+    name = "joint-pf"
+
+    def _step(self, frame: NDArray[np.uint8]) -> Estimate:
+        obs = self.model.observe(frame)
+        n, k = self.n_particles, self.n_targets
+        idx = resample(self.weights, method=self.resampler, rng=self.rng)
+        x = self.particles[idx]
+        prev = self._prev[idx]
+        new = self.dynamics.propagate(x, prev, self._mean, rng=self.rng)
+        objects = np.tile(np.arange(k), n)
+        ll = obs.log_likelihoods(self._boxes(new.reshape(-1, 3), objects), objects)
+        self._prev = x
+        self.particles = new
+        self.weights = _normalised_weights(ll.reshape(n, k).sum(axis=1))
+        return self._estimate(np.repeat(self.weights[:, None], k, axis=1))
+
+
+class _Partitioned(_ParticleTracker):
+    """The partitioned-sampling step shared by PS (one group) and DPS (several)."""
+
+    @abstractmethod
+    def _groups(self, x: NDArray[np.float64], prev: NDArray[np.float64]
+                ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64],
+                           NDArray[np.int64]]:
+        """Split the resampled set into groups: (x, prev) reordered so that the groups
+        are contiguous, the group sizes (C,) and each group's ordering (C, M)."""
+
+    def _partitioned_step(self, frame: NDArray[np.uint8]) -> tuple[Estimate, NDArray]:
+        obs: FrameObservation = self.model.observe(frame)
+        n, m = self.n_particles, self.n_targets
+        idx = resample(self.weights, method=self.resampler, rng=self.rng)
+        x, prev, sizes, orderings = self._groups(self.particles[idx], self._prev[idx])
+        group = np.repeat(np.arange(sizes.size), sizes)
+        rows = np.arange(n)
+        logpi = np.zeros(n)
+        ll = np.zeros((n, m))
+        for j in range(m):
+            obj = orderings[group, j]
+            cur = x[rows, obj]
+            new = self.dynamics.propagate(cur, prev[rows, obj], self._mean[obj], rng=self.rng)
+            prev[rows, obj] = cur
+            x[rows, obj] = new
+            stage = obs.log_likelihoods(self._boxes(new, obj), obj)
+            ll[rows, obj] = stage
+            if j < m - 1:
+                # §3.3: weighted resampling with g = p(Z | X_{o_j}) inside each group; any
+                # constant factor of g cancels, so scale by the largest for range.
+                k, w = weighted_resample_groups(
+                    np.exp(logpi - logpi.max()), np.exp(stage - stage.max()), sizes,
+                    method=self.resampler, rng=self.rng)
+                x, prev, ll = x[k], prev[k], ll[k]
+                logpi = np.log(w)
+        # The set {x, π'} still represents the predicted joint state (weighted resampling
+        # preserves it), so π' Π_i p(Z | X_i) are the unnormalised posterior weights w̃.
+        logw = logpi + ll.sum(axis=1)
+        weights, mixture = self._reassemble(logw, sizes)
+        self.particles = x
+        self._prev = prev
+        self.weights = weights
+        est = self._estimate(np.repeat(weights[:, None], m, axis=1))
+        return est, mixture
+
+    @staticmethod
+    def _reassemble(logw: NDArray[np.float64], sizes: NDArray[np.int64]
+                    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Mixture reassembly (§3.4, after Vermaak, Doucet & Pérez 2003).
+
+        π_c,t ∝ π_c,t−1 Σ_{n∈c} w̃_n, and particle n of group c gets π_c,t w̃_n / Σ_c w̃.
+        The groups are drawn afresh from an equally weighted (resampled) set, so a group
+        of N_c particles starts with π_c,t−1 = N_c / N. With one group this is plain
+        normalisation. Returns the weights (N,) and the mixture weights (C,).
+        """
+        if sizes.size == 1:
+            return _normalised_weights(logw), np.ones(1)
+        starts = np.cumsum(sizes) - sizes
+        log_evidence = np.array([_log_sum_exp(logw[s:s + c]) for s, c in zip(starts, sizes,
+                                                                            strict=True)])
+        log_mix = np.log(sizes / sizes.sum()) + log_evidence
+        mixture = _normalised_weights(log_mix)
+        logw_final = logw + np.repeat(np.log(mixture) - log_evidence, sizes)
+        return _normalised_weights(logw_final), mixture
+
+
+class PartitionedSampling(_Partitioned):
+    """Partitioned sampling (MacCormick & Blake 2000; ALGORITHMS.md §3.3).
+
+    Parameters
+    ----------
+    ordering : int or sequence of int, optional
+        The order in which objects are sampled: an int k is the k-th circular shift
+        (k, k+1, …, K−1, 0, …, k−1) of the targets (0 ≤ k < K; the paper's orderings),
+        a sequence is an explicit permutation of 0…K−1.
+    **params
+        See ``_ParticleTracker`` (n_particles, lam, model, bins, n_parts, kernel, sigma,
+        a1, a2, resampler, rng).
+    """
+
+    name = "ps"
+
+    def __init__(
+        self,
+        *,
+        ordering: int | Sequence[int] = 0,
+        n_particles: int = 300,
+        lam: float = 20.0,
+        model: str = "hsv",
+        bins: int = 10,
+        n_parts: int | None = None,
+        kernel: str | None = None,
+        sigma: Sequence[float] = (2.0, 2.0, 0.001),
+        a1: float = 2.0,
+        a2: float = -1.0,
+        resampler: str = "systematic",
+        rng: RngLike = None,
+    ) -> None:
+        super().__init__(n_particles=n_particles, lam=lam, model=model, bins=bins,
+                         n_parts=n_parts, kernel=kernel, sigma=sigma, a1=a1, a2=a2,
+                         resampler=resampler, rng=rng)
+        if isinstance(ordering, (int, np.integer)) and not isinstance(ordering, bool):
+            if ordering < 0:
+                raise ValueError(f"ordering must be a circular shift >= 0 or a permutation, "
+                                 f"got {ordering!r}")
+        else:
+            try:
+                ordering = [int(o) for o in ordering]
+            except (TypeError, ValueError):
+                raise ValueError(f"ordering must be an int (circular shift) or a sequence of "
+                                 f"target indices, got {ordering!r}") from None
+        self.ordering = ordering
+
+    def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
+        k = boxes.shape[0]
+        if isinstance(self.ordering, list):
+            order = np.asarray(self.ordering, dtype=np.int64)
+            if sorted(order.tolist()) != list(range(k)):
+                raise ValueError(f"ordering {self.ordering} is not a permutation of the "
+                                 f"{k} targets 0..{k - 1}")
+        else:
+            if self.ordering >= k:
+                raise ValueError(f"ordering (circular shift) must lie in [0, {k}) for {k} "
+                                 f"targets, got {self.ordering}")
+            order = circular_shift(k, int(self.ordering))
+        self._order = order[None, :]
+        super()._init(frame, boxes)
+
+    def _groups(self, x, prev):
+        return x, prev, np.array([self.n_particles]), self._order
+
+    def _step(self, frame: NDArray[np.uint8]) -> Estimate:
+        est, _ = self._partitioned_step(frame)
+        return est
+
+
+class DistributedPartitionedSampling(_Partitioned):
+    """Distributed partitioned sampling (Smith & Gatica-Perez 2004; ALGORITHMS.md §3.4).
+
+    Each step the resampled set is divided into ``n_groups`` mixture components of
+    N / C particles (the remainder spread over the first groups); component c runs PS
+    with the (c mod K)-th circular-shift ordering; the components are reassembled with
+    mixture weights π_c,t ∝ π_c,t−1 Σ_{n∈c} w̃_n. All components of a sampling stage are
+    scored in one kernel call. ``Estimate.extras["mixture_weights"]`` is (C,).
+
+    Parameters
+    ----------
+    n_groups : int or None, optional
+        C, the number of mixture components; None: one per target (the paper's C = M).
+        1 gives PS with the identity ordering, draw for draw.
+    assignment : {"random", "interleaved"}, optional
+        **(open)** How particles are assigned to components. "random" (the paper): a
+        uniformly random partition, drawn each step. "interleaved": particle n of the
+        resampled set goes to component n mod C; systematic resampling leaves copies of
+        one ancestor next to each other, so this spreads them over the components
+        (stratified assignment) and uses no randomness.
+    **params
+        See ``_ParticleTracker`` (n_particles, lam, model, bins, n_parts, kernel, sigma,
+        a1, a2, resampler, rng).
+    """
+
+    name = "dps"
+
+    def __init__(
+        self,
+        *,
+        n_groups: int | None = None,
+        assignment: str = "random",
+        n_particles: int = 300,
+        lam: float = 20.0,
+        model: str = "hsv",
+        bins: int = 10,
+        n_parts: int | None = None,
+        kernel: str | None = None,
+        sigma: Sequence[float] = (2.0, 2.0, 0.001),
+        a1: float = 2.0,
+        a2: float = -1.0,
+        resampler: str = "systematic",
+        rng: RngLike = None,
+    ) -> None:
+        super().__init__(n_particles=n_particles, lam=lam, model=model, bins=bins,
+                         n_parts=n_parts, kernel=kernel, sigma=sigma, a1=a1, a2=a2,
+                         resampler=resampler, rng=rng)
+        if n_groups is not None and (isinstance(n_groups, bool) or int(n_groups) != n_groups
+                                     or not 1 <= n_groups <= self.n_particles):
+            raise ValueError(f"n_groups must be an integer in [1, n_particles = "
+                             f"{self.n_particles}] or None, got {n_groups!r}")
+        if assignment not in ASSIGNMENTS:
+            raise ValueError(f"unknown assignment {assignment!r}; valid: "
+                             f"{', '.join(ASSIGNMENTS)}")
+        self.n_groups = None if n_groups is None else int(n_groups)
+        self.assignment = assignment
+
+    def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
+        k = boxes.shape[0]
+        c = k if self.n_groups is None else self.n_groups
+        if c > self.n_particles:
+            raise ValueError(f"n_groups = {c} (one per target) exceeds n_particles = "
+                             f"{self.n_particles}")
+        n = self.n_particles
+        self._sizes_c = np.array([n // c + (i < n % c) for i in range(c)], dtype=np.int64)
+        self._orders = np.stack([circular_shift(k, i % k) for i in range(c)])
+        if self.assignment == "interleaved":
+            self._interleave = np.concatenate([np.arange(i, n, c) for i in range(c)])
+        super()._init(frame, boxes)
+
+    def _groups(self, x, prev):
+        if self._sizes_c.size > 1:
+            if self.assignment == "random":
+                order = self.rng.permutation(self.n_particles)
+            else:
+                order = self._interleave
+            x, prev = x[order], prev[order]
+        return x, prev, self._sizes_c, self._orders
+
+    def _step(self, frame: NDArray[np.uint8]) -> Estimate:
+        est, mixture = self._partitioned_step(frame)
+        est.extras["mixture_weights"] = mixture
+        return est

@@ -1,0 +1,269 @@
+"""Resamplers by name, and weighted resampling (ALGORITHMS.md §3.2).
+
+Every resampler maps normalised weights to ancestor indices. Four schemes (Douc, Cappé &
+Moulines 2005), all inverse-CDF except the deterministic part of ``residual``:
+
+- ``multinomial``: i.i.d. uniforms;
+- ``stratified``: one uniform in each of the n strata [i/n, (i+1)/n);
+- ``systematic``: one uniform shifted by i/n (lowest variance in practice; the default);
+- ``residual``: floor(n w_i) copies of each particle, the rest multinomially on the
+  residual weights.
+
+The particle sets of DPS are mixtures of groups that are resampled separately; a group is
+a contiguous slice of the weight vector (``sizes`` lists the slice lengths) and every
+function here resamples all groups in one vectorised pass, each group within itself and
+to its own size. One group is the usual case.
+
+Example
+-------
+>>> import numpy as np
+>>> rng = np.random.default_rng(0)
+>>> resample(np.array([0.0, 1.0, 0.0]), rng=rng).tolist()
+[1, 1, 1]
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = [
+    "RESAMPLERS",
+    "group_starts",
+    "resample",
+    "resample_groups",
+    "weighted_resample",
+    "weighted_resample_groups",
+]
+
+
+def _positions_multinomial(counts, rng):
+    return rng.random(counts.sum())
+
+
+def _positions_stratified(counts, rng):
+    n = np.repeat(counts, counts)
+    within = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
+    return (within + rng.random(counts.sum())) / n
+
+
+def _positions_systematic(counts, rng):
+    n = np.repeat(counts, counts)
+    within = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
+    return (within + np.repeat(rng.random(counts.size), counts)) / n
+
+
+_POSITIONS: dict[str, Callable[[NDArray[np.int64], np.random.Generator], NDArray]] = {
+    "multinomial": _positions_multinomial,
+    "stratified": _positions_stratified,
+    "systematic": _positions_systematic,
+}
+
+#: Resampler names (``resampler`` parameter of the particle trackers).
+RESAMPLERS: tuple[str, ...] = ("multinomial", "systematic", "stratified", "residual")
+
+
+def group_starts(sizes: NDArray[np.integer]) -> NDArray[np.int64]:
+    """First index of each group, shape (C,), for group lengths ``sizes`` (C,)."""
+    sizes = np.asarray(sizes, dtype=np.int64)
+    return np.cumsum(sizes) - sizes
+
+
+def _check_sizes(sizes, n):
+    sizes = np.asarray([n] if sizes is None else sizes, dtype=np.int64)
+    if sizes.ndim != 1 or sizes.size < 1 or np.any(sizes < 1) or sizes.sum() != n:
+        raise ValueError(f"group sizes must be positive and sum to {n}, got {sizes.tolist()}")
+    return sizes
+
+
+def _normalise_groups(weights, sizes, name):
+    w = np.asarray(weights, dtype=np.float64)
+    if w.ndim != 1 or w.size < 1:
+        raise ValueError(f"{name} must have shape (N,) with N >= 1, got {w.shape}")
+    if not np.all(np.isfinite(w)) or np.any(w < 0):
+        raise ValueError(f"{name} must be finite and non-negative")
+    totals = np.add.reduceat(w, group_starts(sizes))
+    if np.any(totals <= 0):
+        raise ValueError(f"{name} must have a positive sum in every group, got sums "
+                         f"{totals.tolist()}")
+    return w / np.repeat(totals, sizes)
+
+
+def _draw(w, counts, sizes, method, rng):
+    """Indices into ``w`` (normalised per group): ``counts[c]`` draws inside group c."""
+    starts = group_starts(sizes)
+    group_of_draw = np.repeat(np.arange(sizes.size), counts)
+    # Group c's CDF spans (c, c + 1] of the running sum, so one search serves all groups;
+    # clipping keeps a position that rounding pushed over a boundary in its own group.
+    cdf = np.cumsum(w) + 0.0
+    cdf -= np.repeat(np.cumsum(np.add.reduceat(w, starts)) - np.arange(1, sizes.size + 1),
+                     sizes)
+    pos = _POSITIONS[method](counts, rng) + group_of_draw
+    idx = np.searchsorted(cdf, pos, side="right")
+    return np.clip(idx, starts[group_of_draw], starts[group_of_draw] + sizes[group_of_draw] - 1)
+
+
+def resample_groups(
+    weights: NDArray[np.floating],
+    sizes: NDArray[np.integer] | None = None,
+    *,
+    method: str = "systematic",
+    rng: np.random.Generator,
+) -> NDArray[np.int64]:
+    """Resample every group of a weighted set within itself, to its own size.
+
+    Parameters
+    ----------
+    weights : ndarray of shape (N,)
+        Non-negative weights (normalised here, per group).
+    sizes : ndarray of shape (C,), optional
+        Lengths of the contiguous groups, summing to N; None is one group.
+    method : {"multinomial", "systematic", "stratified", "residual"}, optional
+        Resampling scheme (module docstring).
+    rng : numpy.random.Generator
+        Source of randomness.
+
+    Returns
+    -------
+    ndarray of shape (N,), int64
+        Ancestor index of each new particle; entries of group c lie in group c.
+
+    Raises
+    ------
+    ValueError
+        For an unknown method, negative or non-finite weights, a group of zero total
+        weight, or sizes that do not sum to N.
+    """
+    _check_method(method)
+    w = np.asarray(weights)
+    sizes = _check_sizes(sizes, w.shape[0] if w.ndim == 1 else -1)
+    return _resample_normalised(_normalise_groups(w, sizes, "weights"), sizes, method, rng)
+
+
+def _check_method(method):
+    if method not in RESAMPLERS:
+        raise ValueError(f"unknown resampler {method!r}; valid: {', '.join(RESAMPLERS)}")
+
+
+def _resample_normalised(w, sizes, method, rng):
+    """``resample_groups`` on weights already normalised per group."""
+    if method != "residual":
+        return _draw(w, sizes, sizes, method, rng)
+    # Residual: floor(n_c w_i) deterministic copies, the remainder multinomially on the
+    # residual weights n_c w_i − floor(n_c w_i).
+    scaled = w * np.repeat(sizes, sizes)
+    copies = np.floor(scaled).astype(np.int64)
+    fixed = np.repeat(np.arange(w.size), copies)
+    rest = sizes - np.add.reduceat(copies, group_starts(sizes))
+    if not rest.any():
+        return fixed
+    resid = scaled - copies
+    # A group with nothing left to draw may have all-zero residuals: give it dummy mass,
+    # it receives no draw anyway.
+    totals = np.add.reduceat(resid, group_starts(sizes))
+    resid[np.repeat(totals <= 0, sizes)] = 1.0
+    drawn = _draw(_normalise_groups(resid, sizes, "residual weights"), rest, sizes,
+                  "multinomial", rng)
+    # Keep each group's new particles contiguous, in group order.
+    group_of = np.repeat(np.arange(sizes.size), sizes)
+    groups = np.concatenate([group_of[fixed], np.repeat(np.arange(sizes.size), rest)])
+    out = np.concatenate([fixed, drawn])
+    return out[np.argsort(groups, kind="stable")]
+
+
+def resample(
+    weights: NDArray[np.floating],
+    *,
+    method: str = "systematic",
+    rng: np.random.Generator,
+) -> NDArray[np.int64]:
+    """Draw N ancestor indices from weights (N,) by ``method`` (one group).
+
+    Returns
+    -------
+    ndarray of shape (N,), int64
+
+    Raises
+    ------
+    ValueError
+        As ``resample_groups``.
+    """
+    return resample_groups(weights, method=method, rng=rng)
+
+
+def weighted_resample_groups(
+    weights: NDArray[np.floating],
+    g: NDArray[np.floating],
+    sizes: NDArray[np.integer] | None = None,
+    *,
+    method: str = "systematic",
+    rng: np.random.Generator,
+) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
+    """Weighted resampling (MacCormick & Blake 2000; ALGORITHMS.md §3.2), per group.
+
+    Draws ancestors k with probability ρ_k ∝ π_k g(x_k) inside each group and gives the
+    new particle the weight π_k / ρ_k, renormalised in its group: the set represents the
+    same distribution as before, with its particles moved to where ``g`` is high.
+
+    Parameters
+    ----------
+    weights : ndarray of shape (N,)
+        Current weights π (normalised here, per group).
+    g : ndarray of shape (N,)
+        Positive weighting function at each particle (e.g. one object's likelihood); it
+        may be scaled by any constant per group.
+    sizes : ndarray of shape (C,), optional
+        Lengths of the contiguous groups; None is one group.
+    method : str, optional
+        Resampler for the draw (``RESAMPLERS``).
+    rng : numpy.random.Generator
+        Source of randomness.
+
+    Returns
+    -------
+    indices : ndarray of shape (N,), int64
+        Ancestor of each new particle (inside its group).
+    new_weights : ndarray of shape (N,)
+        π_k / ρ_k, normalised to sum 1 in each group.
+
+    Raises
+    ------
+    ValueError
+        For weights or ``g`` that are negative or not finite, a group where π g sums to
+        zero, or the cases of ``resample_groups``.
+    """
+    _check_method(method)
+    w = np.asarray(weights, dtype=np.float64)
+    gv = np.asarray(g, dtype=np.float64)
+    if gv.shape != w.shape:
+        raise ValueError(f"g must have the shape of weights {w.shape}, got {gv.shape}")
+    if not np.all(np.isfinite(gv)) or np.any(gv < 0):
+        raise ValueError("g must be finite and non-negative")
+    sizes = _check_sizes(sizes, w.shape[0] if w.ndim == 1 else -1)
+    pi = _normalise_groups(w, sizes, "weights")
+    rho = _normalise_groups(pi * gv, sizes, "weights * g")
+    idx = _resample_normalised(rho, sizes, method, rng)
+    # rho[idx] > 0: an index of zero probability is never drawn.
+    new = pi[idx] / rho[idx]
+    return idx, new / np.repeat(np.add.reduceat(new, group_starts(sizes)), sizes)
+
+
+def weighted_resample(
+    weights: NDArray[np.floating],
+    g: NDArray[np.floating],
+    *,
+    method: str = "systematic",
+    rng: np.random.Generator,
+) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
+    """Weighted resampling of one set: ``weighted_resample_groups`` with one group.
+
+    Example
+    -------
+    >>> rng = np.random.default_rng(1)
+    >>> idx, w = weighted_resample(np.full(4, 0.25), np.array([1.0, 1.0, 1.0, 3.0]), rng=rng)
+    >>> idx.tolist(), np.round(w * 8, 6).tolist()
+    ([0, 2, 3, 3], [3.0, 3.0, 1.0, 1.0])
+    """
+    return weighted_resample_groups(weights, g, method=method, rng=rng)
