@@ -61,6 +61,7 @@ __all__ = [
     "atomic_path",
     "clean_temp_files",
     "describe_open_error",
+    "describe_read_error",
     "filter_options",
     "frames_per_block",
     "open_checked",
@@ -522,6 +523,26 @@ def describe_open_error(path: str | Path, err: OSError) -> str:
     return f"{p}: not a readable HDF5 file (truncated or corrupted: {first})"
 
 
+def describe_read_error(err: BaseException) -> str:
+    """One line for an error h5py raised while reading a dataset.
+
+    Parameters
+    ----------
+    err : BaseException
+
+    Returns
+    -------
+    str
+        ``"checksum or decompression failed"`` for a damaged chunk, else the error's
+        first line.
+    """
+    text = str(err).strip().splitlines()
+    first = text[0] if text else type(err).__name__
+    if "filter returned failure" in first:
+        return "checksum or decompression failed"
+    return first
+
+
 def _stamp(path: str) -> tuple[int, int, int]:
     st = os.stat(path)
     return st.st_ino, st.st_size, st.st_mtime_ns
@@ -594,10 +615,9 @@ class LazyArray:
         try:
             return self._ds()[key]
         except (OSError, RuntimeError) as err:
-            first = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
             raise DataError(
                 f"{self.path}: {self.dataset}[{_key_text(key)}] is unreadable "
-                f"(damaged file: {first})"
+                f"(damaged file: {describe_read_error(err)})"
             ) from None
 
     def __getitem__(self, key: Any) -> NDArray[Any]:
@@ -725,8 +745,9 @@ def read(path: str | Path, name: str | None = None) -> Sequence:
             frames = LazyArray(p, f"sequences/{name}/frames")
             labels = LazyArray(p, f"sequences/{name}/labels")
         except (KeyError, ValueError, TypeError, OSError, RuntimeError, ConfigError) as err:
-            first = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
-            raise DataError(f"{p}: sequence {name!r} is damaged: {first}") from None
+            raise DataError(
+                f"{p}: sequence {name!r} is damaged: {describe_read_error(err)}"
+            ) from None
     return Sequence(
         name=name,
         seed=seed,
@@ -848,5 +869,6 @@ def read_result(path: str | Path, tracker: str | None = None) -> TrackerResult:
                 order_prob=g["order_prob"][()] if "order_prob" in g else None,
             )
         except (KeyError, ValueError, TypeError, OSError, RuntimeError) as err:
-            first = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
-            raise DataError(f"{p}: result {tracker!r} is damaged: {first}") from None
+            raise DataError(
+                f"{p}: result {tracker!r} is damaged: {describe_read_error(err)}"
+            ) from None

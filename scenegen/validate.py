@@ -1,37 +1,174 @@
 """Checks of a scenegen HDF5 file against schema ``scenegen/1``.
 
-:func:`check_file` returns one line per problem (empty when the file is valid): wrong or
-missing schema, missing datasets, shape or dtype mismatches, labels naming unknown ids,
-visible boxes or visibilities that disagree with the labels, NaN patterns that disagree
-with ``present``, truncated or corrupted data. It streams frames one at a time, so memory
-stays bounded whatever the file's length.
+:func:`check_file` returns one line per problem (empty when the file is valid), each
+naming the file, the sequence and what is wrong:
+
+- the file: missing, a folder, an unfinished temporary file of a write, not HDF5,
+  truncated (with the byte counts), locked by a writer, or with a wrong or missing schema;
+- the layout: missing attributes, groups or datasets, shape or dtype mismatches, a config
+  attribute that does not parse or disagrees with the size attributes, missing templates;
+- the data: chunks that fail their checksum or decompression (named by frame), ids that
+  are not unique and >= 1, unknown roles, ``labels`` naming unknown ids, visible boxes or
+  visibilities that disagree with ``labels``, NaN patterns that disagree with ``present``,
+  centres that disagree with boxes, values out of range.
+
+Frames and labels are read one frame at a time, so memory stays bounded whatever the
+file's length; ground truth (T x K) is read whole. Nothing here raises on a damaged file.
 """
 
 from __future__ import annotations
 
+import faulthandler
 import json
+import multiprocessing
+import signal
+from multiprocessing.connection import Connection
 from pathlib import Path
 from typing import Any
 
 import h5py
 import numpy as np
+from numpy.typing import NDArray
 from scipy import ndimage
 
 from scenegen.config import from_dict
 from scenegen.errors import ConfigError
-from scenegen.io import SCHEMA
+from scenegen.io import SCHEMA, describe_open_error, describe_read_error, temp_file_owner
 from scenegen.sequence import GT_FIELDS
 
 __all__ = ["check_file"]
 
-_MAX_PER_KIND = 5  # report at most this many frames per kind of disagreement
+_MAX_PER_KIND = 5  # frames listed per kind of problem
+_READ_ERRORS = (OSError, RuntimeError, KeyError, ValueError, TypeError)
+_ROLES = {"target", "distractor", "occluder", "clutter"}
+_ATTRS = ("seed", "config", "preset", "n_frames", "height", "width")
 
 
-def _expected_shapes(t: int, h: int, w: int, k: int) -> dict[str, tuple[tuple[int, ...], Any]]:
+def check_file(path: str | Path, *, check_pixels: bool = True, isolate: bool = False) -> list[str]:
+    """Validate a scenegen file; return one line per problem found.
+
+    Parameters
+    ----------
+    path : str or Path
+        A sequence file or a tracker result file.
+    check_pixels : bool
+        Also read every frame (checksums) and re-derive visible boxes and visibility
+        from ``labels`` frame by frame.
+    isolate : bool
+        Run the check in a child process. The HDF5 library can crash (segmentation
+        fault) on some corrupted metadata; isolated, such a crash becomes one problem
+        line instead of killing the caller. ``scenegen validate`` always isolates.
+
+    Returns
+    -------
+    list of str
+        Empty when the file is valid.
+
+    Example
+    -------
+    >>> check_file("missing.h5")
+    ['missing.h5: no such file']
+    """
+    p = Path(path)
+    if isolate:
+        return _check_in_child(p, check_pixels)
+    if not p.exists():
+        return [f"{p}: no such file"]
+    if p.is_dir():
+        return [f"{p}: is a folder, not a scenegen file"]
+    owner = temp_file_owner(p)
+    if owner is not None:
+        return [
+            f"{p}: an unfinished temporary file of a write to {owner[0]!r} "
+            f"(process {owner[1]} on {owner[2] or '?'}); not a result"
+        ]
+    try:
+        f = h5py.File(p, "r")
+    except OSError as err:
+        return [describe_open_error(p, err)]
+    try:
+        with f:
+            return _check_open_file(p, f, check_pixels)
+    except _READ_ERRORS as err:
+        return [f"{p}: damaged HDF5 metadata ({_one_line(err)})"]
+
+
+def _child(path: str, check_pixels: bool, conn: Connection) -> None:
+    faulthandler.disable()  # a crash is reported by the parent, in one line
+    conn.send(check_file(path, check_pixels=check_pixels))
+    conn.close()
+
+
+def _check_in_child(p: Path, check_pixels: bool) -> list[str]:
+    methods = multiprocessing.get_all_start_methods()
+    ctx = multiprocessing.get_context("fork" if "fork" in methods else "spawn")
+    recv, send = ctx.Pipe(duplex=False)
+    proc = ctx.Process(target=_child, args=(str(p), check_pixels, send), daemon=True)
+    proc.start()
+    send.close()
+    try:
+        problems: list[str] | None = recv.recv()
+    except EOFError:
+        problems = None
+    finally:
+        recv.close()
+        proc.join()
+    if problems is not None:
+        return problems
+    code = proc.exitcode or 0
+    try:
+        how = signal.Signals(-code).name if code < 0 else f"exit status {code}"
+    except ValueError:
+        how = f"signal {-code}"
+    return [f"{p}: damaged HDF5 file: the HDF5 library crashed reading it ({how})"]
+
+
+def _check_open_file(p: Path, f: h5py.File, check_pixels: bool) -> list[str]:
+    schema = f.attrs.get("schema")
+    if isinstance(schema, bytes):
+        schema = schema.decode(errors="replace")
+    if schema is None:
+        return [f"{p}: missing schema attribute (expected {SCHEMA!r})"]
+    if schema != SCHEMA:
+        return [f"{p}: schema is {schema!r}, expected {SCHEMA!r}"]
+    problems: list[str] = []
+    if "generator_version" not in f.attrs:
+        problems.append(f"{p}: missing attribute generator_version")
+    if "sequences" in f:
+        names = list(f["sequences"].keys())
+        if not names:
+            problems.append(f"{p}: /sequences holds no sequence")
+        for name in names:
+            where = f"{p}: sequence {name!r}"
+            try:
+                problems += _check_sequence(where, f[f"sequences/{name}"], check_pixels)
+            except _READ_ERRORS as err:
+                problems.append(f"{where}: unreadable ({_one_line(err)})")
+    if "results" in f:
+        problems += _check_results(p, f["results"])
+    if "sequences" not in f and "results" not in f:
+        problems.append(f"{p}: holds neither /sequences nor /results")
+    return problems
+
+
+def _one_line(err: BaseException) -> str:
+    text = str(err).strip().splitlines()
+    return text[0] if text else type(err).__name__
+
+
+def _frames(idx: list[int] | NDArray[Any]) -> str:
+    idx = [int(i) for i in idx]
+    shown = ", ".join(str(i) for i in idx[:_MAX_PER_KIND])
+    return shown + (f" (+{len(idx) - _MAX_PER_KIND} more)" if len(idx) > _MAX_PER_KIND else "")
+
+
+def _expected(t: int, h: int, w: int, k: int) -> dict[str, tuple[tuple[int, ...], Any]]:
     return {
         "frames": ((t, h, w, 3), np.uint8),
         "labels": ((t, h, w), np.uint16),
         "entities/id": ((k,), np.int32),
+        "entities/role": ((k,), str),
+        "entities/name": ((k,), str),
         "gt/box": ((t, k, 4), np.float32),
         "gt/visible_box": ((t, k, 4), np.float32),
         "gt/center": ((t, k, 2), np.float32),
@@ -41,153 +178,202 @@ def _expected_shapes(t: int, h: int, w: int, k: int) -> dict[str, tuple[tuple[in
     }
 
 
-def check_file(path: str | Path, *, check_pixels: bool = True) -> list[str]:
-    """Validate a scenegen file; return one line per problem found.
-
-    Parameters
-    ----------
-    path : str or Path
-    check_pixels : bool
-        Also re-derive visible boxes and visibility from ``labels`` frame by frame.
-    """
-    p = Path(path)
-    if not p.exists():
-        return [f"{p}: no such file"]
-    try:
-        f = h5py.File(p, "r")
-    except OSError:
-        return [f"{p}: not an HDF5 file (or truncated/corrupted)"]
-    with f:
-        schema = f.attrs.get("schema")
-        if isinstance(schema, bytes):
-            schema = schema.decode()
-        if schema is None:
-            return [f"{p}: missing schema attribute (expected {SCHEMA!r})"]
-        if schema != SCHEMA:
-            return [f"{p}: schema is {schema!r}, expected {SCHEMA!r}"]
-        if "sequences" in f:
-            problems: list[str] = []
-            names = list(f["sequences"].keys())
-            if not names:
-                problems.append(f"{p}: /sequences holds no sequence")
-            for name in names:
-                try:
-                    problems += _check_sequence(p, name, f[f"sequences/{name}"], check_pixels)
-                except (OSError, RuntimeError, KeyError, ValueError) as err:
-                    problems.append(f"{p}: sequence {name!r}: unreadable data ({_one_line(err)})")
-            return problems
-        if "results" in f:
-            return _check_results(p, f["results"])
-        return [f"{p}: holds neither /sequences nor /results"]
+def _dtype_ok(ds: h5py.Dataset, dtype: Any) -> bool:
+    if dtype is str:
+        return h5py.check_string_dtype(ds.dtype) is not None
+    return ds.dtype == np.dtype(dtype)
 
 
-def _one_line(err: BaseException) -> str:
-    text = str(err).strip().splitlines()
-    return text[0] if text else type(err).__name__
+def _dtype_name(dtype: Any) -> str:
+    return "string" if dtype is str else str(np.dtype(dtype))
 
 
-def _check_results(p: Path, root: h5py.Group) -> list[str]:
-    problems = []
-    for name, g in root.items():
-        where = f"{p}: results/{name}"
-        for key in ("target_ids", "boxes"):
-            if key not in g:
-                problems.append(f"{where}: missing dataset {key}")
-        if problems:
-            continue
-        m = g["target_ids"].shape[0]
-        if g["boxes"].ndim != 3 or g["boxes"].shape[1:] != (m, 4):
-            problems.append(f"{where}/boxes: shape {g['boxes'].shape}, expected (T, {m}, 4)")
-        if ("orderings" in g) != ("order_prob" in g):
-            problems.append(f"{where}: orderings and order_prob must come together")
-    return problems
-
-
-def _check_sequence(p: Path, name: str, g: h5py.Group, check_pixels: bool) -> list[str]:
-    where = f"{p}: sequence {name!r}"
-    problems: list[str] = []
-    for attr in ("seed", "config", "preset", "n_frames", "height", "width"):
-        if attr not in g.attrs:
-            problems.append(f"{where}: missing attribute {attr}")
-    if problems:
-        return problems
-    try:
-        from_dict(json.loads(g.attrs["config"]))
-    except (ValueError, ConfigError) as err:
-        problems.append(f"{where}: attribute config is not a valid config: {_one_line(err)}")
-    t, h, w = int(g.attrs["n_frames"]), int(g.attrs["height"]), int(g.attrs["width"])
-    if "entities/id" not in g:
-        return [*problems, f"{where}: missing dataset entities/id"]
-    k = int(g["entities/id"].shape[0])
-    for key, (shape, dtype) in _expected_shapes(t, h, w, k).items():
-        if key not in g:
+def _layout(where: str, g: h5py.Group) -> tuple[list[str], tuple[int, int, int, int]]:
+    """Attributes, datasets, shapes and dtypes; returns problems and (T, H, W, K)."""
+    if not isinstance(g, h5py.Group):
+        return [f"{where}: is not a group"], (0, 0, 0, 0)
+    problems = [f"{where}: missing attribute {a}" for a in _ATTRS if a not in g.attrs]
+    size: dict[str, int] = {}
+    for a in ("n_frames", "height", "width"):
+        if a in g.attrs:
+            try:
+                size[a] = int(g.attrs[a])
+            except (TypeError, ValueError):
+                problems.append(f"{where}: attribute {a} is not an integer: {g.attrs[a]!r}")
+    if "config" in g.attrs:
+        try:
+            cfg = from_dict(json.loads(g.attrs["config"]))
+        except (ValueError, TypeError, ConfigError) as err:
+            problems.append(f"{where}: attribute config is not a valid config: {_one_line(err)}")
+        else:
+            for a, value in (("n_frames", cfg.n_frames), ("height", cfg.height),
+                             ("width", cfg.width)):  # fmt: skip
+                if a in size and size[a] != value:
+                    problems.append(
+                        f"{where}: attribute {a}={size[a]} disagrees with the config's {value}"
+                    )
+    if len(size) < 3:
+        return problems, (0, 0, 0, 0)
+    t, h, w = size["n_frames"], size["height"], size["width"]
+    k = -1
+    if isinstance(g.get("entities/id"), h5py.Dataset) and g["entities/id"].ndim == 1:
+        k = int(g["entities/id"].shape[0])
+    for key, (shape, dtype) in _expected(t, h, w, max(k, 0)).items():
+        obj = g.get(key)
+        if obj is None:
             problems.append(f"{where}: missing dataset {key}")
-            continue
-        ds = g[key]
-        if not isinstance(ds, h5py.Dataset):
+        elif not isinstance(obj, h5py.Dataset):
             problems.append(f"{where}: {key} is not a dataset")
-            continue
-        if ds.shape != shape:
-            problems.append(f"{where}: {key} has shape {ds.shape}, expected {shape}")
-        if ds.dtype != np.dtype(dtype):
-            problems.append(f"{where}: {key} has dtype {ds.dtype}, expected {np.dtype(dtype)}")
-    for key in ("entities/role", "entities/name"):
-        if key not in g:
-            problems.append(f"{where}: missing dataset {key}")
-        elif g[key].shape != (k,):
-            problems.append(f"{where}: {key} has shape {g[key].shape}, expected ({k},)")
-    if "templates" not in g:
+        else:
+            if k < 0 and key == "entities/id":
+                problems.append(f"{where}: entities/id has shape {obj.shape}, expected (K,)")
+            elif obj.shape != shape:
+                problems.append(f"{where}: {key} has shape {obj.shape}, expected {shape}")
+            if not _dtype_ok(obj, dtype):
+                problems.append(
+                    f"{where}: {key} has dtype {obj.dtype}, expected {_dtype_name(dtype)}"
+                )
+    if not isinstance(g.get("templates"), h5py.Group):
         problems.append(f"{where}: missing group templates")
+    return problems, (t, h, w, k)
+
+
+def _read_small(where: str, g: h5py.Group, keys: list[str]) -> tuple[dict[str, Any], list[str]]:
+    out, problems = {}, []
+    for key in keys:
+        try:
+            out[key] = g[key][()]
+        except _READ_ERRORS as err:
+            problems.append(f"{where}: {key} is unreadable ({describe_read_error(err)})")
+    return out, problems
+
+
+def _check_sequence(where: str, g: h5py.Group, check_pixels: bool) -> list[str]:
+    problems, (t, h, w, k) = _layout(where, g)
     if problems:
         return problems
-
-    ids = g["entities/id"][()]
+    keys = ["entities/id", "entities/role", *(f"gt/{key}" for key in GT_FIELDS)]
+    data, problems = _read_small(where, g, keys)
+    if "entities/id" not in data:
+        return problems
+    ids = data["entities/id"]
     if np.any(ids < 1) or len(np.unique(ids)) != k:
         problems.append(f"{where}: entities/id must be unique and >= 1, got {ids.tolist()[:10]}")
         return problems
-    roles = {r.decode() if isinstance(r, bytes) else str(r) for r in g["entities/role"][()]}
-    bad_roles = roles - {"target", "distractor", "occluder", "clutter"}
-    if bad_roles:
-        problems.append(f"{where}: entities/role has unknown roles {sorted(bad_roles)}")
-    gt = {key: g[f"gt/{key}"][()] for key in GT_FIELDS}
+    if "entities/role" in data:
+        roles = {r.decode() if isinstance(r, bytes) else str(r) for r in data["entities/role"]}
+        if roles - _ROLES:
+            problems.append(f"{where}: entities/role has unknown roles {sorted(roles - _ROLES)}")
+    problems += _check_templates(where, g["templates"], ids)
+    gt = {key: data.get(f"gt/{key}") for key in GT_FIELDS}
+    if all(v is not None for v in gt.values()):
+        problems += _check_gt(where, gt)
+    if check_pixels:
+        problems += _check_frames(where, g["frames"])
+        problems += _check_labels(where, g["labels"], ids, gt)
+    return problems
+
+
+def _check_templates(where: str, grp: h5py.Group, ids: NDArray[Any]) -> list[str]:
+    problems = []
+    missing = [int(i) for i in ids if str(int(i)) not in grp]
+    if missing:
+        problems.append(f"{where}: templates missing for ids {_frames(missing)}")
+    for key, ds in grp.items():
+        if not isinstance(ds, h5py.Dataset) or ds.ndim != 3 or ds.shape[2] != 4:
+            shape = getattr(ds, "shape", None)
+            problems.append(f"{where}: templates/{key} has shape {shape}, expected (h, w, 4)")
+        elif ds.dtype != np.uint8:
+            problems.append(f"{where}: templates/{key} has dtype {ds.dtype}, expected uint8")
+        else:
+            try:
+                ds[()]
+            except _READ_ERRORS as err:
+                problems.append(
+                    f"{where}: templates/{key} is unreadable ({describe_read_error(err)})"
+                )
+    return problems
+
+
+def _check_gt(where: str, gt: dict[str, NDArray[Any]]) -> list[str]:
+    problems = []
     present = gt["present"].astype(bool)
     for key in ("box", "center"):
-        nan = np.isnan(gt[key]).any(axis=-1)
-        bad = np.flatnonzero((nan == present).any(axis=1))
+        nan = np.isnan(gt[key])
+        bad = np.flatnonzero((nan.any(axis=-1) == present).any(axis=1) | (
+            nan.any(axis=-1) != nan.all(axis=-1)).any(axis=1))  # fmt: skip
         if bad.size:
             problems.append(
                 f"{where}: gt/{key} NaN pattern disagrees with gt/present at frames {_frames(bad)}"
             )
-    bad = np.flatnonzero(((gt["visibility"] != 0) & ~present).any(axis=1))
+    bad = np.flatnonzero((~np.isnan(gt["visible_box"]).all(axis=-1) & ~present).any(axis=1))
+    if bad.size:
+        problems.append(
+            f"{where}: gt/visible_box is set where gt/present is false at frames {_frames(bad)}"
+        )
+    vis = gt["visibility"]
+    bad = np.flatnonzero(((vis != 0) & ~present).any(axis=1))
     if bad.size:
         problems.append(f"{where}: gt/visibility is nonzero where absent at frames {_frames(bad)}")
-    if np.any((gt["visibility"] < 0) | (gt["visibility"] > 1 + 1e-6)):
-        problems.append(f"{where}: gt/visibility has values outside [0, 1]")
-    if check_pixels:
-        problems += _check_labels(where, g, ids, gt)
+    bad = np.flatnonzero(((vis < 0) | (vis > 1 + 1e-6) | np.isnan(vis)).any(axis=1))
+    if bad.size:
+        problems.append(f"{where}: gt/visibility is outside [0, 1] at frames {_frames(bad)}")
+    box, center = gt["box"], gt["center"]
+    with np.errstate(invalid="ignore"):
+        size_bad = (box[..., 2:] <= 0).any(axis=-1) & present
+        mid = box[..., :2] + box[..., 2:] / 2
+        off = (np.abs(center - mid) > 0.5 + 1e-3).any(axis=-1) & present
+    bad = np.flatnonzero(size_bad.any(axis=1))
+    if bad.size:
+        problems.append(f"{where}: gt/box has width or height <= 0 at frames {_frames(bad)}")
+    bad = np.flatnonzero(off.any(axis=1))
+    if bad.size:
+        problems.append(f"{where}: gt/center is not the centre of gt/box at frames {_frames(bad)}")
+    bad = np.flatnonzero((gt["depth"] < 0).any(axis=1))
+    if bad.size:
+        problems.append(f"{where}: gt/depth is negative at frames {_frames(bad)}")
     return problems
 
 
-def _frames(idx: np.ndarray) -> str:
-    shown = ", ".join(str(int(i)) for i in idx[:_MAX_PER_KIND])
-    return shown + (f" (+{idx.size - _MAX_PER_KIND} more)" if idx.size > _MAX_PER_KIND else "")
+def _check_frames(where: str, frames: h5py.Dataset) -> list[str]:
+    bad, reason = [], ""
+    for t in range(frames.shape[0]):
+        try:
+            frames[t]
+        except _READ_ERRORS as err:
+            bad.append(t)
+            reason = reason or describe_read_error(err)
+    if not bad:
+        return []
+    return [f"{where}: frames is damaged at frames {_frames(bad)} ({reason})"]
 
 
-def _check_labels(where: str, g: h5py.Group, ids: np.ndarray, gt: dict[str, Any]) -> list[str]:
-    labels = g["labels"]
-    t_n = labels.shape[0]
+def _check_labels(
+    where: str, labels: h5py.Dataset, ids: NDArray[Any], gt: dict[str, Any]
+) -> list[str]:
     max_id = int(ids.max()) if ids.size else 0
     # id -> entity index; ids need not be 1..K in order.
     lut = np.full(max_id + 1, -1, dtype=np.int64)
     lut[ids] = np.arange(ids.size)
-    unknown, box_bad, vis_bad = [], [], []
+    unreadable, unknown, box_bad, vis_bad = [], [], [], []
+    reason = ""
     vbox, vis, present = gt["visible_box"], gt["visibility"], gt["present"]
-    for t in range(t_n):
-        lab = labels[t]
+    for t in range(labels.shape[0]):
+        try:
+            lab = labels[t]
+        except _READ_ERRORS as err:
+            unreadable.append(t)
+            reason = reason or describe_read_error(err)
+            continue
         top = int(lab.max()) if lab.size else 0
-        counts = np.bincount(lab.ravel(), minlength=max_id + 1)
-        if top > max_id or np.any((counts[1:] > 0) & (lut[1:] < 0)):
+        if top > max_id:
             unknown.append(t)
+            continue
+        counts = np.bincount(lab.ravel(), minlength=max_id + 1)
+        if np.any((counts[1:] > 0) & (lut[1:] < 0)):
+            unknown.append(t)
+            continue
+        if vbox is None or vis is None or present is None:
             continue
         slices = ndimage.find_objects(lab.astype(np.int32), max_label=max_id)
         expect = np.full((ids.size, 4), np.nan, dtype=np.float32)
@@ -204,17 +390,70 @@ def _check_labels(where: str, g: h5py.Group, ids: np.ndarray, gt: dict[str, Any]
         if np.any(seen & ~present[t]) or np.any((vis[t] > 0) != seen):
             vis_bad.append(t)
     out = []
+    if unreadable:
+        out.append(f"{where}: labels is damaged at frames {_frames(unreadable)} ({reason})")
     if unknown:
-        out.append(
-            f"{where}: labels name ids not in entities/id at frames {_frames(np.array(unknown))}"
-        )
+        out.append(f"{where}: labels name ids not in entities/id at frames {_frames(unknown)}")
     if box_bad:
-        out.append(
-            f"{where}: gt/visible_box disagrees with labels at frames {_frames(np.array(box_bad))}"
-        )
+        out.append(f"{where}: gt/visible_box disagrees with labels at frames {_frames(box_bad)}")
     if vis_bad:
         out.append(
             f"{where}: gt/visibility or gt/present disagree with labels at frames "
-            f"{_frames(np.array(vis_bad))}"
+            f"{_frames(vis_bad)}"
         )
     return out
+
+
+def _check_results(p: Path, root: h5py.Group) -> list[str]:
+    problems: list[str] = []
+    if not isinstance(root, h5py.Group) or not len(root):
+        return [f"{p}: /results holds no tracker result"]
+    for name, g in root.items():
+        where = f"{p}: result {name!r}"
+        if not isinstance(g, h5py.Group):
+            problems.append(f"{where}: is not a group")
+            continue
+        problems += [
+            f"{where}: missing attribute {a}"
+            for a in ("tracker", "params", "seed", "sequence")
+            if a not in g.attrs
+        ]
+        if "params" in g.attrs:
+            try:
+                json.loads(g.attrs["params"])
+            except (ValueError, TypeError) as err:
+                problems.append(f"{where}: attribute params is not JSON: {_one_line(err)}")
+        missing = [
+            key for key in ("target_ids", "boxes") if not isinstance(g.get(key), h5py.Dataset)
+        ]
+        problems += [f"{where}: missing dataset {key}" for key in missing]
+        if missing:
+            continue
+        m = g["target_ids"].shape[0] if g["target_ids"].ndim == 1 else -1
+        t = g["boxes"].shape[0] if g["boxes"].ndim else 0
+        expect: dict[str, tuple[tuple[int, ...] | str, Any]] = {
+            "target_ids": ((m,) if m >= 0 else "(M,)", np.int32),
+            "boxes": ((t, m, 4), np.float32),
+        }
+        if ("orderings" in g) != ("order_prob" in g):
+            problems.append(f"{where}: orderings and order_prob must come together")
+        elif "orderings" in g:
+            n_ord = g["orderings"].shape[0] if g["orderings"].ndim == 2 else -1
+            expect["orderings"] = ((n_ord, m), np.int16)
+            expect["order_prob"] = ((t, n_ord), np.float32)
+        for key, (shape, dtype) in expect.items():
+            ds = g[key]
+            if ds.shape != shape:
+                problems.append(f"{where}: {key} has shape {ds.shape}, expected {shape}")
+            if ds.dtype != np.dtype(dtype):
+                problems.append(f"{where}: {key} has dtype {ds.dtype}, expected {np.dtype(dtype)}")
+        data, unreadable = _read_small(where, g, list(expect))
+        problems += unreadable
+        orderings = data.get("orderings")
+        if (
+            orderings is not None
+            and orderings.size
+            and (orderings.min() < 0 or orderings.max() >= m)
+        ):
+            problems.append(f"{where}: orderings name positions outside 0..{m - 1}")
+    return problems

@@ -171,7 +171,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
 
     from scenegen.validate import check_file
 
-    problems = check_file(args.file)
+    problems = check_file(args.file, isolate=True)
     if problems:
         for line in problems:
             print(line, file=sys.stderr)
