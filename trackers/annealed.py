@@ -49,7 +49,9 @@ def survival_beta(log_lik: NDArray[np.float64], alpha: float) -> NDArray[np.floa
 
     The rule of the PARSEC bodytrack annealed filter (Deutscher et al.'s adaptive
     annealing): a smaller β flattens the weights and raises the survival rate, which is 1
-    at β = 0. Found by bisection (40 halvings) per target.
+    at β = 0. Searched on a geometric grid of 65 values over [1e-8, 1], then on 65 values
+    between the bracketing grid points (relative precision about 0.5 %), all targets and
+    candidates in one vectorised evaluation per stage.
 
     Parameters
     ----------
@@ -62,16 +64,25 @@ def survival_beta(log_lik: NDArray[np.float64], alpha: float) -> NDArray[np.floa
     -------
     ndarray of shape (K,)
     """
-    k = log_lik.shape[0]
-    lo = np.zeros(k)
-    hi = np.ones(k)
-    for _ in range(40):
-        mid = 0.5 * (lo + hi)
-        ok = survival_rate(mid[:, None] * log_lik) >= alpha
-        lo = np.where(ok, mid, lo)
-        hi = np.where(ok, hi, mid)
-    full = survival_rate(log_lik) >= alpha
-    return np.where(full, 1.0, lo)
+    log_w = log_lik - log_lik.max(axis=1, keepdims=True)
+    coarse = np.broadcast_to(np.logspace(-8.0, 0.0, 65), (log_w.shape[0], 65))
+    lo, hi = _bracket(log_w, coarse, alpha)
+    fine = lo[:, None] + (hi - lo)[:, None] * np.linspace(0.0, 1.0, 65)
+    lo, _ = _bracket(log_w, fine, alpha)
+    return lo
+
+
+def _bracket(log_w: NDArray[np.float64], betas: NDArray[np.float64],
+             alpha: float) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Per row of candidates ``betas`` (K, G), increasing: the last β of the leading run
+    whose survival rate is >= alpha, and the next candidate (the same β at the end)."""
+    w = np.exp(betas[:, :, None] * log_w[:, None, :])
+    rate = w.sum(axis=2) ** 2 / (log_w.shape[1] * (w * w).sum(axis=2))
+    ok = rate >= alpha
+    ok[:, 0] = True  # the smallest candidate is the floor of β
+    last = np.where(ok.all(axis=1), ok.shape[1] - 1, np.argmin(ok, axis=1) - 1)
+    rows = np.arange(betas.shape[0])
+    return betas[rows, last], betas[rows, np.minimum(last + 1, ok.shape[1] - 1)]
 
 
 def resample_targets(particles: NDArray[np.float64], weights: NDArray[np.float64],

@@ -75,7 +75,7 @@ def test_adaptive_beta_keeps_the_survival_rate():
     assert beta[0] == 1.0
     rate = survival_rate(beta[:, None] * log_lik)
     assert np.all(rate >= 0.5)
-    np.testing.assert_allclose(rate[1:], 0.5, atol=1e-6)
+    assert np.all(rate[1:] < 0.51)  # the search's precision
     assert np.all(beta[1:] < 1.0)
 
 

@@ -83,6 +83,16 @@ def _pixel_range(lo, size, n):
 
 
 @njit(cache=True)
+def _chord(ex, half_w, dy2, c0, c1):
+    """Columns [ca, cb) of the ellipse's chord on a row with normalised dy² < 1, widened by
+    one pixel on each side so rounding never drops a pixel (the exact test is per pixel)."""
+    half = half_w * np.sqrt(1.0 - dy2)
+    ca = int(np.ceil(ex - half - 0.5)) - 1
+    cb = int(np.ceil(ex + half - 0.5)) + 1
+    return max(ca, c0), min(cb, c1)
+
+
+@njit(cache=True)
 def _window(bin_img, cx, cy, w, h, kernel, hist, totals, touched):
     """Accumulate the kernel-weighted histogram of the window of size (w, h) centred at
     (cx, cy) into ``hist`` (zero on entry), with ``region_histograms``' pixel rule: pixel
@@ -108,7 +118,8 @@ def _window(bin_img, cx, cy, w, h, kernel, hist, totals, touched):
         dy2 = dy * dy
         if dy2 >= 1.0:
             continue
-        for c in range(c0, c1):
+        ca, cb = _chord(ex, 0.5 * w, dy2, c0, c1)
+        for c in range(ca, cb):
             dx = (c + 0.5 - ex) * inv_hw
             r2 = dx * dx + dy2
             if r2 >= 1.0:
@@ -155,12 +166,17 @@ def _clear(hist, touched, n_touched):
 
 
 @njit(cache=True)
-def _shift(bin_img, cx, cy, w, h, q, hist, total):
+def _shift(bin_img, cx, cy, w, h, q, hist, total, touched, n_touched, weight):
     """New centre by eq. 26 with a constant shadow; returns (x, y, sum of weights).
 
     Visits the pixels ``_window`` visited (same box range, same ellipse test) and skips
-    those that carried no weight there.
+    those that carried no weight there. ``weight`` (B,) is scratch space for the per-bin
+    weights of eq. 25, so the pixel loop takes no square root.
     """
+    for t in range(n_touched):
+        b = touched[t]
+        # eq. 25: w_i = sqrt(q_b / p_b(y0)) with p_b = hist_b / total.
+        weight[b] = np.sqrt(q[b] * total / hist[b])
     rows, cols = bin_img.shape
     x = cx - 0.5 * w
     y = cy - 0.5 * h
@@ -179,20 +195,23 @@ def _shift(bin_img, cx, cy, w, h, q, hist, total):
         dy2 = dy * dy
         if dy2 >= 1.0:
             continue
-        for c in range(c0, c1):
+        ca, cb = _chord(ex, 0.5 * w, dy2, c0, c1)
+        row_w = 0.0
+        row_x = 0.0
+        for c in range(ca, cb):
             px = c + 0.5
             dx = (px - ex) * inv_hw
             if dx * dx + dy2 >= 1.0:
                 continue
             b = bin_img[r, c]
-            hb = hist[b]
-            if hb <= 0.0:
+            if hist[b] <= 0.0:
                 continue
-            # eq. 25: w_i = sqrt(q_b / p_b(y0)) with p_b = hist_b / total.
-            wi = np.sqrt(q[b] * total / hb)
-            sx += wi * px
-            sy += wi * py
-            sw += wi
+            wi = weight[b]
+            row_x += wi * px
+            row_w += wi
+        sx += row_x
+        sy += row_w * py
+        sw += row_w
     if sw <= 0.0:
         return cx, cy, 0.0
     return sx / sw, sy / sw, sw
@@ -209,6 +228,7 @@ def _mean_shift(bin_img, models, model_index, centres, sizes, kernel, max_iter, 
     hist = np.zeros(n_bins)
     totals = np.empty(1)
     touched = np.empty(n_bins, dtype=np.int64)
+    weight = np.empty(n_bins)
     eps2 = eps * eps
     for p in range(n_points):
         q = models[model_index[p]]
@@ -220,7 +240,8 @@ def _mean_shift(bin_img, models, model_index, centres, sizes, kernel, max_iter, 
         d0 = _distance(q, hist, totals, touched, n, n_bins)
         it = 0
         while it < max_iter and d0 > min_distance and totals[0] > 0.0:
-            x1, y1, sw = _shift(bin_img, x0, y0, w, h, q, hist, totals[0])
+            x1, y1, sw = _shift(bin_img, x0, y0, w, h, q, hist, totals[0], touched, n,
+                                weight)
             it += 1
             if sw <= 0.0:
                 break
