@@ -90,7 +90,10 @@ class KalmanTracker(Tracker):
     search_radius : int
         Search window half-size around the predicted position, px.
     step : int
-        Coarse-to-fine search stride; 1 is exhaustive.
+        Coarse-to-fine search stride; 1 is exhaustive. The coarse grid of the default 2
+        is safe because of the blur (σ = 2 px smooths textures below the grid's Nyquist
+        limit; measured on ``shm-crossing``: the same errors as exhaustive search, about
+        2.5x faster); with ``blur=0`` on fine textures use 1.
     min_visible : float
         Fraction of the template that must be compared for a match to count.
     support : {"box", "ellipse"}
@@ -120,7 +123,7 @@ class KalmanTracker(Tracker):
         r_gain: float = 0.01,
         r_floor: float = 0.5,
         search_radius: int = 12,
-        step: int = 1,
+        step: int = 2,
         min_visible: float = 0.25,
         support: str = "ellipse",
         blur: float = 2.0,

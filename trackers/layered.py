@@ -168,6 +168,7 @@ class LayeredMatcher:
         self.step = int(step)
         self.min_visible = float(min_visible)
         self._frame_hw = (h, w)
+        self._buffer: NDArray[np.uint8] | None = None
 
     def measure(
         self,
@@ -194,7 +195,6 @@ class LayeredMatcher:
             Mask the pixels of the objects matched in front (False: every object is
             matched on the unmasked frame).
         """
-        frame = self._smooth(frame)
         c = np.asarray(centres, dtype=np.float64).reshape(self.n_objects, 2)
         h, w = self._frame_hw
         shift = np.round(c - self._centre0)
@@ -206,6 +206,7 @@ class LayeredMatcher:
         origin[:, 0] = np.clip(origin[:, 0], -self.sizes[:, 1] - lim, w + lim)
         origin[:, 1] = np.clip(origin[:, 1], -self.sizes[:, 0] - lim, h + lim)
         active = self._inside_fraction(origin) >= self.min_visible
+        frame = self._smooth_windows(frame, origin, active)
         rows = np.ascontiguousarray(order, dtype=np.int64)
         n_order = rows.shape[0]
         pos = np.zeros((n_order, self.n_objects, 2), dtype=np.int64)
@@ -235,6 +236,40 @@ class LayeredMatcher:
         if self.blur <= 0:
             return frame
         return cv2.GaussianBlur(frame, (0, 0), self.blur, borderType=cv2.BORDER_REPLICATE)
+
+    def _smooth_windows(
+        self, frame: NDArray[np.uint8], origin: NDArray[np.int64], active: NDArray[np.bool_]
+    ) -> NDArray[np.uint8]:
+        """The frame blurred inside the search windows of the active objects.
+
+        Only the windows are read by the kernel, so only they are blurred: each window is
+        cut with a margin wider than the Gaussian's support (so its inside equals the
+        whole-frame blur, which replicates the frame's own border the same way) and
+        written into a buffer; pixels outside every window are left stale.
+        """
+        if self.blur <= 0:
+            return frame
+        h, w = self._frame_hw
+        if self._buffer is None:
+            self._buffer = np.zeros((h, w, 3), dtype=np.uint8)
+        out = self._buffer
+        r = self.search_radius
+        pad = int(np.ceil(4 * self.blur)) + 1
+        for k in np.flatnonzero(active):
+            x0, y0 = int(origin[k, 0]) - r, int(origin[k, 1]) - r
+            x1, y1 = x0 + int(self.sizes[k, 1]) + 2 * r, y0 + int(self.sizes[k, 0]) + 2 * r
+            cx0, cy0 = max(x0 - pad, 0), max(y0 - pad, 0)
+            cx1, cy1 = min(x1 + pad, w), min(y1 + pad, h)
+            if cx0 >= cx1 or cy0 >= cy1:
+                continue
+            crop = cv2.GaussianBlur(
+                frame[cy0:cy1, cx0:cx1], (0, 0), self.blur, borderType=cv2.BORDER_REPLICATE
+            )
+            wx0, wy0 = max(x0, 0), max(y0, 0)
+            wx1, wy1 = min(x1, w), min(y1, h)
+            if wx0 < wx1 and wy0 < wy1:
+                out[wy0:wy1, wx0:wx1] = crop[wy0 - cy0 : wy1 - cy0, wx0 - cx0 : wx1 - cx0]
+        return out
 
 
 def check_matcher_params(

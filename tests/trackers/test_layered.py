@@ -184,3 +184,27 @@ def test_bad_matcher_parameters(kwargs, match):
     frame = np.zeros((20, 20, 3), np.uint8)
     with pytest.raises(ValueError, match=match):
         LayeredMatcher(frame, [[2, 2, 5, 5]], **kwargs)
+
+
+def test_window_blur_equals_whole_frame_blur():
+    rng = np.random.default_rng(6)
+    frame0 = _texture(rng, 90, 140)
+    boxes = np.array(
+        [[-5.0, 10.0, 24.0, 20.0], [60.0, 40.0, 30.0, 30.0], [110.0, 62.0, 26.0, 26.0]]
+    )
+    sigma = 1.7
+    blurred = LayeredMatcher(frame0, boxes, search_radius=6, blur=sigma, step=1)
+    plain = LayeredMatcher(
+        cv2.GaussianBlur(frame0, (0, 0), sigma, borderType=cv2.BORDER_REPLICATE), boxes,
+        search_radius=6, blur=0.0, step=1,
+    )
+    np.testing.assert_array_equal(blurred.templates, plain.templates)
+    frame = np.roll(frame0, (2, -3), axis=(0, 1))
+    centres = boxes[:, :2] + boxes[:, 2:] / 2 + [[-2.0, 1.0], [1.0, 2.0], [-3.0, 3.0]]
+    order = orderings(3)
+    a = blurred.measure(frame, centres, order)
+    b = plain.measure(
+        cv2.GaussianBlur(frame, (0, 0), sigma, borderType=cv2.BORDER_REPLICATE), centres, order
+    )
+    np.testing.assert_array_equal(a.mse, b.mse)
+    np.testing.assert_array_equal(a.centres, b.centres)

@@ -64,7 +64,7 @@ def _fill_valid(h, w, rx, ry, valid, support, sizes, front, n_front, front_pos):
 
 @njit(cache=True)
 def _score(
-    frame, rx, ry, valid, tpl, sup, th, tw, dx, dy, s, n_max, min_count, best
+    frame, rx, ry, valid, tpl, sup, rows, tw, dx, dy, s, n_max, min_count, best
 ):  # pragma: no cover
     """(mean squared difference, pixels compared) of one candidate.
 
@@ -75,7 +75,8 @@ def _score(
     # A partial sum above this bound can never beat ``best``: the mean divides by at most
     # 3 n_max.
     bound = best * 3.0 * n_max
-    for a in range(0, th, s):
+    for k in range(rows.shape[0]):
+        a = rows[k]
         i = dy + a
         r = ry + i
         for b in range(0, tw, s):
@@ -92,6 +93,30 @@ def _score(
     if cnt < min_count or cnt == 0:
         return np.inf, cnt
     return acc / (3.0 * cnt), cnt
+
+
+@njit(cache=True)
+def _row_order(th, s):  # pragma: no cover - compiled
+    """Template rows 0, s, 2s, ... in coarse-to-fine interleaved order (0, 16s, 8s, ...).
+
+    Spread-out rows make a partial sum representative early, so that a poor candidate is
+    abandoned after fewer rows.
+    """
+    n = (th + s - 1) // s
+    out = np.empty(n, dtype=np.int64)
+    taken = np.zeros(n, dtype=np.bool_)
+    k = 0
+    g = 1
+    while g * 2 < n:
+        g *= 2
+    while g >= 1:
+        for q in range(0, n, g):
+            if not taken[q]:
+                taken[q] = True
+                out[k] = q * s
+                k += 1
+        g //= 2
+    return out
 
 
 @njit(cache=True)
@@ -128,6 +153,8 @@ def _match(
                 n_full += 1
                 if a % step == 0 and b % step == 0:
                     n_sub += 1
+    rows_sub = _row_order(th, step)
+    rows_full = _row_order(th, 1)
     bx = -1
     by = -1
     lo_x = 0
@@ -142,7 +169,7 @@ def _match(
             dy = offsets[k, 1]
             if dx % step != 0 or dy % step != 0:
                 continue
-            e, _ = _score(frame, rx, ry, valid, tpl, sup, th, tw, dx, dy, step, n_sub,
+            e, _ = _score(frame, rx, ry, valid, tpl, sup, rows_sub, tw, dx, dy, step, n_sub,
                           min_sub, best)
             if e < best:
                 best = e
@@ -164,7 +191,8 @@ def _match(
         dy = offsets[k, 1]
         if dx < lo_x or dx > hi_x or dy < lo_y or dy > hi_y:
             continue
-        e, n = _score(frame, rx, ry, valid, tpl, sup, th, tw, dx, dy, 1, n_full, min_full, best)
+        e, n = _score(frame, rx, ry, valid, tpl, sup, rows_full, tw, dx, dy, 1, n_full, min_full,
+                      best)
         if e < best:
             best = e
             best_n = n
