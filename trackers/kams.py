@@ -49,7 +49,7 @@ class KAMS(AnnealedPF):
 
     name = "kams"
 
-    def __init__(self, *, n_particles: int = 40, n_layers: int = 3, lam: float = 20.0,
+    def __init__(self, *, n_particles: int = 40, n_layers: int = 3, lam: float = 1000.0,
                  sigma: float | Sequence[float] = 12.0, sigma_decay: float = 0.5,
                  schedule: str = "adaptive", alpha: float = 0.5, beta_ratio: float = 0.5,
                  max_iter: int = 5, eps: float = 0.5, resampler: str = "systematic",
