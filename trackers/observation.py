@@ -40,7 +40,7 @@ __all__ = ["MODELS", "ColourModel", "FrameObservation"]
 
 #: Observation model names and their default (n_parts, kernel).
 MODELS: dict[str, tuple[int, str]] = {
-    "hsv": (2, "uniform"),
+    "hsv": (2, "epanechnikov"),
     "rgb": (1, "cone"),
 }
 

@@ -235,6 +235,7 @@ class _Partitioned(_ParticleTracker):
         rows = np.arange(n)
         logpi = np.zeros(n)
         ll = np.zeros((n, m))
+        log_g = np.zeros(n)
         for j in range(m):
             obj = orderings[group, j]
             cur = x[rows, obj]
@@ -244,12 +245,17 @@ class _Partitioned(_ParticleTracker):
             stage = obs.log_likelihoods(self._boxes(new, obj), obj)
             ll[rows, obj] = stage
             if j < m - 1:
-                # §3.3: weighted resampling with g = p(Z | X_{o_j}) inside each group; any
-                # constant factor of g cancels, so scale by the largest for range.
+                # §3.3 weighted resampling inside each group with the weighting function
+                # g_j = Π_{i<=j} p(Z | X_{o_i}) of the objects placed so far. The carried
+                # weights are π ∝ 1 / g_{j-1}, so ancestors are drawn ∝ p(Z | X_{o_j}) and
+                # the particles stay concentrated where every placed object is likely;
+                # weighting by p(Z | X_{o_j}) alone would undo the earlier stages.
+                # Constant factors of π and g cancel: scale by the largest for range.
+                log_g += stage
                 k, w = weighted_resample_groups(
-                    np.exp(logpi - logpi.max()), np.exp(stage - stage.max()), sizes,
+                    np.exp(logpi - logpi.max()), np.exp(log_g - log_g.max()), sizes,
                     method=self.resampler, rng=self.rng)
-                x, prev, ll = x[k], prev[k], ll[k]
+                x, prev, ll, log_g = x[k], prev[k], ll[k], log_g[k]
                 logpi = np.log(w)
         # The set {x, π'} still represents the predicted joint state (weighted resampling
         # preserves it), so π' Π_i p(Z | X_i) are the unnormalised posterior weights w̃.

@@ -261,7 +261,7 @@ def _row_weights(wbuf, ca, cb, cx, inv_hw, dy2, kernel):
         else:
             k = 1.0 - np.sqrt(r2)
         # r² >= 1 (outside the ellipse) gives k <= 0: weight 0, so it adds nothing.
-        wbuf[c - ca] = np.int64(max(k, 0.0) * _ONE)
+        wbuf[c - ca] = np.int64(max(k, 0.0) * _ONE + 0.5)
 
 
 @njit(cache=True)

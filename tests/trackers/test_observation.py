@@ -1,0 +1,201 @@
+"""Histogram kernel and colour observation models against plain per-patch oracles."""
+
+import cv2
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from skimage.color import rgb2hsv
+
+from trackers.kernels.histogram import (
+    KERNEL_CONE,
+    KERNEL_EPANECHNIKOV,
+    KERNEL_UNIFORM,
+    bhattacharyya_distance,
+    hsv_n_bins,
+    quantize_hsv,
+    quantize_rgb,
+    region_distances,
+    region_histograms,
+)
+from trackers.observation import ColourModel
+
+KERNELS = (KERNEL_UNIFORM, KERNEL_EPANECHNIKOV, KERNEL_CONE)
+
+
+def _reference_histogram(bin_img, box, n_bins, kernel, n_parts):
+    """One box's histogram the slow, obvious way: every pixel centre tested."""
+    rows, cols = bin_img.shape
+    x, y, w, h = box
+    rr, cc = np.mgrid[0:rows, 0:cols]
+    px, py = cc + 0.5, rr + 0.5
+    inside = (px >= x) & (px < x + w) & (py >= y) & (py < y + h)
+    r2 = ((px - (x + w / 2)) / (w / 2)) ** 2 + ((py - (y + h / 2)) / (h / 2)) ** 2
+    if kernel == KERNEL_UNIFORM:
+        weight = np.ones_like(r2)
+    elif kernel == KERNEL_EPANECHNIKOV:
+        weight = np.clip(1.0 - r2, 0.0, None)
+    else:
+        weight = np.clip(1.0 - np.sqrt(r2), 0.0, None)
+    weight = np.where(inside, weight, 0.0)
+    part = np.minimum(((py - y) / (h / n_parts)).astype(int), n_parts - 1)
+    out = []
+    for j in range(n_parts):
+        wj = np.where(part == j, weight, 0.0)
+        hist = np.bincount(bin_img.ravel(), weights=wj.ravel(), minlength=n_bins)
+        total = hist.sum()
+        out.append(hist / total if total > 0 else np.full(n_bins, 1.0 / n_bins))
+    return np.concatenate(out) / n_parts
+
+
+def _frame(seed, height, width):
+    """A noise frame with a few flat rectangles (flat regions and noise both matter)."""
+    rng = np.random.default_rng(seed)
+    frame = rng.integers(0, 256, (height, width, 3), dtype=np.uint8)
+    for _ in range(3):
+        x0, y0 = rng.integers(0, width), rng.integers(0, height)
+        frame[y0:y0 + rng.integers(1, 20), x0:x0 + rng.integers(1, 20)] = rng.integers(0, 256, 3)
+    return frame
+
+
+@settings(max_examples=40)
+@given(seed=st.integers(0, 2**32 - 1), n_bins=st.integers(2, 300),
+       n_hists=st.integers(1, 20), common_ref=st.booleans())
+def test_bhattacharyya_equals_opencv(seed, n_bins, n_hists, common_ref):
+    rng = np.random.default_rng(seed)
+    # Sparse histograms too: zero bins are where sqrt(p q) formulas usually slip.
+    p = rng.dirichlet(np.full(n_bins, 0.3), n_hists) * (rng.random((n_hists, n_bins)) > 0.3)
+    p[:, 0] += 1e-3
+    p /= p.sum(axis=1, keepdims=True)
+    q = rng.dirichlet(np.ones(n_bins), 1 if common_ref else n_hists)
+    ours = bhattacharyya_distance(p, q[0] if common_ref else q)
+    theirs = [cv2.compareHist(p[i].astype(np.float32), q[0 if common_ref else i]
+                              .astype(np.float32), cv2.HISTCMP_BHATTACHARYYA)
+              for i in range(n_hists)]
+    np.testing.assert_allclose(ours, theirs, atol=2e-6)
+
+
+@settings(max_examples=25)
+@given(seed=st.integers(0, 2**32 - 1), height=st.integers(5, 40), width=st.integers(5, 40),
+       model=st.sampled_from(["rgb", "hsv"]), bins=st.integers(1, 12),
+       kernel=st.sampled_from(KERNELS), n_parts=st.integers(1, 3))
+def test_region_histograms_equal_per_patch_numpy(seed, height, width, model, bins, kernel,
+                                                  n_parts):
+    rng = np.random.default_rng(seed)
+    frame = _frame(seed, height, width)
+    if model == "rgb":
+        bin_img, n_bins = quantize_rgb(frame, bins), bins ** 3
+    else:
+        bin_img, n_bins = quantize_hsv(frame, bins, bins, bins), hsv_n_bins(bins, bins, bins)
+    n = 12
+    # Boxes anywhere: inside, cut by every border, wholly outside, sub-pixel and huge.
+    boxes = np.column_stack([
+        rng.uniform(-0.5 * width, 1.2 * width, n), rng.uniform(-0.5 * height, 1.2 * height, n),
+        rng.uniform(0.3, 1.5 * width, n), rng.uniform(0.3, 1.5 * height, n)])
+    boxes[0] = [0.0, 0.0, width, height]
+    boxes[1] = [-3.0, -2.0, 8.0, 7.0]
+    boxes[2] = [width - 2.5, height - 3.5, 6.0, 7.0]
+    boxes[3] = [width + 1.0, 1.0, 5.0, 5.0]
+    hists = region_histograms(bin_img, boxes, n_bins, kernel, n_parts)
+    expected = np.stack([_reference_histogram(bin_img, b, n_bins, kernel, n_parts)
+                         for b in boxes])
+    # Weights are accumulated in 2**-32 fixed point: exact to ~1e-9 of a small total.
+    np.testing.assert_allclose(hists, expected, rtol=0, atol=1e-8)
+    np.testing.assert_allclose(hists.sum(axis=1), 1.0, atol=1e-12)
+    refs = rng.dirichlet(np.ones(n_bins * n_parts), 3)
+    index = rng.integers(0, 3, n)
+    dist = region_distances(bin_img, boxes, refs, index, kernel, n_parts)
+    np.testing.assert_allclose(dist, bhattacharyya_distance(expected, refs[index]),
+                               rtol=0, atol=1e-7)
+
+
+def test_empty_region_is_uniform():
+    bins = np.zeros((10, 10), dtype=np.int32)
+    hist = region_histograms(bins, np.array([[20.0, 20.0, 5.0, 5.0], [3.2, 3.2, 0.2, 0.2]]),
+                             4, KERNEL_CONE, 2)
+    np.testing.assert_allclose(hist, 1.0 / 8)
+
+
+def test_quantize_rgb_formula():
+    rng = np.random.default_rng(3)
+    frame = rng.integers(0, 256, (7, 9, 3), dtype=np.uint8)
+    b = frame.astype(int) * 10 // 256
+    np.testing.assert_array_equal(quantize_rgb(frame), b[..., 0] * 100 + b[..., 1] * 10 + b[..., 2])
+
+
+def _reference_hsv(frame, hb, sb, vb, s_min, v_min):
+    f = frame.astype(np.int64)
+    r, g, b = f[..., 0], f[..., 1], f[..., 2]
+    mx, mn = f.max(-1), f.min(-1)
+    d = mx - mn
+    h6 = np.where(mx == r, np.where(g < b, g - b + 6 * d, g - b),
+                  np.where(mx == g, b - r + 2 * d, r - g + 4 * d))
+    hbin = np.minimum(h6 * hb // np.maximum(6 * d, 1), hb - 1)
+    sbin = np.minimum(d * sb // np.maximum(mx, 1), sb - 1)
+    vbin = np.minimum(mx * vb // 255, vb - 1)
+    coloured = (d > 0) & (d * 2**20 >= np.ceil(s_min * 2**20) * mx) & (mx >= v_min * 255 - 1e-9)
+    return np.where(coloured, hbin * sb + sbin, hb * sb + vbin)
+
+
+@settings(max_examples=20)
+@given(seed=st.integers(0, 2**32 - 1), hb=st.integers(1, 40), sb=st.integers(1, 40),
+       vb=st.integers(1, 40), s_min=st.floats(0.0, 1.0), v_min=st.floats(0.0, 1.0))
+def test_quantize_hsv_equals_integer_reference(seed, hb, sb, vb, s_min, v_min):
+    frame = _frame(seed, 30, 30)
+    out = quantize_hsv(frame, hb, sb, vb, s_min, v_min)
+    np.testing.assert_array_equal(out, _reference_hsv(frame, hb, sb, vb, s_min, v_min))
+    assert out.min() >= 0 and out.max() < hsv_n_bins(hb, sb, vb)
+
+
+def test_quantize_hsv_agrees_with_skimage():
+    frame = _frame(5, 64, 64)
+    hsv = rgb2hsv(frame)
+    h, s, v = hsv[..., 0], hsv[..., 1], hsv[..., 2]
+    coloured = (s >= 0.1) & (v >= 0.2)
+    ref = np.where(coloured, np.minimum((h * 10).astype(int), 9) * 10
+                   + np.minimum((s * 10).astype(int), 9), 100 + np.minimum((v * 10).astype(int), 9))
+    # skimage's floating-point rounding can put an exact bin edge on either side.
+    assert np.mean(quantize_hsv(frame) == ref) > 0.995
+
+
+@pytest.mark.parametrize("kind", ["hsv", "rgb"])
+def test_model_scores_template_at_zero_and_shifted_worse(kind):
+    frame = _frame(1, 60, 80)
+    frame[20:40, 30:50] = (200, 30, 30)
+    frame[30:40, 30:50] = (30, 30, 200)
+    model = ColourModel(kind, lam=20.0)
+    box = np.array([[30.0, 20.0, 20.0, 20.0]])
+    model.set_references(frame, box)
+    obs = model.observe(frame)
+    boxes = np.array([[30.0, 20.0, 20.0, 20.0], [36.0, 24.0, 20.0, 20.0], [0.0, 0.0, 20.0, 20.0]])
+    d = obs.distances(boxes, np.zeros(3, dtype=int))
+    assert d[0] == pytest.approx(0.0, abs=1e-7)
+    assert d[0] < d[1] < d[2]
+    np.testing.assert_allclose(obs.log_likelihoods(boxes, np.zeros(3, dtype=int)), -20.0 * d**2)
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"kind": "lab"}, "unknown observation model 'lab'; valid: hsv, rgb"),
+    ({"kernel": "gauss"}, "unknown kernel 'gauss'"),
+    ({"lam": 0.0}, "lam"),
+    ({"bins": 0}, "bins"),
+    ({"n_parts": 0}, "n_parts"),
+])
+def test_model_rejects_bad_parameters(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        ColourModel(**kwargs)
+
+
+def test_kernel_rejects_bad_input():
+    bins = np.zeros((10, 10), dtype=np.int32)
+    with pytest.raises(ValueError, match="positive width and height"):
+        region_histograms(bins, np.array([[1.0, 1.0, 0.0, 3.0]]), 4, KERNEL_UNIFORM)
+    with pytest.raises(ValueError, match="bin_img values"):
+        region_histograms(bins + 4, np.array([[1.0, 1.0, 2.0, 3.0]]), 4, KERNEL_UNIFORM)
+    with pytest.raises(ValueError, match="kernel"):
+        region_histograms(bins, np.array([[1.0, 1.0, 2.0, 3.0]]), 4, 7)
+    with pytest.raises(ValueError, match="ref_index"):
+        region_distances(bins, np.array([[1.0, 1.0, 2.0, 3.0]]), np.full((1, 4), 0.25),
+                         np.array([1]), KERNEL_UNIFORM)
+    with pytest.raises(ValueError, match="observe"):
+        ColourModel("rgb").observe(np.zeros((4, 4, 3), dtype=np.uint8))

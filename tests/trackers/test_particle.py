@@ -1,0 +1,198 @@
+"""Condensation, joint PF, PS and DPS: reductions, tracking, impoverishment, bad input."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+import trackers
+from scenegen.config import AR2, Motion
+from scenegen.generator import generate
+from scenegen.presets import get
+from trackers.particle import (
+    Condensation,
+    DistributedPartitionedSampling,
+    PartitionedSampling,
+    circular_shift,
+)
+
+PF_NAMES = ("condensation", "joint-pf", "ps", "dps")
+COLOURS = [((220, 40, 40), (40, 60, 200)), ((30, 160, 60), (250, 220, 60)),
+           ((200, 40, 200), (90, 230, 230)), ((250, 140, 0), (20, 20, 20))]
+
+
+def _scene(n_objects, n_frames=6, seed=0):
+    """Two-colour 20x20 squares moving ~1.5 px/frame on noise; frames and true boxes."""
+    rng = np.random.default_rng(seed)
+    h, w = 90, 120
+    start = np.array([[15.0, 15.0], [70.0, 20.0], [20.0, 55.0], [75.0, 60.0]])[:n_objects]
+    vel = rng.uniform(-1.5, 1.5, (n_objects, 2))
+    frames, boxes = [], []
+    for t in range(n_frames):
+        f = rng.integers(0, 256, (h, w, 3), dtype=np.uint8)
+        pos = np.round(start + t * vel)
+        for k, (x, y) in enumerate(pos.astype(int)):
+            f[y:y + 10, x:x + 20] = COLOURS[k][0]
+            f[y + 10:y + 20, x:x + 20] = COLOURS[k][1]
+        frames.append(f)
+        boxes.append(np.column_stack([pos, np.full((n_objects, 2), 20.0)]))
+    return np.stack(frames), np.stack(boxes)
+
+
+def _run(tracker, frames, boxes):
+    tracker.init(frames[0], boxes[0])
+    out = []
+    for f in frames[1:]:
+        est = tracker.step(f)
+        out.append((est.boxes.copy(), tracker.particles.copy(), np.array(tracker.weights),
+                    {k: np.array(v) for k, v in est.extras.items()}))
+    return out
+
+
+def _assert_same_runs(a, b):
+    for (ba, pa, wa, _), (bb, pb, wb, _) in zip(a, b, strict=True):
+        np.testing.assert_array_equal(ba, bb)
+        np.testing.assert_array_equal(pa, pb)
+        np.testing.assert_array_equal(np.ravel(wa), np.ravel(wb))
+
+
+@pytest.mark.parametrize("resampler", ["systematic", "residual"])
+def test_ps_with_one_object_is_condensation(resampler):
+    frames, boxes = _scene(1)
+    a = _run(PartitionedSampling(n_particles=80, rng=5, resampler=resampler), frames, boxes)
+    b = _run(Condensation(n_particles=80, rng=5, resampler=resampler), frames, boxes)
+    _assert_same_runs(a, b)
+
+
+def test_dps_with_one_group_is_ps():
+    frames, boxes = _scene(3)
+    a = _run(DistributedPartitionedSampling(n_groups=1, n_particles=90, rng=3), frames, boxes)
+    b = _run(PartitionedSampling(ordering=0, n_particles=90, rng=3), frames, boxes)
+    _assert_same_runs(a, b)
+
+
+def test_circular_shift_ordering_equals_explicit_permutation():
+    frames, boxes = _scene(3)
+    a = _run(PartitionedSampling(ordering=2, n_particles=60, rng=1), frames, boxes)
+    b = _run(PartitionedSampling(ordering=(2, 0, 1), n_particles=60, rng=1), frames, boxes)
+    _assert_same_runs(a, b)
+    np.testing.assert_array_equal(circular_shift(4, 1), [1, 2, 3, 0])
+
+
+@pytest.mark.parametrize("name", PF_NAMES)
+def test_same_seed_same_track_and_exposed_state(name):
+    frames, boxes = _scene(3)
+    a = _run(trackers.make(name, n_particles=60, rng=11), frames, boxes)
+    b = _run(trackers.make(name, n_particles=60, rng=11), frames, boxes)
+    c = _run(trackers.make(name, n_particles=60, rng=12), frames, boxes)
+    _assert_same_runs(a, b)
+    assert not np.array_equal(a[-1][1], c[-1][1])
+    box, particles, weights, extras = a[-1]
+    assert box.shape == (3, 4) and particles.shape == (60, 3, 3)
+    assert weights.shape == ((60, 3) if name == "condensation" else (60,))
+    np.testing.assert_allclose(weights.sum(axis=0), 1.0)
+    assert extras["uniqueness"].shape == (3,) and extras["effective_dynamics"].shape == (3,)
+    assert np.all((extras["uniqueness"] > 0) & (extras["uniqueness"] <= 1))
+    if name == "dps":
+        assert extras["mixture_weights"].shape == (3,)
+        np.testing.assert_allclose(extras["mixture_weights"].sum(), 1.0)
+
+
+def _iou(a, b):
+    x0 = np.maximum(a[..., 0], b[..., 0])
+    y0 = np.maximum(a[..., 1], b[..., 1])
+    x1 = np.minimum(a[..., 0] + a[..., 2], b[..., 0] + b[..., 2])
+    y1 = np.minimum(a[..., 1] + a[..., 3], b[..., 1] + b[..., 3])
+    inter = np.clip(x1 - x0, 0, None) * np.clip(y1 - y0, 0, None)
+    return inter / (a[..., 2] * a[..., 3] + b[..., 2] * b[..., 3] - inter)
+
+
+def _easy_config(n_objects, n_frames):
+    """DPS synthetic targets only (no distractor, no clutter), moving gently."""
+    cfg = get("dps-synthetic")
+    walk = AR2(boundary="reflect", a1=1.5, a2=-0.5, sigma=1.5, margin=2.0)
+    targets = [dataclasses.replace(e, motion=Motion(x=walk, y=walk))
+               for e in cfg.entities if e.role == "target"][:n_objects]
+    return dataclasses.replace(cfg, entities=tuple(targets), n_frames=n_frames)
+
+
+@pytest.fixture(scope="module")
+def easy_scenes():
+    out = []
+    for seed in (0, 1):
+        seq = generate(_easy_config(2, 20), seed=seed)
+        out.append((np.asarray(seq.frames), seq.init_boxes(0),
+                    np.asarray(seq.gt.box)[:, seq.target_indices()]))
+    return out
+
+
+@pytest.mark.parametrize("name", PF_NAMES)
+def test_tracks_easy_generated_scenes(name, easy_scenes):
+    for i, (frames, init, gt) in enumerate(easy_scenes):
+        result = trackers.track(trackers.make(name, n_particles=300, rng=i), frames, init)
+        iou = _iou(result.boxes[1:], gt[1:])
+        assert np.mean(iou >= 0.5) >= 0.95, (name, i, np.round(iou, 2))
+
+
+def test_ps_impoverishes_early_objects():
+    """DPS §3.3: the first object of a PS ordering goes through every weighted-resampling
+    stage and keeps the fewest distinct values; the last keeps them all."""
+    seq = generate(_easy_config(3, 12), seed=2)
+    for ordering, (first, last) in ((0, (0, 2)), (1, (1, 0))):
+        result = trackers.track(trackers.make("ps", ordering=ordering, n_particles=200, rng=4),
+                                np.asarray(seq.frames), seq.init_boxes(0))
+        u = result.extras["uniqueness"][1:].mean(axis=0)
+        assert u[first] < u[last], (ordering, u)
+    # DPS shares the burden: no object as impoverished as PS's first.
+    result = trackers.track(trackers.make("dps", n_particles=201, rng=4),
+                            np.asarray(seq.frames), seq.init_boxes(0))
+    assert result.extras["uniqueness"][1:].mean(axis=0).min() > u[1]
+
+
+@pytest.mark.parametrize("name", PF_NAMES)
+def test_bad_boxes_and_frames_raise(name):
+    frames, boxes = _scene(2)
+    with pytest.raises(ValueError, match="outside"):
+        trackers.make(name, n_particles=20).init(frames[0], [[500.0, 5.0, 10.0, 10.0]])
+    with pytest.raises(ValueError, match="zero or negative size"):
+        trackers.make(name, n_particles=20).init(frames[0], [[5.0, 5.0, 0.0, 10.0]])
+    tracker = trackers.make(name, n_particles=20, rng=0)
+    tracker.init(frames[0], boxes[0])
+    with pytest.raises(ValueError, match="shape changed"):
+        tracker.step(frames[1][:50])
+
+
+@pytest.mark.parametrize("name, params, match", [
+    ("particle", {}, "unknown tracker 'particle'; valid trackers: condensation"),
+    ("ps", {"orderings": 1}, "unknown parameter 'orderings' for tracker 'ps'; valid: ordering"),
+    ("dps", {"n_groups": 0}, "n_groups"),
+    ("dps", {"assignment": "greedy"}, "unknown assignment 'greedy'; valid: random, interleaved"),
+    ("joint-pf", {"n_particles": 0}, "n_particles"),
+    ("condensation", {"resampler": "best"}, "unknown resampler 'best'"),
+    ("ps", {"model": "lab"}, "unknown observation model 'lab'"),
+    ("ps", {"ordering": "first"}, "ordering"),
+    ("joint-pf", {"sigma": (1.0, 1.0)}, "sigma"),
+])
+def test_bad_parameters_raise(name, params, match):
+    with pytest.raises(ValueError, match=match):
+        trackers.make(name, **params)
+
+
+@pytest.mark.parametrize("tracker, match", [
+    (PartitionedSampling(ordering=3), r"ordering \(circular shift\) must lie in \[0, 2\)"),
+    (PartitionedSampling(ordering=(0, 0)), "not a permutation"),
+    (DistributedPartitionedSampling(n_particles=1), "exceeds n_particles = 1"),
+])
+def test_bad_ordering_or_groups_for_the_targets_raise(tracker, match):
+    frames, boxes = _scene(2)
+    with pytest.raises(ValueError, match=match):
+        tracker.init(frames[0], boxes[0])
+
+
+def test_interleaved_assignment_tracks():
+    frames, boxes = _scene(3)
+    runs = _run(DistributedPartitionedSampling(assignment="interleaved", n_particles=61, rng=2),
+                frames, boxes)
+    for (box, _, _, extras), truth in zip(runs, boxes[1:], strict=True):
+        np.testing.assert_allclose(extras["mixture_weights"].sum(), 1.0)
+        assert np.all(_iou(box, truth) > 0.5)
