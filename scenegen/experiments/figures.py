@@ -63,7 +63,8 @@ def _dps_synthetic(res: dict[str, Any], out: Path) -> list[str]:
             for s in shown:
                 ed = np.asarray(methods[s]["effective_dynamics"], dtype=float)
                 series[s] = (ed[:, c] if ed.ndim == 2 else ed).tolist()
-            _bars(axes[1 + c], objs, series, f"eff. dynamics {'uv'[c] if n_comp > 1 else ''} %")
+            name = f"eff. dynamics {'uv'[c]} %" if n_comp > 1 else "eff. dynamics (u, v mean) %"
+            _bars(axes[1 + c], objs, series, name)
         axes[-1].set_xlabel("object")
         axes[0].legend(fontsize=8, ncol=4)
         fig.tight_layout()

@@ -16,9 +16,12 @@ from scenegen.errors import ConfigError
 from scenegen.experiments import derive_seed, get, names, run_experiment
 from scenegen.experiments.runner import Task, execute, plan_tasks
 
-# A small stochastic sweep: two runs of two methods on a shortened sequence.
-NAME = "shm-depth"
-KW = {"runs": 2, "quick": True, "progress": False, "figures": False}
+# A small stochastic sweep: two seeded runs of two particle filters (quick: fewer
+# particles, λ = 20 only).
+NAME = "dps-synthetic"
+METHODS = ["nonps", "dps"]
+KW = {"runs": 2, "quick": True, "methods": METHODS, "progress": False, "figures": False}
+N_TASKS = 4
 
 
 @pytest.fixture(scope="module")
@@ -35,8 +38,8 @@ def test_seed_derivation_is_stable():
     )
     assert derive_seed("a") == 6023598183589259276
     assert derive_seed(0, "x", 1) != derive_seed(0, "x", 2)
-    t = Task(NAME, "shm", "shm-crossing", "", None, 0, 0, True)
-    other_run = Task(NAME, "shm", "shm-crossing", "", None, 1, 0, True)
+    t = Task(NAME, "dps", "dps-synthetic", "lam", 20.0, 0, 0, True)
+    other_run = Task(NAME, "dps", "dps-synthetic", "lam", 20.0, 1, 0, True)
     assert t.tracker_seed() != other_run.tracker_seed()
 
 
@@ -57,7 +60,7 @@ def test_same_bytes_on_a_dask_cluster(reference, tmp_path):
 
 def test_lost_dask_worker_loses_no_results(reference, tmp_path):
     distributed = pytest.importorskip("distributed")
-    tasks = plan_tasks(get(NAME), runs=2, seed=0, quick=True)
+    tasks = plan_tasks(get(NAME), runs=2, seed=0, quick=True, methods=METHODS)
     killed: list[int] = []
     with distributed.LocalCluster(
         n_workers=2, processes=True, threads_per_worker=1, dashboard_address=None
@@ -80,7 +83,7 @@ def test_lost_dask_worker_loses_no_results(reference, tmp_path):
 def test_resume_skips_stored_runs_and_gives_same_results(reference, tmp_path):
     shutil.copytree(reference / "runs", tmp_path / "runs")
     stored = sorted((tmp_path / "runs").glob("*.json"))
-    assert len(stored) == 6
+    assert len(stored) == N_TASKS
     # An interrupted sweep: half the runs are missing.
     for p in stored[::2]:
         p.unlink()
@@ -92,7 +95,7 @@ def test_resume_skips_stored_runs_and_gives_same_results(reference, tmp_path):
     run_experiment(NAME, tmp_path, jobs=1, **KW)
     assert json.loads(kept.read_text())["marker"] == "stored before the interruption"
     assert (tmp_path / "results.json").read_bytes() == (reference / "results.json").read_bytes()
-    assert len(list((tmp_path / "runs").glob("*.json"))) == 6
+    assert len(list((tmp_path / "runs").glob("*.json"))) == N_TASKS
     assert not list((tmp_path / "runs").glob(".*"))  # no temporary files left behind
 
 
@@ -110,7 +113,8 @@ def test_stale_or_damaged_run_files_are_redone(reference, tmp_path):
 def test_results_json_is_deterministic_and_complete(reference):
     doc = json.loads((reference / "results.json").read_text())
     assert doc["experiment"] == NAME and doc["runs"] == 2 and doc["quick"] is True
-    assert {m["slug"] for m in doc["methods"]} == {"kalman", "shm", "shm-fast"}
+    assert {m["slug"] for m in doc["methods"]} == set(METHODS)
+    assert list(doc["summary"]["by_value"]) == ["20"]
     assert "fidelity" in doc and "summary" in doc
     text = (reference / "results.json").read_text()
     assert "NaN" not in text and "Infinity" not in text
@@ -120,7 +124,7 @@ def test_unknown_names_list_the_valid_ones(tmp_path):
     with pytest.raises(ConfigError, match="valid experiments: dps-synthetic, dps-occlusion"):
         run_experiment("nope", tmp_path)
     with pytest.raises(ConfigError, match="valid methods: kalman, shm, shm-fast"):
-        run_experiment(NAME, tmp_path, methods=["dps"], **KW)
+        run_experiment("shm-depth", tmp_path, methods=["dps"], runs=1)
     with pytest.raises(ConfigError, match="runs must be >= 1"):
         run_experiment(NAME, tmp_path, runs=0, quick=True)
     assert names() == [
@@ -146,10 +150,11 @@ def _cli(argv):
 
 def test_experiment_verb(reference, tmp_path, capsys):
     shutil.copytree(reference / "runs", tmp_path / "runs")
-    assert _cli(["experiment", NAME, "--runs", "2", "--quick", "--jobs", "1",
-                 "-o", str(tmp_path)]) == 0
+    assert _cli(["experiment", NAME, "--runs", "2", "--quick", "--jobs", "1", "--method",
+                 "nonps", "--method", "dps", "-o", str(tmp_path)]) == 0
     assert capsys.readouterr().out.strip().endswith("results.json")
-    for f in ("results.json", "table.md", "ordering_probability.png"):
+    assert (tmp_path / "results.json").read_bytes() == (reference / "results.json").read_bytes()
+    for f in ("table.md", "success_recovery.png", "fig4_uniqueness_effective_dynamics.png"):
         assert (tmp_path / f).stat().st_size > 0
     with pytest.raises(ConfigError, match="valid experiments"):
         _cli(["experiment", "bogus", "-o", str(tmp_path)])
@@ -180,16 +185,16 @@ def test_report_links_tables_figures_and_previews(reference, tmp_path):
 
     shutil.copytree(reference, tmp_path / "experiments" / NAME)
     run_experiment(NAME, tmp_path / "experiments" / NAME, jobs=1, runs=2, quick=True,
-                   progress=False)
+                   methods=METHODS, progress=False)
     (tmp_path / "presets").mkdir()
     for f in ("kams-a.png", "kams-a.gif", "kams-a.h5"):
         (tmp_path / "presets" / f).write_bytes(b"x")
     index = build_report(tmp_path)
     page = index.read_text()
-    assert "experiments/shm-depth/ordering_probability.png" in page
-    assert "experiments/shm-depth/table.md" in page
+    assert f"experiments/{NAME}/success_recovery.png" in page
+    assert f"experiments/{NAME}/table.md" in page
     assert "presets/kams-a.gif" in page and "presets/kams-a.png" in page
-    assert "id='fidelity'" in page and "dps-synthetic" in page  # missing ones are listed
+    assert "id='fidelity'" in page and "kams-accuracy" in page  # missing ones are listed
     doc = json.loads((tmp_path / "results.json").read_text())
     assert list(doc["experiments"]) == [NAME]
     assert build_report(tmp_path).read_text() == page  # deterministic
