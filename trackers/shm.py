@@ -24,8 +24,11 @@ true ordering the squared-difference mean follows an exponential density, giving
   scale: the moving average of ``min_j E_j``.
 - ``"objects"``: the paper's per-object exponentials, ``Σ_m e^{j,m} / ē_m`` with one scale
   per object. Masking removes pixels from the mean of the object behind, so these means
-  are taken over different pixel sets under different orderings; on objects whose
-  appearance varies (rotation, shading) this is a weaker test than ``"union"``.
+  are taken over different pixel sets under different orderings, which makes it the
+  weaker test when appearance varies. Measured on ``shm-crossing`` seeds 0–3 (share of
+  overlap frames whose most probable ordering is the true one): with the default
+  matching (ellipse support, blur 2) both give 1.00; with box support and no blur,
+  ``"union"`` gives 0.82–1.00 and ``"objects"`` 0.41–0.70.
 
 The scales are exponential moving averages (rate ``mse_rate``) of the smallest mean over
 orderings — the exponential density's mean under the true ordering — floored at
@@ -56,7 +59,10 @@ dropped, and an object whose measurement is missing under orderings of total pro
 
 Cost: ``L`` orderings need up to ``M L`` template searches per frame (``M`` when no objects
 are close) and the Gaussian-sum filter ``M L²`` Kalman updates of dimension ``4 M``; more
-than 4 objects (24 orderings) is refused.
+than 4 objects (24 orderings) is refused. Measured on a 2-core machine under load: two
+objects on 360x288 (``shm-crossing``) about 2–3 ms per frame for either tracker; four
+objects (two crossing, 30x30 px) about 12 ms per frame for ``shm-fast`` and 70 ms for
+``shm`` (576 ordering pairs, state dimension 16).
 """
 
 from __future__ import annotations

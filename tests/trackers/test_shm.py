@@ -20,22 +20,26 @@ def _texture(rng: np.random.Generator, h: int, w: int) -> np.ndarray:
     return big[4 : 4 + h, 4 : 4 + w].clip(0, 255).astype(np.uint8)
 
 
-def _crossing(seed: int, n_frames: int = 80, period: int = 40, size: int = 30):
+def _crossing(seed: int, n_frames: int = 80, period: int = 40, size: int = 30, n_static=0):
     """Two textured squares oscillating in antiphase; the front one swaps at each crossing.
 
-    Returns frames (T, H, W, 3), boxes0 (2, 4), true centres (T, 2, 2), depth (T, 2).
+    ``n_static`` more squares stand still in the bottom row, behind the moving ones.
+    Returns frames (T, H, W, 3), boxes0 (M, 4), true centres (T, M, 2), depth (T, M).
     """
     rng = np.random.default_rng(seed)
     h, w = 120, 200
     bg = _texture(rng, h, w)
-    tpl = [_texture(rng, size, size), _texture(rng, size, size)]
+    tpl = [_texture(rng, size, size) for _ in range(2 + n_static)]
     t = np.arange(n_frames)
     x = np.stack([85 + 55 * np.cos(2 * np.pi * t / period),
                   85 - 55 * np.cos(2 * np.pi * t / period)], axis=1)
-    y = np.array([40.0, 50.0])
+    y = np.array([40.0, 44.0])
     # Crossings at t = period/4 + k period/2; the order swaps halfway between crossings.
     a_front = ((t + period // 4) // (period // 2)) % 2 == 0
+    x = np.concatenate([x, np.tile(10.0 + 45 * np.arange(n_static), (n_frames, 1))], axis=1)
+    y = np.concatenate([y, np.full(n_static, 85.0)])
     depth = np.where(a_front[:, None], [0, 1], [1, 0])
+    depth = np.concatenate([depth, np.tile(2 + np.arange(n_static), (n_frames, 1))], axis=1)
     frames = np.empty((n_frames, h, w, 3), np.uint8)
     for k in range(n_frames):
         f = bg.astype(np.float64)
@@ -45,7 +49,7 @@ def _crossing(seed: int, n_frames: int = 80, period: int = 40, size: int = 30):
         frames[k] = np.clip(f + rng.normal(0, 3.0, f.shape), 0, 255).astype(np.uint8)
     xr = np.round(x)
     centres = np.stack([xr + size / 2, np.broadcast_to(y + size / 2, xr.shape)], axis=2)
-    boxes0 = np.array([[xr[0, 0], y[0], size, size], [xr[0, 1], y[1], size, size]])
+    boxes0 = np.column_stack([xr[0], y, np.full_like(y, size), np.full_like(y, size)])
     return frames, boxes0, centres, depth
 
 
@@ -66,16 +70,26 @@ def _centre_error(result, centres):
     return np.linalg.norm(est - centres, axis=2)
 
 
-@pytest.mark.parametrize("name", ["shm", "shm-fast"])
-def test_synthetic_crossing_order_and_positions(name):
+@pytest.mark.parametrize(
+    "name, params",
+    [
+        ("shm", {}),
+        ("shm-fast", {}),
+        ("shm", {"evidence": "objects"}),
+        ("shm-fast", {"evidence": "objects"}),
+        ("shm", {"use_mse": False}),
+        ("shm-fast", {"motion": "ar2", "step": 1}),
+    ],
+)
+def test_synthetic_crossing_order_and_positions(name, params):
     frames, boxes0, centres, depth = _crossing(0)
-    tracker = trackers.make(name)
+    tracker = trackers.make(name, **params)
     res = trackers.track(tracker, frames, boxes0)
     assert tracker.orderings.dtype == np.int16 and tracker.orderings.shape == (2, 2)
     prob = res.extras["order_prob"]
     assert prob.shape == (len(frames), 2)
     np.testing.assert_allclose(prob[1:].sum(axis=1), 1.0)
-    boxes = np.stack([centres - 15, np.full_like(centres, 30)], axis=2).reshape(-1, 2, 4)
+    boxes = np.concatenate([centres - 15, np.full_like(centres, 30)], axis=2)
     occl = _overlap(boxes) >= 0.2
     occl[0] = False
     truth = _ordering_index(tracker.orderings, depth)
@@ -84,9 +98,28 @@ def test_synthetic_crossing_order_and_positions(name):
     assert _centre_error(res, centres)[1:].max() < 3.0
 
 
+@pytest.mark.parametrize("name, n_static", [("shm-fast", 1), ("shm-fast", 2), ("shm", 1)])
+def test_pairwise_order_among_more_objects(name, n_static):
+    frames, boxes0, centres, depth = _crossing(3, n_frames=60, n_static=n_static)
+    tracker = trackers.make(name)
+    res = trackers.track(tracker, frames, boxes0)
+    n_obj = 2 + n_static
+    assert tracker.orderings.shape == (len(np.unique(tracker.orderings, axis=0)), n_obj)
+    prob = res.extras["order_prob"]
+    assert prob.shape == (60, 6 if n_obj == 3 else 24)
+    # P(object 0 in front of object 1): orderings listing 0 before 1.
+    pos = np.argsort(tracker.orderings, axis=1)
+    p01 = prob[:, pos[:, 0] < pos[:, 1]].sum(axis=1)
+    boxes = np.concatenate([centres - 15, np.full_like(centres, 30)], axis=2)
+    occl = _overlap(boxes[:, :2]) >= 0.2
+    occl[0] = False
+    assert ((p01 > 0.5) == (depth[:, 0] < depth[:, 1]))[occl].mean() >= 0.9
+    assert _centre_error(res, centres)[1:].max() < 3.0
+
+
 def test_fast_shm_beats_kalman_during_synthetic_occlusions():
     frames, boxes0, centres, depth = _crossing(1)
-    boxes = np.stack([centres - 15, np.full_like(centres, 30)], axis=2).reshape(-1, 2, 4)
+    boxes = np.concatenate([centres - 15, np.full_like(centres, 30)], axis=2)
     occl = _overlap(boxes) >= 0.2
     err_fast = _centre_error(trackers.track(trackers.make("shm-fast"), frames, boxes0), centres)
     err_kal = _centre_error(trackers.track(trackers.make("kalman"), frames, boxes0), centres)
