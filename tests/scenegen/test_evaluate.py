@@ -117,3 +117,19 @@ def test_evaluate_verb_table_json_and_mismatch(seq, tmp_path, capsys):
     with pytest.raises(DataError, match="5 frames but sequence 'two' has 12") as err:
         _cli(["evaluate", str(data), str(bad)])
     assert "bad.h5" in str(err.value)
+
+
+def test_cli_exit_codes(seq, tmp_path, capsys):
+    from scenegen.cli import main
+
+    data = tmp_path / "seq.h5"
+    scenegen.write(data, seq)
+    boxes = np.asarray(seq.gt.box[:, seq.target_indices()], dtype=np.float32)
+    res = tmp_path / "res.h5"
+    write_result(res, TrackerResult("kalman", {}, 0, seq.name, seq.target_ids()[:1], boxes[:, :1]))
+    assert main(["evaluate", str(data), str(res)]) == 1
+    err = capsys.readouterr().err
+    assert "tracks 1 targets but sequence 'two' has 2" in err and "Traceback" not in err
+    write_result(res, TrackerResult("kalman", {}, 0, seq.name, seq.target_ids(), boxes))
+    assert main(["evaluate", str(data), str(res), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["overall"]["idf1"] == 1.0

@@ -202,3 +202,13 @@ def test_report_links_tables_figures_and_previews(reference, tmp_path):
         "<table>\n<tr><th>a</th><th>b</th></tr>\n"
         "<tr><td><strong>1</strong></td><td><code>x&lt;y</code></td></tr>\n</table>"
     )
+
+
+def test_cli_exit_codes_for_bad_input(tmp_path, capsys):
+    from scenegen.cli import main
+
+    assert main(["experiment", "nope", "-o", str(tmp_path)]) == 2
+    assert "valid experiments: dps-synthetic" in capsys.readouterr().err
+    assert main(["experiment", NAME, "--method", "x", "-o", str(tmp_path)]) == 2
+    assert "valid methods: nonps, ps-1234567" in capsys.readouterr().err
+    assert main(["experiment", NAME, "--jobs", "0", "-o", str(tmp_path)]) == 2
