@@ -19,11 +19,17 @@ the frame and is not masked. A candidate is valid only if ``|V| ≥ min_visible 
 Search: candidates are visited nearest the window centre (the prediction) first; a
 candidate whose partial sum already exceeds the best score times the largest possible
 pixel count is abandoned after that template row (its mean can only be larger), which
-never changes the result but skips most of the work once a good match is found. With
-``step`` > 1 a coarse pass first scores the candidates on a grid of stride ``step`` with
-the template subsampled by ``step``, then a full-resolution pass scores the
-``(2 step − 1)²`` candidates around the coarse winner: faster, but it can miss the optimum
-of fine, high-frequency textures; ``step`` = 1 is exhaustive.
+never changes the result. Template rows are visited interleaved (0, 16, 8, 24, ...) so that
+a partial sum is representative early. With ``step`` > 1 a coarse pass first scores the
+candidates on a grid of stride ``step`` with the template subsampled by ``step``, then a
+full-resolution pass scores the ``(2 step − 1)²`` candidates around the coarse winner:
+faster, but it can miss the optimum of fine, high-frequency textures; ``step`` = 1 is
+exhaustive.
+
+Measured on ``shm-crossing`` (two ~40x40 objects, radius 12, all 2 orderings, the calls
+of a ``shm-fast`` run replayed, CPU time per call): step 1 1.6 ms, without the early
+exit 7.0 ms; step 2 0.3 ms, without the early exit 0.8 ms. A branch-free row loop (0/1
+weights on a padded copy of the window) measured slower, 2.5 ms for step 1.
 
 Orderings that cannot differ are not recomputed: the match of object ``m`` depends only on
 the front objects whose footprint intersects ``m``'s search region and on where they were
