@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 import trackers
+from scenegen.metrics import centre_error, tracked_fraction
 
 
 def sequence(scenegen_sequence, n_frames):
@@ -35,3 +36,40 @@ def test_mean_shift_moves_the_particles_onto_modes(scenegen_sequence):
     d_plain = plain.targets.distances(obs, plain.particles)
     d_shifted = shifted.targets.distances(obs, shifted.particles)
     assert np.mean(d_shifted) < np.mean(d_plain)
+
+
+def tracked_fractions(scenegen_sequence, preset, name, seeds, **params):
+    """Proportion of each run tracked before failure (see test_meanshift_scenes.py for
+    "tracks to the end": the error never stays above the 15 px radius for 5 frames)."""
+    out = []
+    for seed in seeds:
+        seq = scenegen_sequence(preset, seed=seed)
+        k = seq.target_indices()[0]
+        gt = np.asarray(seq.gt.box[:, k], dtype=np.float64)
+        result = trackers.track(trackers.make(name, rng=seed, **params),
+                                np.asarray(seq.frames), gt[:1])
+        out.append(tracked_fraction(centre_error(result.boxes[:, 0], gt), 15.0))
+    return np.array(out)
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason=(
+    "measured 0/10 runs tracked to the end on kams-d (seeds 0-9; mean tracked fraction "
+    "0.19): its 600 clutter discs of the target's own palette leave 5% of the frame white, "
+    "~1 in 10 has the target's four colours in equal parts (its histogram), and the "
+    "mean-shift basin there is ~6 px against per-frame jumps of ~20-40 px (σ = 14)"))
+def test_kams_with_40_particles_tracks_kams_d_to_the_end_in_most_runs(scenegen_sequence):
+    fractions = tracked_fractions(scenegen_sequence, "kams-d", "kams", range(10),
+                                  n_particles=40)
+    assert np.mean(fractions == 1.0) >= 0.5
+
+
+@pytest.mark.slow
+def test_kams_tracks_kams_d_longer_than_the_annealed_filter(scenegen_sequence):
+    # The paper's robustness claim, with the same 40 particles and 3 layers (measured
+    # mean tracked fraction over seeds 0-7: kams 0.19, annealed 0.11).
+    seeds = range(8)
+    kams = tracked_fractions(scenegen_sequence, "kams-d", "kams", seeds, n_particles=40)
+    annealed = tracked_fractions(scenegen_sequence, "kams-d", "annealed", seeds,
+                                 n_particles=40)
+    assert kams.mean() > annealed.mean()
