@@ -317,14 +317,13 @@ min_visible, support, blur
             missed = np.isnan(zm).any(axis=1)
             # A missed object contributes the uniform density of an improper measurement.
             loglik += np.where(missed, self._log_u, pairs.log_likelihood)
-        log_ev = self._evidence.log_evidence(meas.mse, meas.counts)
         logw = (
             self._evidence.log_pi[ii, jj]
             + np.log(np.maximum(self.order_prob, 1e-300))[ii]
             + loglik
         )
         if self.use_mse:
-            logw = logw + log_ev[jj]
+            logw = logw + self._evidence.log_evidence(meas.mse, meas.counts)[jj]
         logw = logw.reshape(n_order, n_order)  # [i, j]
         top = logw.max()
         log_pj = top + np.log(np.exp(logw - top).sum(axis=0))
