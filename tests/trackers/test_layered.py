@@ -123,14 +123,19 @@ def test_true_ordering_explains_the_overlap_best():
         assert meas.n_searches == 4
 
 
-def test_distant_objects_are_matched_once_per_frame():
-    rng = np.random.default_rng(1)
-    frame = _texture(rng, 120, 200)
-    boxes = np.array([[10, 10, 20, 20], [80, 60, 20, 20], [160, 90, 20, 20]], float)
+@settings(max_examples=10, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), n_obj=st.integers(1, MAX_OBJECTS))
+def test_distant_objects_are_matched_once_per_frame(seed, n_obj):
+    rng = np.random.default_rng(seed)
+    frame = _texture(rng, 120, 60 * n_obj)
+    # One object per 60 px column: windows (radius 5) of 20 px objects never meet.
+    x = 60 * np.arange(n_obj) + rng.uniform(8, 32, n_obj)
+    y = rng.uniform(8, 92, n_obj)
+    boxes = np.column_stack([x, y, np.full(n_obj, 20.0), np.full(n_obj, 20.0)])
     matcher = LayeredMatcher(frame, boxes, search_radius=5)
-    order = orderings(3)
-    meas = matcher.measure(frame, boxes[:, :2] + 10, order)
-    assert meas.n_searches == 3
+    moved = np.roll(frame, (int(rng.integers(-3, 4)), int(rng.integers(-3, 4))), axis=(0, 1))
+    meas = matcher.measure(moved, boxes[:, :2] + 10, orderings(n_obj))
+    assert meas.n_searches == n_obj
     assert (meas.mse == meas.mse[0]).all() and (meas.centres == meas.centres[0]).all()
 
 
