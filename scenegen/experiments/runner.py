@@ -38,6 +38,7 @@ __all__ = [
     "load_record",
     "plan_tasks",
     "run_task",
+    "tracker_params",
     "write_json_atomic",
 ]
 
@@ -297,12 +298,19 @@ def write_json_atomic(path: Path, data: Any, *, indent: int | None = None) -> No
 
 
 def load_record(path: Path, task: Task) -> dict[str, Any] | None:
-    """The stored record of ``task`` at ``path``, or None if missing, unreadable or stale."""
+    """The stored record of ``task`` at ``path``, or None if missing, unreadable or stale.
+
+    Stale means stored for another key (experiment, method, preset, value, run, seed,
+    quick) or with other tracker parameters.
+    """
     try:
         data = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, ValueError):
         return None
     if not isinstance(data, dict) or data.get("key") != _round(task.key()):
+        return None
+    # Parameters changed since the run was stored (a new version of the experiment).
+    if data.get("params") != _round(tracker_params(get(task.experiment), task)):
         return None
     return data
 

@@ -106,6 +106,9 @@ def test_stale_or_damaged_run_files_are_redone(reference, tmp_path):
     rec = json.loads(stored[1].read_text())
     rec["key"]["seed"] = 99  # a run of another base seed: not this sweep's
     stored[1].write_text(json.dumps(rec))
+    rec = json.loads(stored[2].read_text())
+    rec["params"]["n_particles"] = 7  # stored by an older definition of the experiment
+    stored[2].write_text(json.dumps(rec))
     run_experiment(NAME, tmp_path, jobs=1, **KW)
     assert (tmp_path / "results.json").read_bytes() == (reference / "results.json").read_bytes()
 
