@@ -223,7 +223,12 @@ class SHMTracker(_SHMBase):
 min_visible, support, blur
         As for ``trackers.kalman_tracker.KalmanTracker``.
     p_stay : float
-        Probability that the depth ordering stays the same from one frame to the next.
+        Probability that the depth ordering stays the same from one frame to the next
+        (**open**). The order cannot be observed while the objects are apart and may
+        change then, so the belief should relax towards uniform within a few frames
+        (by a factor ``(L p_stay − 1) / (L − 1)`` per frame). Measured on
+        ``shm-crossing`` seeds 0–7: depth-order accuracy 100% for 0.5 to 0.9; mean
+        ``max |P − 1/L|`` on frames where the targets are apart 0.04 at 0.8, 0.11 at 0.9.
     lam : float
         Sharpness of the squared-difference evidence ``exp(−lam e / ē)``.
     mse_rate : float
@@ -248,7 +253,7 @@ min_visible, support, blur
     Example
     -------
     >>> import trackers
-    >>> tracker = trackers.make("shm", p_stay=0.9)
+    >>> tracker = trackers.make("shm", p_stay=0.8)
     """
 
     name = "shm"
@@ -268,7 +273,7 @@ min_visible, support, blur
         min_visible: float = 0.25,
         support: str = "ellipse",
         blur: float = 2.0,
-        p_stay: float = 0.9,
+        p_stay: float = 0.8,
         lam: float = 1.0,
         mse_rate: float = 0.1,
         mse_floor: float = 25.0,
@@ -386,7 +391,7 @@ min_visible, support, blur, p_stay, lam, mse_rate, mse_floor, evidence
         min_visible: float = 0.25,
         support: str = "ellipse",
         blur: float = 2.0,
-        p_stay: float = 0.9,
+        p_stay: float = 0.8,
         lam: float = 1.0,
         mse_rate: float = 0.1,
         mse_floor: float = 25.0,
