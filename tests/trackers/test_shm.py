@@ -98,6 +98,22 @@ def test_synthetic_crossing_order_and_positions(name, params):
     assert _centre_error(res, centres)[1:].max() < 3.0
 
 
+@pytest.mark.parametrize("name", ["shm", "shm-fast"])
+def test_probabilities_relax_to_equal_once_objects_are_apart(name):
+    frames, boxes0, centres, depth = _crossing(0)
+    boxes = np.concatenate([centres - 15, np.full_like(centres, 30)], axis=2)
+    touching = _overlap(boxes) > 0
+    since = np.zeros(len(frames), int)  # frames since the boxes last touched
+    for t in range(1, len(frames)):
+        since[t] = 0 if touching[t] else since[t - 1] + 1
+    prob = trackers.track(trackers.make(name), frames, boxes0).extras["order_prob"]
+    apart = (since >= 8) & (np.arange(len(frames)) > 20)
+    assert apart.sum() >= 10
+    assert np.abs(prob[apart] - 0.5).max() < 0.05
+    # ... while during the crossings one ordering clearly dominated.
+    assert np.abs(prob[1:] - 0.5).max() > 0.45
+
+
 @pytest.mark.parametrize("name, n_static", [("shm-fast", 1), ("shm-fast", 2), ("shm", 1)])
 def test_pairwise_order_among_more_objects(name, n_static):
     frames, boxes0, centres, depth = _crossing(3, n_frames=60, n_static=n_static)
