@@ -12,10 +12,8 @@ from __future__ import annotations
 
 import html
 import json
-import os
 import re
 import sys
-import tempfile
 from pathlib import Path
 from typing import Any
 
@@ -144,14 +142,10 @@ def _rel(path: Path, root: Path) -> str:
 
 
 def _write_atomic(path: Path, text: str) -> None:
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    from scenegen.io import atomic_path
+
+    with atomic_path(path, path.suffix) as tmp:
+        tmp.write_text(text, encoding="utf-8")
 
 
 def _fidelity(all_results: dict[str, dict[str, Any]]) -> list[str]:

@@ -6,6 +6,18 @@ stopped, then writes ``results.json`` (deterministic: sorted keys, no timestamps
 rounded to fixed decimals), ``table.md`` (the paper's table with its figures beside ours)
 and PNG figures. Results do not depend on the executor or the number of workers.
 
+From the command line::
+
+    scenegen experiment dps-synthetic -o out/dps              # all local cores
+    scenegen experiment dps-synthetic --jobs 4 -o out/dps     # rerun: resumes, same bytes
+    dask scheduler &                                          # or an existing cluster
+    dask worker tcp://HOST:8786 --nthreads 1 &                # on each machine
+    scenegen experiment dps-synthetic --scheduler tcp://HOST:8786 -o out/dps
+
+Dask workers need this package installed; each run generates its own sequence, so only
+the small task key and the run's record travel over the network. Numba kernels run on one
+thread per task, so one worker thread per core is the right setting.
+
 Example
 -------
 >>> from scenegen.experiments import run_experiment
@@ -15,8 +27,6 @@ Example
 from __future__ import annotations
 
 import json
-import os
-import tempfile
 from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
@@ -62,14 +72,10 @@ def _round(x: Any) -> Any:
 
 
 def _write_text(path: Path, text: str) -> None:
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    from scenegen.io import atomic_path
+
+    with atomic_path(path, path.suffix) as tmp:
+        tmp.write_text(text, encoding="utf-8")
 
 
 def run_experiment(

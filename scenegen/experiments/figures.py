@@ -6,8 +6,6 @@ writes its figure atomically and returns the file names written.
 
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
 from typing import Any
 
@@ -19,15 +17,11 @@ __all__ = ["write_figures"]
 
 
 def _save(fig: Figure, path: Path) -> str:
+    from scenegen.io import atomic_path
+
     FigureCanvasAgg(fig)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".png", dir=path.parent)
-    os.close(fd)
-    try:
+    with atomic_path(path, ".png") as tmp:
         fig.savefig(tmp, dpi=100, format="png", metadata={"Software": None})
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
     return path.name
 
 

@@ -17,7 +17,6 @@ import functools
 import hashlib
 import json
 import os
-import tempfile
 from collections.abc import Callable, Iterable
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import asdict, dataclass
@@ -46,6 +45,7 @@ SCHEDULER_TIMEOUT = 5.0
 """Seconds to wait for a Dask scheduler before giving up (the contract allows 10)."""
 
 _DECIMALS = 6
+_MIN_OVERLAP = 0.1  # pairs overlapping less than this say nothing about depth order
 
 
 def derive_seed(*parts: Any) -> int:
@@ -272,29 +272,27 @@ def run_task(task: Task) -> dict[str, Any]:
         record["orderings"] = np.asarray(orderings).astype(int)
         record["true_order"] = metrics.ordering_index(depth, orderings)
         record["depth_order_accuracy"] = metrics.depth_order_accuracy(
-            extras["order_prob"], orderings, depth, gt
+            extras["order_prob"], orderings, depth, gt, min_overlap=_MIN_OVERLAP
         )
         over = metrics.overlap_fraction(gt[:, :, None, :], gt[:, None, :, :])
         off_diagonal = ~np.eye(len(idx), dtype=bool)
-        record["overlap"] = np.any((over >= 0.1) & off_diagonal, axis=(1, 2))
+        record["overlap"] = np.any((over >= _MIN_OVERLAP) & off_diagonal, axis=(1, 2))
     return _round(record)
 
 
 def write_json_atomic(path: Path, data: Any, *, indent: int | None = None) -> None:
-    """Write ``data`` as JSON (sorted keys) to ``path`` atomically: temp file, then rename."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            json.dump(data, f, sort_keys=True, allow_nan=False, indent=indent,
+    """Write ``data`` as JSON (sorted keys, no NaN) to ``path`` atomically.
+
+    Uses :func:`scenegen.io.atomic_path`: a temporary file in the same folder, flushed and
+    renamed into place, so a killed process never leaves a half-written file there.
+    """
+    from scenegen.io import atomic_path
+
+    text = json.dumps(data, sort_keys=True, allow_nan=False, indent=indent,
                       separators=(",", ":") if indent is None else (",", ": "))
-            f.write("\n")
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with atomic_path(path, ".json") as tmp:
+        tmp.write_text(text + "\n", encoding="utf-8")
 
 
 def load_record(path: Path, task: Task) -> dict[str, Any] | None:
