@@ -135,14 +135,15 @@ class AnnealedPF(Tracker):
         default to 1000, not the DPS value 20: on the kams presets the target's window
         matches its model to d ≈ 0–0.02 and the nearest clutter discs to d ≈ 0.03–0.2, so
         λ = 20 weights them within a factor of 2 and the weighted mean straddles modes
-        (kams on kams-a, seeds 0–9: 5/10 runs tracked at λ = 20, 10/10 at λ = 400 and 1000).
+        (kams-a, seeds 0–9, runs tracked: annealed 1/10 at λ = 20, 7/10 at λ = 1000; kams
+        6/10 at λ = 20, 10/10 at λ = 400 and 1000).
     sigma : float or sequence of float, optional
         **(open)** Noise per layer, in pixels. A sequence gives each layer's standard
         deviation, first layer first; a number is the first layer's, each later layer
         multiplying it by ``sigma_decay`` (noise shrinks as the weighting sharpens, as
-        Deutscher et al.'s P_m does). The default 8 px suits the kams presets, whose
-        target jumps by about 6–12 px a frame (annealed on kams-a, seeds 0–9, λ = 1000:
-        8/10 runs tracked at 8 px, 7/10 at 12 px).
+        Deutscher et al.'s P_m does). The default 12 px suits the kams presets, whose
+        target jumps by about 6–12 px a frame on kams-a (annealed on kams-a, seeds 0–9,
+        λ = 1000: 7/10 runs tracked at 12 px, 6/10 at 8 px).
     sigma_decay : float, optional
         Ratio between successive layers' noise when ``sigma`` is a number, in (0, 1].
     schedule : str, optional
@@ -184,7 +185,7 @@ class AnnealedPF(Tracker):
     name = "annealed"
 
     def __init__(self, *, n_particles: int = 100, n_layers: int = 3, lam: float = 1000.0,
-                 sigma: float | Sequence[float] = 8.0, sigma_decay: float = 0.5,
+                 sigma: float | Sequence[float] = 12.0, sigma_decay: float = 0.5,
                  schedule: str = "adaptive", alpha: float = 0.5, beta_ratio: float = 0.5,
                  resampler: str = "systematic", kernel: str = "cone", bins: int = 10,
                  rng: RngLike = None) -> None:

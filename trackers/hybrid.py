@@ -33,7 +33,7 @@ class HybridPF(Tracker):
         default to 1000, not the DPS value 20: on the kams presets the target's window
         matches its model to d ≈ 0–0.02 and the nearest clutter discs to d ≈ 0.03–0.2, so
         λ = 20 weights them within a factor of 2 and the weighted mean straddles modes
-        (hybrid on kams-a, seeds 0–9: 3/10 runs tracked at λ = 200, 9/10 at λ = 1000).
+        (hybrid on kams-a, seeds 0–9: 7/10 runs tracked at λ = 200, 9/10 at λ = 1000).
     sigma : float, optional
         Position noise added after the constant-velocity prediction, in pixels (>= 0).
     max_iter : int, optional

@@ -33,10 +33,7 @@ class KAMS(AnnealedPF):
         5).
     eps : float, optional
         Mean-shift stopping shift, in pixels.
-    sigma : float or sequence of float, optional
-        Noise per layer, as for ``AnnealedPF``; the default first layer is wider (12 px)
-        because mean shift pulls the dispersed particles back onto the modes (KAMS §2).
-    n_layers, lam, sigma_decay, schedule, alpha, beta_ratio, resampler, kernel, bins, rng
+    n_layers, lam, sigma, sigma_decay, schedule, alpha, beta_ratio, resampler, kernel, bins, rng
         As for ``AnnealedPF``.
 
     Notes
