@@ -142,7 +142,8 @@ def evaluate(
         ``sequence``, ``tracker``, ``n_frames``, ``targets`` (one dict per target: ``id``,
         ``name``, ``frames`` evaluated, ``tracked`` (% of frames with T = 1), ``success``
         (tracked in every frame), ``recovered``, ``precision`` and ``recall`` (% over
-        tracked frames), ``mean_iou``, ``mean_centre_error`` (px), ``auc``,
+        tracked frames), ``mean_iou``, ``mean_centre_error`` (px, over frames with an
+        estimate), ``auc``,
         ``precision_20``, ``failure_frame`` (-1 if none)), and ``overall`` (``mean_iou``,
         ``auc``, ``precision_20``, ``mota``, ``motp``, ``idf1``, and ``depth_order_accuracy``
         (%) for SHM results). Undefined numbers are None.
@@ -169,8 +170,8 @@ def evaluate(
         raise DataError(
             f"result boxes hold {est.shape[1]} targets but target_ids lists {ids.shape[0]}"
         )
-    targets = np.asarray(sequence.target_indices())
-    tracked = targets[np.asarray(sequence.gt.present)[0, targets]]
+    target_idx = np.asarray(sequence.target_indices())
+    tracked = target_idx[np.asarray(sequence.gt.present)[0, target_idx]]
     if ids.shape[0] != tracked.shape[0]:
         raise DataError(
             f"result tracks {ids.shape[0]} targets but sequence {name!r} has "
