@@ -32,6 +32,12 @@ from scenegen.errors import ConfigError
 
 __all__ = [
     "AR2",
+    "MAX_BLUR",
+    "MAX_COLORS",
+    "MAX_FRAMES",
+    "MAX_FRAME_ENTITIES",
+    "MAX_MAGNITUDE",
+    "MAX_SIDE",
     "Appearance",
     "Background",
     "ClutterSpec",
@@ -51,6 +57,26 @@ Boundary = Literal["reflect", "clamp", "free"]
 Role = Literal["target", "distractor", "occluder", "clutter"]
 
 _MAX_ENTITIES = 65535  # labels are uint16 and 0 is the background
+
+# Upper limits that keep a valid config within sane memory and time: a config beyond them
+# is rejected with a ConfigError naming the field rather than attempted (a width of 10^9
+# would otherwise fail deep inside the generator, or exhaust memory).
+MAX_SIDE = 8192
+"""Largest frame width or height, and largest appearance (template) side, in pixels."""
+MAX_FRAMES = 1_000_000
+"""Most frames in one sequence."""
+MAX_FRAME_ENTITIES = 20_000_000
+"""Most frames x entities (clutter items included). Planning keeps about 50 bytes per
+entity per frame (trajectories, presence, depths), so this caps it near 1 GB; e.g.
+20,000 frames of 1,000 entities."""
+MAX_MAGNITUDE = 1e9
+"""Largest absolute value of any number in a config (positions, velocities, sigmas,
+frame indices, depths, ...): far beyond any canvas, and safe from int64 overflow."""
+MAX_COLORS = 256
+"""Most colours drawn per clutter item (``n_colors``)."""
+MAX_BLUR = 256.0
+"""Largest background texture ``scale`` (Gaussian std, pixels): the blur costs time in
+proportion to it."""
 
 
 def _fail(path: str, msg: str) -> typing.NoReturn:
@@ -127,6 +153,8 @@ class Appearance:
     def __post_init__(self) -> None:
         if self.size[0] < 1 or self.size[1] < 1:
             _fail("size", f"width and height must be >= 1, got {list(self.size)}")
+        if max(self.size) > MAX_SIDE:
+            _fail("size", f"width and height must be <= {MAX_SIDE}, got {list(self.size)}")
         if len(self.colors) < 1:
             _fail("colors", "needs at least one colour")
         for i, c in enumerate(self.colors):
@@ -261,8 +289,8 @@ class ClutterSpec:
             _fail("palette", "needs at least one colour")
         for i, c in enumerate(self.palette):
             _check_color(f"palette[{i}]", c)
-        if self.n_colors < 1:
-            _fail("n_colors", f"must be >= 1, got {self.n_colors}")
+        if not 1 <= self.n_colors <= MAX_COLORS:
+            _fail("n_colors", f"must be in 1..{MAX_COLORS}, got {self.n_colors}")
         if self.min_size < 0 or self.min_size > min(self.appearance.size):
             _fail("min_size", f"must be in 0..{min(self.appearance.size)}, got {self.min_size}")
         if self.region is not None and (self.region[2] <= 0 or self.region[3] <= 0):
@@ -285,8 +313,8 @@ class Background:
         _check_color("color", self.color)
         if not 0 <= self.low <= self.high <= 255:
             _fail("low", f"need 0 <= low <= high <= 255, got low={self.low} high={self.high}")
-        if self.scale <= 0:
-            _fail("scale", f"must be > 0, got {self.scale}")
+        if not 0 < self.scale <= MAX_BLUR:
+            _fail("scale", f"must be in (0, {MAX_BLUR:g}], got {self.scale}")
 
 
 @dataclass(frozen=True)
@@ -346,6 +374,16 @@ class SceneConfig:
         n_total = len(self.entities) + sum(c.count for c in self.clutter)
         if n_total > _MAX_ENTITIES:
             _fail("entities", f"at most {_MAX_ENTITIES} entities in all, got {n_total}")
+        for f, limit in (("width", MAX_SIDE), ("height", MAX_SIDE), ("n_frames", MAX_FRAMES)):
+            if getattr(self, f) > limit:
+                _fail(f, f"must be <= {limit}, got {getattr(self, f)}")
+        if self.n_frames * n_total > MAX_FRAME_ENTITIES:
+            _fail(
+                "n_frames",
+                f"{self.n_frames} frames x {n_total} entities exceeds {MAX_FRAME_ENTITIES:,} "
+                "(planning would need too much memory)",
+            )
+        _check_magnitudes(self, "")
         self._check_depth_ties()
 
     def _check_depth_ties(self) -> None:
@@ -365,6 +403,24 @@ class SceneConfig:
 
 # --------------------------------------------------------------------------------------
 # Parsing from plain data (dicts from YAML/JSON) with field paths in every error.
+
+
+def _check_magnitudes(obj: Any, path: str) -> None:
+    """Every number in a (nested) config is at most MAX_MAGNITUDE in absolute value."""
+    if dataclasses.is_dataclass(obj):
+        for f in dataclasses.fields(obj):
+            _check_magnitudes(getattr(obj, f.name), f"{path}.{f.name}" if path else f.name)
+    elif isinstance(obj, tuple):
+        for i, v in enumerate(obj):
+            _check_magnitudes(v, f"{path}[{i}]")
+    elif isinstance(obj, (int, float)) and not isinstance(obj, bool):
+        if not abs(obj) <= MAX_MAGNITUDE:  # also catches NaN
+            _fail(path, f"must be at most {MAX_MAGNITUDE:g} in magnitude, got {_short(obj)}")
+
+
+def _short(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 24 else f"{text[:20]}... ({len(text)} characters)"
 
 
 def _type_name(tp: Any) -> str:
@@ -415,6 +471,8 @@ def _convert(value: Any, tp: Any, path: str) -> Any:
     if tp is float:
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             _fail(path, f"must be a number, got {value!r}")
+        if isinstance(value, int) and abs(value) > MAX_MAGNITUDE:
+            _fail(path, f"must be at most {MAX_MAGNITUDE:g} in magnitude, got {_short(value)}")
         if not math.isfinite(value):
             _fail(path, f"must be finite, got {value!r}")
         return float(value)
