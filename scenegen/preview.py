@@ -104,7 +104,12 @@ def write_preview(
         if ext == ".gif":
             from PIL import Image
 
-            imgs = [Image.fromarray(f) for f in frames]
+            # Fast octree quantisation without dithering: the default median cut takes
+            # seconds per frame on noisy backgrounds.
+            imgs = [
+                Image.fromarray(f).quantize(256, method=Image.Quantize.FASTOCTREE, dither=0)
+                for f in frames
+            ]
             imgs[0].save(
                 tmp, format="GIF", save_all=True, append_images=imgs[1:], duration=80, loop=0
             )
