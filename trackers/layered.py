@@ -119,6 +119,24 @@ class LayeredMatcher:
         Template support, see the module docstring.
     blur : float
         Std in pixels of the Gaussian pre-smoothing of frames and templates (0 = none).
+
+    Attributes
+    ----------
+    templates : ndarray of shape (M, TH, TW, 3), uint8
+        Reference images (blurred if ``blur`` > 0), padded to the largest box.
+    support : ndarray of shape (M, TH, TW), bool
+        Support of each template (False in the padding and outside frame 0).
+    sizes : ndarray of shape (M, 2), int64
+        Template (height, width).
+
+    Example
+    -------
+    >>> import numpy as np
+    >>> frame = np.random.default_rng(0).integers(0, 256, (60, 80, 3), dtype=np.uint8)
+    >>> matcher = LayeredMatcher(frame, [[10, 10, 16, 16], [40, 20, 16, 16]], step=1)
+    >>> meas = matcher.measure(frame, [[18, 18], [48, 28]], orderings(2))
+    >>> meas.centres[0].tolist(), meas.n_searches
+    ([[18.0, 18.0], [48.0, 28.0]], 2)
     """
 
     def __init__(
