@@ -19,6 +19,7 @@ from trackers.observation import FrameObservation
 from trackers.resampling import RESAMPLERS, resample_groups
 
 __all__ = [
+    "ESTIMATES",
     "SCHEDULES",
     "AnnealedPF",
     "check_particles",
@@ -26,10 +27,14 @@ __all__ = [
     "resample_targets",
     "survival_beta",
     "survival_rate",
+    "weighted_estimate",
 ]
 
 #: β schedules of ``AnnealedPF``.
 SCHEDULES = ("adaptive", "geometric")
+
+#: Estimators of ``AnnealedPF``.
+ESTIMATES = ("mean", "mode")
 
 
 def normalised_weights(log_w: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -85,6 +90,23 @@ def _bracket(log_w: NDArray[np.float64], betas: NDArray[np.float64],
     return betas[rows, last], betas[rows, np.minimum(last + 1, ok.shape[1] - 1)]
 
 
+def weighted_estimate(particles: NDArray[np.float64], weights: NDArray[np.float64],
+                      radius: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
+    """Weighted mean (K, 2) of each target's particles (K, N, 2) with weights (K, N).
+
+    With ``radius`` (K,), only the particles within that distance of the target's heaviest
+    particle count (the weighted mean of its mode), so that a set split between the target
+    and a distractor is not averaged into the empty space between them.
+    """
+    if radius is not None:
+        best = particles[np.arange(particles.shape[0]), np.argmax(weights, axis=1)]
+        gap = particles - best[:, None, :]
+        near = np.einsum("knc,knc->kn", gap, gap) <= radius[:, None] ** 2
+        weights = weights * near
+        weights = weights / weights.sum(axis=1, keepdims=True)
+    return np.einsum("kn,knc->kc", weights, particles)
+
+
 def resample_targets(particles: NDArray[np.float64], weights: NDArray[np.float64],
                      rng: np.random.Generator, method: str) -> NDArray[np.float64]:
     """Resample every target's particles (K, N, D) by its weights (K, N), in one call.
@@ -121,7 +143,8 @@ class AnnealedPF(Tracker):
     4. weight by w^β_m with w = exp(−λ d²) (KAMS eq. 1, 3).
 
     There is no motion model: particles start where the previous frame ended (KAMS §2).
-    The estimate is the weighted mean of the last layer (β_0 = 1). With one layer this is
+    The estimate is the weighted mean of the last layer (β_0 = 1), or of its main mode
+    (``estimate``). With one layer this is
     the bootstrap (SIR) filter with random-walk noise ``sigma``.
 
     Parameters
@@ -155,6 +178,12 @@ class AnnealedPF(Tracker):
         Survival rate of the adaptive schedule, in (0, 1).
     beta_ratio : float, optional
         Ratio of the geometric schedule, in (0, 1].
+    estimate : str, optional
+        **(open)** ``"mean"`` (default; KAMS): the weighted mean of the last layer;
+        ``"mode"``: the weighted mean of the particles within half the target's smaller
+        box side of the heaviest particle, which does not average a set split between the
+        target and a distractor (kams on kams-b, seeds 0–9: 4/10 runs tracked to the end
+        with "mean", 6/10 with "mode").
     resampler : str, optional
         Resampling method, by name (``trackers.resampling``).
     kernel : str, optional
@@ -187,8 +216,8 @@ class AnnealedPF(Tracker):
     def __init__(self, *, n_particles: int = 100, n_layers: int = 3, lam: float = 1000.0,
                  sigma: float | Sequence[float] = 12.0, sigma_decay: float = 0.5,
                  schedule: str = "adaptive", alpha: float = 0.5, beta_ratio: float = 0.5,
-                 resampler: str = "systematic", kernel: str = "cone", bins: int = 10,
-                 rng: RngLike = None) -> None:
+                 estimate: str = "mean", resampler: str = "systematic", kernel: str = "cone",
+                 bins: int = 10, rng: RngLike = None) -> None:
         super().__init__(rng=rng)
         check_particles(n_particles, lam, resampler)
         if int(n_layers) != n_layers or n_layers < 1:
@@ -196,6 +225,9 @@ class AnnealedPF(Tracker):
         if schedule not in SCHEDULES:
             raise ValueError(f"unknown schedule {schedule!r}; valid schedules: "
                              f"{', '.join(SCHEDULES)}")
+        if estimate not in ESTIMATES:
+            raise ValueError(f"unknown estimate {estimate!r}; valid estimates: "
+                             f"{', '.join(ESTIMATES)}")
         if not 0.0 < alpha < 1.0:
             raise ValueError(f"alpha must lie in (0, 1), got {alpha!r}")
         if not 0.0 < beta_ratio <= 1.0:
@@ -210,6 +242,7 @@ class AnnealedPF(Tracker):
         self.schedule = schedule
         self.alpha = float(alpha)
         self.beta_ratio = float(beta_ratio)
+        self.estimate = estimate
         self.resampler = resampler
         self.kernel = kernel
         self.bins = int(bins)
@@ -239,7 +272,8 @@ class AnnealedPF(Tracker):
             betas[:, j] = self._beta(log_lik, m)
             w = normalised_weights(betas[:, j, None] * log_lik)
         self.particles, self.weights = x, w
-        centres = np.einsum("kn,knc->kc", w, x)[:, None, :]
+        radius = 0.5 * self.targets.sizes.min(axis=1) if self.estimate == "mode" else None
+        centres = weighted_estimate(x, w, radius)[:, None, :]
         confidence = 1.0 - self.targets.distances(obs, centres)[:, 0]
         return Estimate(self.targets.boxes(centres)[:, 0],
                         {"confidence": confidence, "beta": betas})

@@ -5,7 +5,12 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from trackers.annealed import check_particles, normalised_weights, resample_targets
+from trackers.annealed import (
+    check_particles,
+    normalised_weights,
+    resample_targets,
+    weighted_estimate,
+)
 from trackers.base import Estimate, RngLike, Tracker
 from trackers.meanshift import ColourTargets, check_kernel_bins, check_mean_shift, keep_inside
 
@@ -104,6 +109,6 @@ class HybridPF(Tracker):
         self.velocities = res.centres - x
         self.particles = res.centres
         self.weights = normalised_weights(-self.lam * res.distances**2)
-        centres = np.einsum("kn,knc->kc", self.weights, self.particles)[:, None, :]
+        centres = weighted_estimate(self.particles, self.weights)[:, None, :]
         confidence = 1.0 - self.targets.distances(obs, centres)[:, 0]
         return Estimate(self.targets.boxes(centres)[:, 0], {"confidence": confidence})

@@ -33,7 +33,9 @@ class KAMS(AnnealedPF):
         5).
     eps : float, optional
         Mean-shift stopping shift, in pixels.
-    n_layers, lam, sigma, sigma_decay, schedule, alpha, beta_ratio, resampler, kernel, bins, rng
+    n_layers, lam, sigma, sigma_decay, schedule, alpha, beta_ratio, estimate, resampler
+        As for ``AnnealedPF``.
+    kernel, bins, rng
         As for ``AnnealedPF``.
 
     Notes
@@ -52,12 +54,13 @@ class KAMS(AnnealedPF):
     def __init__(self, *, n_particles: int = 40, n_layers: int = 3, lam: float = 1000.0,
                  sigma: float | Sequence[float] = 12.0, sigma_decay: float = 0.5,
                  schedule: str = "adaptive", alpha: float = 0.5, beta_ratio: float = 0.5,
-                 max_iter: int = 5, eps: float = 0.5, resampler: str = "systematic",
-                 kernel: str = "cone", bins: int = 10, rng: RngLike = None) -> None:
+                 estimate: str = "mean", max_iter: int = 5, eps: float = 0.5,
+                 resampler: str = "systematic", kernel: str = "cone", bins: int = 10,
+                 rng: RngLike = None) -> None:
         super().__init__(n_particles=n_particles, n_layers=n_layers, lam=lam, sigma=sigma,
                          sigma_decay=sigma_decay, schedule=schedule, alpha=alpha,
-                         beta_ratio=beta_ratio, resampler=resampler, kernel=kernel,
-                         bins=bins, rng=rng)
+                         beta_ratio=beta_ratio, estimate=estimate, resampler=resampler,
+                         kernel=kernel, bins=bins, rng=rng)
         check_mean_shift(max_iter, eps)
         self.max_iter = int(max_iter)
         self.eps = float(eps)

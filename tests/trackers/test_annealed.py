@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import trackers
-from trackers.annealed import survival_beta, survival_rate
+from trackers.annealed import survival_beta, survival_rate, weighted_estimate
 from trackers.observation import ColourModel
 from trackers.resampling import resample_groups
 
@@ -97,6 +97,7 @@ def test_same_seed_same_result_other_seed_differs(scenegen_sequence):
         ({"sigma": -1.0}, "sigma"),
         ({"sigma_decay": 0.0}, "sigma_decay"),
         ({"schedule": "linear"}, "adaptive, geometric"),
+        ({"estimate": "median"}, "mean, mode"),
         ({"alpha": 1.0}, "alpha"),
         ({"beta_ratio": 1.5}, "beta_ratio"),
         ({"resampler": "best"}, "systematic"),
@@ -107,3 +108,23 @@ def test_same_seed_same_result_other_seed_differs(scenegen_sequence):
 def test_bad_parameters_raise_value_error(params, message):
     with pytest.raises(ValueError, match=message):
         trackers.make("annealed", **params)
+
+
+def test_mode_estimate_ignores_a_second_mode():
+    particles = np.array([[[10.0, 10.0], [11.0, 10.0], [60.0, 10.0], [61.0, 10.0]]])
+    weights = np.array([[0.3, 0.3, 0.2, 0.2]])
+    np.testing.assert_allclose(weighted_estimate(particles, weights), [[30.5, 10.0]])
+    np.testing.assert_allclose(weighted_estimate(particles, weights, np.array([15.0])),
+                               [[10.5, 10.0]])
+
+
+def test_mode_estimate_is_the_mean_when_the_set_is_one_mode(scenegen_sequence):
+    frames, boxes = first_frames_and_boxes(scenegen_sequence, n_frames=5)
+    mean = trackers.make("annealed", n_particles=30, sigma=2.0, rng=3)
+    mode = trackers.make("annealed", n_particles=30, sigma=2.0, estimate="mode", rng=3)
+    for tracker in (mean, mode):
+        tracker.init(frames[0], boxes)
+    for frame in frames[1:]:
+        a, b = mean.step(frame), mode.step(frame)
+        # σ = 2 px keeps every particle well within the mode radius (15 px).
+        np.testing.assert_allclose(a.boxes, b.boxes, atol=1e-9)
