@@ -77,7 +77,7 @@ __all__ = [
 
 SCHEMA = "scenegen/1"
 COMPRESSIONS = ("gzip", "lzf", "none")
-BLOCK_BYTES = 128 * 2**20
+BLOCK_BYTES = 32 * 2**20
 """Upper bound on the pixel bytes (frames + labels) of one block rendered and written at
 once: long or large sequences are written a block at a time in bounded memory."""
 
@@ -479,6 +479,7 @@ def write_scenario(
                     ds[c.start : stop] = c.gt[key]
             if progress is not None:
                 progress(stop)
+            del c  # else this block stays alive while the next one renders: twice the memory
         _write_templates(g, scenario.template_images())
 
 

@@ -20,6 +20,7 @@ MODULES = (
     "scenegen.bench.particle",
     "scenegen.bench.meanshift",
     "scenegen.bench.shm",
+    "scenegen.bench.reliability",
 )
 
 
