@@ -17,6 +17,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from trackers.kernels.sampling import count_distinct
+
 __all__ = ["effective_dynamics", "uniqueness"]
 
 
@@ -42,16 +44,7 @@ def uniqueness(particles: NDArray[np.floating]) -> NDArray[np.float64]:
     [0.25, 0.75]
     """
     p = _check_particles(particles)
-    n, k = p.shape[0], p.shape[1]
-    # One lexicographic sort of all sub-states, object first: equal sub-states of an
-    # object become neighbours, and each object's first row starts a new run.
-    flat = p.transpose(1, 0, 2).reshape(n * k, 3)
-    obj = np.repeat(np.arange(k), n)
-    s = flat[np.lexsort((flat[:, 2], flat[:, 1], flat[:, 0], obj))]
-    new = np.ones(n * k, dtype=bool)
-    new[1:] = np.any(s[1:] != s[:-1], axis=1)
-    new[::n] = True
-    return np.add.reduceat(new, np.arange(0, n * k, n)) / n
+    return count_distinct(p) / p.shape[0]
 
 
 def effective_dynamics(particles: NDArray[np.floating], sigma: NDArray[np.floating]

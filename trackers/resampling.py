@@ -24,10 +24,10 @@ Example
 
 from __future__ import annotations
 
-from collections.abc import Callable
-
 import numpy as np
 from numpy.typing import NDArray
+
+from trackers.kernels.sampling import MULTINOMIAL, STRATIFIED, SYSTEMATIC, inverse_cdf_groups
 
 __all__ = [
     "RESAMPLERS",
@@ -39,27 +39,14 @@ __all__ = [
 ]
 
 
-def _positions_multinomial(counts, rng):
-    return rng.random(counts.sum())
-
-
-def _positions_stratified(counts, rng):
-    n = np.repeat(counts, counts)
-    within = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
-    return (within + rng.random(counts.sum())) / n
-
-
-def _positions_systematic(counts, rng):
-    n = np.repeat(counts, counts)
-    within = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
-    return (within + np.repeat(rng.random(counts.size), counts)) / n
-
-
-_POSITIONS: dict[str, Callable[[NDArray[np.int64], np.random.Generator], NDArray]] = {
-    "multinomial": _positions_multinomial,
-    "stratified": _positions_stratified,
-    "systematic": _positions_systematic,
+# Uniforms per group (systematic) or per draw, and how the kernel turns them into
+# positions of the groups' CDFs.
+_MODES: dict[str, int] = {
+    "multinomial": MULTINOMIAL,
+    "stratified": STRATIFIED,
+    "systematic": SYSTEMATIC,
 }
+
 
 #: Resampler names (``resampler`` parameter of the particle trackers).
 RESAMPLERS: tuple[str, ...] = ("multinomial", "systematic", "stratified", "residual")
@@ -93,16 +80,9 @@ def _normalise_groups(weights, sizes, name):
 
 def _draw(w, counts, sizes, method, rng):
     """Indices into ``w`` (normalised per group): ``counts[c]`` draws inside group c."""
-    starts = group_starts(sizes)
-    group_of_draw = np.repeat(np.arange(sizes.size), counts)
-    # Group c's CDF spans (c, c + 1] of the running sum, so one search serves all groups;
-    # clipping keeps a position that rounding pushed over a boundary in its own group.
-    cdf = np.cumsum(w) + 0.0
-    cdf -= np.repeat(np.cumsum(np.add.reduceat(w, starts)) - np.arange(1, sizes.size + 1),
-                     sizes)
-    pos = _POSITIONS[method](counts, rng) + group_of_draw
-    idx = np.searchsorted(cdf, pos, side="right")
-    return np.clip(idx, starts[group_of_draw], starts[group_of_draw] + sizes[group_of_draw] - 1)
+    mode = _MODES[method]
+    uniforms = rng.random(sizes.size if mode == SYSTEMATIC else int(counts.sum()))
+    return inverse_cdf_groups(w, sizes, counts, uniforms, mode)
 
 
 def resample_groups(

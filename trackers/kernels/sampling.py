@@ -1,0 +1,138 @@
+"""Compiled helpers of the particle filters' bookkeeping (numba).
+
+A DPS step resamples seven times and measures its particle set once; done with a dozen
+small numpy calls each, that bookkeeping cost as much as the likelihoods. Here each is one
+compiled call:
+
+- ``inverse_cdf_groups``: ancestor indices of every group of a weighted set at once, from
+  uniforms drawn by the caller (so randomness stays with the caller's Generator);
+- ``count_distinct``: distinct sub-states per object of a particle set.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+from numpy.typing import NDArray
+
+__all__ = ["MULTINOMIAL", "STRATIFIED", "SYSTEMATIC", "count_distinct", "inverse_cdf_groups"]
+
+#: How ``inverse_cdf_groups`` turns uniforms into positions in [0, 1) of a group's CDF.
+MULTINOMIAL = 0  # one uniform per draw, used as is
+STRATIFIED = 1  # one uniform per draw, in stratum i: (i + u_i) / n
+SYSTEMATIC = 2  # one uniform per group, shared: (i + u) / n
+
+
+@njit(cache=True)
+def _inverse_cdf_groups(weights, sizes, counts, uniforms, mode):
+    n_groups = sizes.shape[0]
+    cdf = np.empty(weights.shape[0])
+    out = np.empty(counts.sum(), dtype=np.int64)
+    start = 0
+    j = 0
+    for g in range(n_groups):
+        stop = start + sizes[g]
+        total = 0.0
+        for i in range(start, stop):
+            total += weights[i]
+        acc = 0.0
+        for i in range(start, stop):
+            acc += weights[i]
+            cdf[i] = acc / total
+        cdf[stop - 1] = 1.0
+        m = counts[g]
+        for i in range(m):
+            if mode == MULTINOMIAL:
+                u = uniforms[j]
+            elif mode == STRATIFIED:
+                u = (i + uniforms[j]) / m
+            else:
+                u = (i + uniforms[g]) / m
+            # First index of the group whose cumulative weight exceeds u.
+            lo = start
+            hi = stop - 1
+            while lo < hi:
+                mid = (lo + hi) // 2
+                if cdf[mid] > u:
+                    hi = mid
+                else:
+                    lo = mid + 1
+            out[j] = lo
+            j += 1
+        start = stop
+    return out
+
+
+def inverse_cdf_groups(
+    weights: NDArray[np.floating],
+    sizes: NDArray[np.integer],
+    counts: NDArray[np.integer],
+    uniforms: NDArray[np.floating],
+    mode: int,
+) -> NDArray[np.int64]:
+    """Inverse-CDF draws inside contiguous groups of a weighted set.
+
+    Parameters
+    ----------
+    weights : ndarray of shape (N,)
+        Non-negative weights with a positive sum in every group (not checked here: the
+        callers in ``trackers.resampling`` validate).
+    sizes : ndarray of shape (C,)
+        Group lengths, summing to N.
+    counts : ndarray of shape (C,)
+        Draws per group.
+    uniforms : ndarray
+        Uniforms in [0, 1): one per draw (``MULTINOMIAL``, ``STRATIFIED``) or one per group
+        (``SYSTEMATIC``).
+    mode : int
+        ``MULTINOMIAL``, ``STRATIFIED`` or ``SYSTEMATIC``.
+
+    Returns
+    -------
+    ndarray of shape (counts.sum(),), int64
+        Indices into ``weights``, group by group; draws of group c lie in group c.
+
+    Example
+    -------
+    >>> inverse_cdf_groups(np.array([1.0, 3.0, 1.0, 1.0]), np.array([2, 2]),
+    ...                    np.array([2, 2]), np.array([0.5, 0.5]), SYSTEMATIC).tolist()
+    [1, 1, 2, 3]
+    """
+    return _inverse_cdf_groups(np.ascontiguousarray(weights, dtype=np.float64),
+                               np.ascontiguousarray(sizes, dtype=np.int64),
+                               np.ascontiguousarray(counts, dtype=np.int64),
+                               np.ascontiguousarray(uniforms, dtype=np.float64), int(mode))
+
+
+@njit(cache=True)
+def _count_distinct(particles):
+    n, k = particles.shape[0], particles.shape[1]
+    out = np.zeros(k, dtype=np.int64)
+    for obj in range(k):
+        u = particles[:, obj, 0].copy()
+        order = np.argsort(u)
+        start = 0
+        while start < n:
+            stop = start + 1
+            while stop < n and u[order[stop]] == u[order[start]]:
+                stop += 1
+            # Inside a run of equal u, count distinct (v, a) by comparing each row with
+            # the earlier rows of the run (runs are copies of one particle in practice).
+            for i in range(start, stop):
+                a = order[i]
+                new = True
+                for j in range(start, i):
+                    b = order[j]
+                    if (particles[a, obj, 1] == particles[b, obj, 1]
+                            and particles[a, obj, 2] == particles[b, obj, 2]):
+                        new = False
+                        break
+                if new:
+                    out[obj] += 1
+            start = stop
+    return out
+
+
+def count_distinct(particles: NDArray[np.floating]) -> NDArray[np.int64]:
+    """Number of distinct rows (u, v, a) per object of particles (N, K, 3), shape (K,)."""
+    return _count_distinct(np.ascontiguousarray(particles, dtype=np.float64))
