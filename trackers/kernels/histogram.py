@@ -251,17 +251,12 @@ _DENSE_BINS = 256
 
 
 @njit(cache=True, fastmath=True)
-def _row_weights(wbuf, ca, cb, cx, inv_hw, dy2, kernel):
-    """Fixed-point kernel weights of pixels ca..cb-1 of one row (vectorised loop)."""
+def _cone_weights(wbuf, ca, cb, cx, inv_hw, dy2):
+    """Fixed-point cone weights 1 − r of pixels ca..cb-1 of one row (vectorised loop)."""
     for c in range(ca, cb):
         dx = (c + 0.5 - cx) * inv_hw
-        r2 = dx * dx + dy2
-        if kernel == KERNEL_EPANECHNIKOV:
-            k = 1.0 - r2
-        else:
-            k = 1.0 - np.sqrt(r2)
-        # r² >= 1 (outside the ellipse) gives k <= 0: weight 0, so it adds nothing.
-        wbuf[c - ca] = np.int64(max(k, 0.0) * _ONE + 0.5)
+        # r >= 1 (outside the ellipse) gives a weight <= 0: clamped to 0, it adds nothing.
+        wbuf[c - ca] = np.int64(max(1.0 - np.sqrt(dx * dx + dy2), 0.0) * _ONE + 0.5)
 
 
 @njit(cache=True)
@@ -287,6 +282,10 @@ def _accumulate(bin_img, x, y, w, h, n_bins, kernel, n_parts, hist, totals, wbuf
     inv_hh = 2.0 / h
     band = h / n_parts
     unit = np.int64(_ONE)
+    if kernel == KERNEL_EPANECHNIKOV:
+        for c in range(c0, c1):
+            dx = (c + 0.5 - cx) * inv_hw
+            wbuf[c - c0] = np.int64(dx * dx * _ONE + 0.5)
     for r in range(r0, r1):
         py = r + 0.5
         part = int((py - y) / band)
@@ -309,13 +308,31 @@ def _accumulate(bin_img, x, y, w, h, n_bins, kernel, n_parts, hist, totals, wbuf
         dy2 = dy * dy
         if dy2 >= 1.0:
             continue
-        # Columns of the ellipse's chord on this row, widened by one pixel so that
+        acc = 0
+        if kernel == KERNEL_EPANECHNIKOV:
+            # Separable: k = (1 − dy²) − dx², in fixed point, clamped to 0 outside the
+            # ellipse; dx² was tabulated once per box.
+            wr = np.int64((1.0 - dy2) * _ONE + 0.5)
+            if shift < 0:
+                for c in range(c0, c1):
+                    k = max(wr - wbuf[c - c0], 0)
+                    hist[offset + row[c]] += k
+                    acc += k
+            else:
+                for c in range(c0, c1):
+                    k = max(wr - wbuf[c - c0], 0)
+                    b = offset + row[c]
+                    hist[b] += k
+                    acc += k
+                    mask |= one << np.uint64(b >> shift)
+            totals[part] += acc
+            continue
+        # Cone: columns of the ellipse's chord on this row, widened by one pixel so that
         # rounding never drops a pixel (those outside get weight 0).
         half = 0.5 * w * np.sqrt(1.0 - dy2)
         ca = max(c0, _first_inside(cx - half) - 1)
         cb = min(c1, _first_inside(cx + half) + 1)
-        _row_weights(wbuf, ca, cb, cx, inv_hw, dy2, kernel)
-        acc = 0
+        _cone_weights(wbuf, ca, cb, cx, inv_hw, dy2)
         if shift < 0:
             for c in range(ca, cb):
                 k = wbuf[c - ca]
