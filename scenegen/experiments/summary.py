@@ -5,6 +5,15 @@ paper's table), ``comparisons`` (every number the paper prints beside ours, with
 they agree) and ``fidelity`` (the paper's qualitative claims, checked on our numbers).
 :func:`render_table` turns it into ``table.md``.
 
+Choices (DPS §3.1 leaves them open): the distracted/occluded object's precision and
+recall are averaged over its tracked frames only (T = 1; the paper's note under Table 2);
+for the other objects (Table 1) over all frames, a lost frame counting 0, so that losing
+an object shows in its precision. Success and recovery follow
+:func:`scenegen.metrics.success_rate` and :func:`scenegen.metrics.recovery_rate` (recovered
+= tracked in the last :data:`scenegen.evaluate.DEFAULT_RECOVER_FRAMES` frames). "PS mean"
+is the mean over the circular-shift orderings of each ordering's figure; "PS worst" the
+ordering with the lowest recovery of the hard object.
+
 Agreement rule (ours): a percentage agrees with the paper's when within
 :data:`AGREE_POINTS` percentage points; a pixel error when within :data:`AGREE_PX` pixels or
 25 %; a z score when both are on the same side of the 99.5 % one-sided limit (2.58).
