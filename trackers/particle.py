@@ -72,9 +72,11 @@ def _normalised_weights(logw: NDArray[np.float64]) -> NDArray[np.float64]:
     return w / w.sum()
 
 
-def _log_sum_exp(x: NDArray[np.float64]) -> float:
-    m = x.max()
-    return float(m + np.log(np.exp(x - m).sum()))
+def _group_log_sum_exp(x: NDArray[np.float64], starts: NDArray[np.int64],
+                       sizes: NDArray[np.int64]) -> NDArray[np.float64]:
+    """log Σ exp(x) over each contiguous group, shape (C,), without overflow."""
+    m = np.maximum.reduceat(x, starts)
+    return m + np.log(np.add.reduceat(np.exp(x - np.repeat(m, sizes)), starts))
 
 
 class _ParticleTracker(Tracker):
@@ -260,7 +262,7 @@ class _Partitioned(_ParticleTracker):
         # The set {x, π'} still represents the predicted joint state (weighted resampling
         # preserves it), so π' Π_i p(Z | X_i) are the unnormalised posterior weights w̃.
         logw = logpi + ll.sum(axis=1)
-        weights, mixture = self._reassemble(logw, sizes)
+        weights, mixture = self._reassemble(logw, logpi, sizes)
         self.particles = x
         self._prev = prev
         self.weights = weights
@@ -268,23 +270,24 @@ class _Partitioned(_ParticleTracker):
         return est, mixture
 
     @staticmethod
-    def _reassemble(logw: NDArray[np.float64], sizes: NDArray[np.int64]
-                    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    def _reassemble(logw: NDArray[np.float64], logpi: NDArray[np.float64],
+                    sizes: NDArray[np.int64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Mixture reassembly (§3.4, after Vermaak, Doucet & Pérez 2003).
 
-        π_c,t ∝ π_c,t−1 Σ_{n∈c} w̃_n, and particle n of group c gets π_c,t w̃_n / Σ_c w̃.
-        The groups are drawn afresh from an equally weighted (resampled) set, so a group
-        of N_c particles starts with π_c,t−1 = N_c / N. With one group this is plain
-        normalisation. Returns the weights (N,) and the mixture weights (C,).
+        π_c,t ∝ π_c,t−1 Σ_{n∈c} w̃_n, and particle n of group c gets π_c,t w̃_n / Σ_c w̃,
+        with w̃_n = π'_n Π_i p(Z | X_i) (log ``logw``) and π' the group's proposal weights
+        (log ``logpi``) normalised in the group, so that Σ_c w̃ estimates the group's
+        evidence. The groups are drawn afresh from an equally weighted (resampled) set, so
+        a group of N_c particles starts with π_c,t−1 = N_c / N. With one group this is
+        plain normalisation. Returns the weights (N,) and the mixture weights (C,).
         """
         if sizes.size == 1:
             return _normalised_weights(logw), np.ones(1)
         starts = np.cumsum(sizes) - sizes
-        log_evidence = np.array([_log_sum_exp(logw[s:s + c]) for s, c in zip(starts, sizes,
-                                                                            strict=True)])
-        log_mix = np.log(sizes / sizes.sum()) + log_evidence
-        mixture = _normalised_weights(log_mix)
-        logw_final = logw + np.repeat(np.log(mixture) - log_evidence, sizes)
+        log_total = _group_log_sum_exp(logw, starts, sizes)
+        log_evidence = log_total - _group_log_sum_exp(logpi, starts, sizes)
+        mixture = _normalised_weights(np.log(sizes / sizes.sum()) + log_evidence)
+        logw_final = logw + np.repeat(np.log(mixture) - log_total, sizes)
         return _normalised_weights(logw_final), mixture
 
 

@@ -196,3 +196,21 @@ def test_interleaved_assignment_tracks():
     for (box, _, _, extras), truth in zip(runs, boxes[1:], strict=True):
         np.testing.assert_allclose(extras["mixture_weights"].sum(), 1.0)
         assert np.all(_iou(box, truth) > 0.5)
+
+
+def test_mixture_reassembly_weights_groups_by_size_and_evidence():
+    """§3.4: π_c ∝ (N_c / N) Σ_{n∈c} w̃_n, with w̃ relative to normalised π' in the group."""
+    sizes = np.array([3, 2])
+    logpi = np.log(np.array([1.0, 1.0, 2.0, 5.0, 5.0]))  # unnormalised π' per group
+    lik = np.array([0.5, 1.0, 2.0, 3.0, 1.0])
+    weights, mixture = DistributedPartitionedSampling._reassemble(logpi + np.log(lik), logpi,
+                                                                   sizes)
+    pi = np.exp(logpi)
+    ev = np.array([np.sum(pi[:3] * lik[:3]) / pi[:3].sum(),
+                   np.sum(pi[3:] * lik[3:]) / pi[3:].sum()])
+    expected_mix = sizes / 5 * ev / np.sum(sizes / 5 * ev)
+    np.testing.assert_allclose(mixture, expected_mix)
+    w = pi * lik
+    expected = np.concatenate([expected_mix[0] * w[:3] / w[:3].sum(),
+                               expected_mix[1] * w[3:] / w[3:].sum()])
+    np.testing.assert_allclose(weights, expected)
