@@ -215,3 +215,22 @@ def test_cli_exit_codes_for_bad_input(tmp_path, capsys):
     assert main(["experiment", NAME, "--method", "x", "-o", str(tmp_path)]) == 2
     assert "valid methods: nonps, ps-1234567" in capsys.readouterr().err
     assert main(["experiment", NAME, "--jobs", "0", "-o", str(tmp_path)]) == 2
+
+
+@pytest.mark.parametrize(
+    ("name", "methods", "figures"),
+    [
+        ("dps-occlusion", ["dps"], ["success_recovery.png", "uniqueness.png"]),
+        ("kams-accuracy", ["sok"], ["centre_error.png"]),
+        ("kams-robustness", ["kams", "meanshift"], ["robustness_z.png"]),
+        ("shm-depth", ["kalman", "shm-fast"], ["ordering_probability.png"]),
+    ],
+)
+def test_every_experiment_end_to_end_in_quick_mode(tmp_path, name, methods, figures):
+    res = run_experiment(name, tmp_path, runs=1 if name != "kams-robustness" else 2,
+                         quick=True, methods=methods, jobs=1, progress=False)
+    assert res["experiment"] == name and res["summary"]
+    table = (tmp_path / "table.md").read_text()
+    assert table.startswith(f"# {name}:") and "## Fidelity" in table
+    for f in figures:
+        assert (tmp_path / f).stat().st_size > 1000, f
