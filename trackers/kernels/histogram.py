@@ -24,6 +24,9 @@ Conventions shared by every function here (CONTRACT.md "Coordinates"):
 - A band with no pixel of positive weight (box outside the frame, or smaller than a pixel)
   gets the uniform histogram 1 / n_bins: it carries no colour information, so it is
   neither attracted to nor repelled from any reference.
+- Weights are summed in 32.32 fixed point (each pixel's weight rounded to 2**-32), so a
+  histogram is exact to about 1e-9 of its band's total weight, and the same pixels give
+  bit-identical sums in any order.
 """
 
 from __future__ import annotations
@@ -560,7 +563,7 @@ def region_distances(
     >>> img = np.array([[0, 1], [1, 1]], dtype=np.int32)
     >>> d = region_distances(img, np.array([[0.0, 0.0, 2.0, 2.0]]),
     ...                      np.array([[0.25, 0.75]]), np.array([0]), KERNEL_UNIFORM)
-    >>> np.round(d, 12).tolist()
+    >>> np.round(d, 6).tolist()
     [0.0]
     """
     q = np.ascontiguousarray(refs, dtype=np.float64)
@@ -627,7 +630,7 @@ def bhattacharyya_distance(
     Example
     -------
     >>> bhattacharyya_distance(np.array([[0.5, 0.5], [1.0, 0.0]]), np.array([0.5, 0.5]))
-    array([0.        , 0.54119610])
+    array([0.       , 0.5411961])
     """
     rho = bhattacharyya_coefficient(hists, refs)
     return np.sqrt(np.maximum(0.0, 1.0 - rho))
