@@ -58,9 +58,15 @@ def group_starts(sizes: NDArray[np.integer]) -> NDArray[np.int64]:
     return np.cumsum(sizes) - sizes
 
 
+def _finite_non_negative(x):
+    # One sum and one min instead of elementwise masks: a NaN or an infinity makes the
+    # sum non-finite (inf − inf is NaN), a negative entry the minimum negative.
+    return bool(np.isfinite(x.sum())) and x.min() >= 0
+
+
 def _check_sizes(sizes, n):
     sizes = np.asarray([n] if sizes is None else sizes, dtype=np.int64)
-    if sizes.ndim != 1 or sizes.size < 1 or np.any(sizes < 1) or sizes.sum() != n:
+    if sizes.ndim != 1 or sizes.size < 1 or sizes.min() < 1 or sizes.sum() != n:
         raise ValueError(f"group sizes must be positive and sum to {n}, got {sizes.tolist()}")
     return sizes
 
@@ -69,10 +75,10 @@ def _normalise_groups(weights, sizes, name):
     w = np.asarray(weights, dtype=np.float64)
     if w.ndim != 1 or w.size < 1:
         raise ValueError(f"{name} must have shape (N,) with N >= 1, got {w.shape}")
-    if not np.all(np.isfinite(w)) or np.any(w < 0):
+    if not _finite_non_negative(w):
         raise ValueError(f"{name} must be finite and non-negative")
     totals = np.add.reduceat(w, group_starts(sizes))
-    if np.any(totals <= 0):
+    if totals.min() <= 0:
         raise ValueError(f"{name} must have a positive sum in every group, got sums "
                          f"{totals.tolist()}")
     return w / np.repeat(totals, sizes)
@@ -219,7 +225,7 @@ def weighted_resample_groups(
     gv = np.asarray(g, dtype=np.float64)
     if gv.shape != w.shape:
         raise ValueError(f"g must have the shape of weights {w.shape}, got {gv.shape}")
-    if not np.all(np.isfinite(gv)) or np.any(gv < 0):
+    if gv.size and not _finite_non_negative(gv):
         raise ValueError("g must be finite and non-negative")
     sizes = _check_sizes(sizes, w.shape[0] if w.ndim == 1 else -1)
     pi = _normalise_groups(w, sizes, "weights")

@@ -462,7 +462,8 @@ def _check_region_args(bin_img, boxes, n_bins, kernel, n_parts, check_bins=True)
     bx = np.ascontiguousarray(boxes, dtype=np.float64)
     if bx.ndim != 2 or bx.shape[1] != 4:
         raise ValueError(f"boxes must have shape (P, 4), got {bx.shape}")
-    if bx.size and not (np.all(np.isfinite(bx)) and np.all(bx[:, 2:] > 0)):
+    # A NaN or an infinity makes the sum non-finite.
+    if bx.size and not (np.isfinite(bx.sum()) and bx[:, 2:].min() > 0):
         raise ValueError("boxes must be finite with positive width and height")
     return img.astype(np.int32, copy=False), bx, int(n_bins), int(kernel), int(n_parts)
 
