@@ -190,6 +190,8 @@ def _shift(bin_img, cx, cy, w, h, q, hist, total, touched, n_touched, weight):
     ey = y + 0.5 * h
     inv_hw = 2.0 / w
     inv_hh = 2.0 / h
+    # Offsets from the centre rather than absolute positions: a scene shifted by whole
+    # pixels gives the same sums, so exact ties stay exact (no 64.50000000000001).
     sx = 0.0
     sy = 0.0
     sw = 0.0
@@ -211,14 +213,14 @@ def _shift(bin_img, cx, cy, w, h, q, hist, total, touched, n_touched, weight):
             if hist[b] <= 0.0:
                 continue
             wi = weight[b]
-            row_x += wi * px
+            row_x += wi * (px - cx)
             row_w += wi
         sx += row_x
-        sy += row_w * py
+        sy += row_w * (py - cy)
         sw += row_w
     if sw <= 0.0:
         return cx, cy, 0.0
-    return sx / sw, sy / sw, sw
+    return cx + sx / sw, cy + sy / sw, sw
 
 
 @njit(cache=True)
