@@ -55,6 +55,7 @@ from scenegen.sequence import GT_FIELDS, Entities, GroundTruth, Sequence
 __all__ = [
     "BLOCK_BYTES",
     "COMPRESSIONS",
+    "LIBVER",
     "SCHEMA",
     "LazyArray",
     "TrackerResult",
@@ -62,6 +63,7 @@ __all__ = [
     "clean_temp_files",
     "describe_open_error",
     "describe_read_error",
+    "describe_temp_file",
     "filter_options",
     "frames_per_block",
     "open_checked",
@@ -81,6 +83,14 @@ BLOCK_BYTES = 32 * 2**20
 """Upper bound on the pixel bytes (frames + labels) of one block rendered and written at
 once: long or large sequences are written a block at a time in bounded memory."""
 
+LIBVER = ("v110", "v110")
+"""HDF5 file-format bounds of written files: readable by HDF5 1.10 and later (2016), and
+their chunk index (a fixed array) stays small whatever the frame count, so writing
+20,000 frames does not grow memory the way the 1.8 format's B-tree index does."""
+
+# Writers write whole chunks once and never read them back, so the chunk cache (8 MiB per
+# dataset by default in HDF5 2) would only hold memory: it is switched off.
+_WRITE_OPTIONS: dict[str, Any] = {"libver": LIBVER, "rdcc_nbytes": 0}
 _STR = h5py.string_dtype("utf-8")
 _BLOCK = 64  # frames per write call, at most
 _TEMP_NAME = re.compile(r"^\.(?P<target>.+)\.(?P<kind>tmp|old)-(?P<pid>\d+)@(?P<host>[\w.]*)-")
@@ -415,7 +425,7 @@ def write(path: str | Path, *sequences: Sequence, compression: str = "gzip") -> 
     if not sequences:
         raise ConfigError("write needs at least one sequence")
     filter_options(compression)
-    with atomic_path(path) as tmp, h5py.File(tmp, "w") as f:
+    with atomic_path(path) as tmp, h5py.File(tmp, "w", **_WRITE_OPTIONS) as f:
         _write_header(f)
         for seq in sequences:
             g, frames, labels = _create_sequence_group(f, _meta(seq), seq.entities, compression)
@@ -465,7 +475,7 @@ def write_scenario(
     }
     filter_options(compression)
     block = frames_per_block(cfg.height, cfg.width, max(1, int(chunk)))
-    with atomic_path(path) as tmp, h5py.File(tmp, "w") as f:
+    with atomic_path(path) as tmp, h5py.File(tmp, "w", **_WRITE_OPTIONS) as f:
         _write_header(f)
         g, frames, labels = _create_sequence_group(f, meta, scenario.entities(), compression)
         gt = _create_gt(g, cfg.n_frames, scenario.n_entities, block)
@@ -487,6 +497,29 @@ def write_scenario(
 # Reading
 
 
+def describe_temp_file(path: str | Path) -> str | None:
+    """One line saying that ``path`` is a temporary file of an atomic write, or None.
+
+    Parameters
+    ----------
+    path : str or Path
+
+    Returns
+    -------
+    str or None
+        ``"PATH: an unfinished temporary file of a write to 'NAME' (process PID on HOST,
+        running)"`` (or ``no longer running``; the state is only known on this host).
+    """
+    owner = temp_file_owner(path)
+    if owner is None:
+        return None
+    target, pid, host = owner
+    where = f"process {pid} on {host or '?'}"
+    if host == _host():
+        where += ", running" if _running(pid) else ", no longer running"
+    return f"{path}: an unfinished temporary file of a write to {target!r} ({where})"
+
+
 def describe_open_error(path: str | Path, err: OSError) -> str:
     """One line saying why HDF5 could not open ``path``.
 
@@ -504,13 +537,9 @@ def describe_open_error(path: str | Path, err: OSError) -> str:
     """
     p = Path(path)
     text = str(err)
-    owner = temp_file_owner(p)
-    if owner is not None:
-        state = "running" if owner[2] == _host() and _running(owner[1]) else "gone"
-        return (
-            f"{p}: an unfinished temporary file of a write to {owner[0]!r} "
-            f"(process {owner[1]} on {owner[2] or '?'}, {state})"
-        )
+    temp = describe_temp_file(p)
+    if temp is not None:
+        return temp
     if "unable to lock file" in text:
         return f"{p}: is being written by another process (the HDF5 file is locked)"
     m = re.search(r"truncated file: eof = (\d+).*stored_eof = (\d+)", text)
@@ -656,14 +685,17 @@ def open_checked(path: str | Path) -> h5py.File:
     Raises
     ------
     DataError
-        If the file is missing, a folder, not HDF5, truncated, being written by another
-        process, or of another schema.
+        If the file is missing, a folder, a temporary file of an unfinished write, not
+        HDF5, truncated, being written by another process, or of another schema.
     """
     p = Path(path)
     if not p.exists():
         raise DataError(f"{p}: no such file")
     if p.is_dir():
         raise DataError(f"{p}: is a folder, not a scenegen file")
+    temp = describe_temp_file(p)
+    if temp is not None:  # incomplete by construction, even when HDF5 could open it
+        raise DataError(temp)
     try:
         f = h5py.File(p, "r")
     except OSError as err:
@@ -810,7 +842,7 @@ def write_result(path: str | Path, *results: TrackerResult) -> None:
     """
     if not results:
         raise ConfigError("write_result needs at least one result")
-    with atomic_path(path) as tmp, h5py.File(tmp, "w") as f:
+    with atomic_path(path) as tmp, h5py.File(tmp, "w", **_WRITE_OPTIONS) as f:
         _write_header(f)
         root = f.create_group("results")
         for r in results:

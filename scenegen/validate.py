@@ -33,7 +33,7 @@ from scipy import ndimage
 
 from scenegen.config import from_dict
 from scenegen.errors import ConfigError
-from scenegen.io import SCHEMA, describe_open_error, describe_read_error, temp_file_owner
+from scenegen.io import SCHEMA, describe_open_error, describe_read_error, describe_temp_file
 from scenegen.sequence import GT_FIELDS
 
 __all__ = ["check_file"]
@@ -76,12 +76,9 @@ def check_file(path: str | Path, *, check_pixels: bool = True, isolate: bool = F
         return [f"{p}: no such file"]
     if p.is_dir():
         return [f"{p}: is a folder, not a scenegen file"]
-    owner = temp_file_owner(p)
-    if owner is not None:
-        return [
-            f"{p}: an unfinished temporary file of a write to {owner[0]!r} "
-            f"(process {owner[1]} on {owner[2] or '?'}); not a result"
-        ]
+    temp = describe_temp_file(p)
+    if temp is not None:
+        return [temp]
     try:
         f = h5py.File(p, "r")
     except OSError as err:

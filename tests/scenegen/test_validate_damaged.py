@@ -317,8 +317,7 @@ def test_not_hdf5_folder_and_temp_file(copy, tmp_path):
     tmp = tmp_path / ".small.h5.tmp-4242@somehost-abc123"
     shutil.copy(copy(), tmp)
     assert check_file(tmp) == [
-        f"{tmp}: an unfinished temporary file of a write to 'small.h5' "
-        "(process 4242 on somehost); not a result"
+        f"{tmp}: an unfinished temporary file of a write to 'small.h5' (process 4242 on somehost)"
     ]
 
 
