@@ -2,6 +2,8 @@
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import trackers
 from trackers.annealed import survival_beta, survival_rate, weighted_estimate
@@ -128,3 +130,26 @@ def test_mode_estimate_is_the_mean_when_the_set_is_one_mode(scenegen_sequence):
         a, b = mean.step(frame), mode.step(frame)
         # σ = 2 px keeps every particle well within the mode radius (15 px).
         np.testing.assert_allclose(a.boxes, b.boxes, atol=1e-9)
+
+
+@settings(max_examples=10, deadline=None)
+@given(
+    n_layers=st.integers(1, 4),
+    schedule=st.sampled_from(["adaptive", "geometric"]),
+    alpha=st.floats(0.1, 0.9),
+    beta_ratio=st.floats(0.05, 1.0),
+    lam=st.sampled_from([20.0, 1000.0]),
+    seed=st.integers(0, 2**32 - 1),
+)
+def test_layers_keep_valid_betas_weights_and_particles(scenegen_sequence, n_layers, schedule,
+                                                       alpha, beta_ratio, lam, seed):
+    frames, boxes = first_frames_and_boxes(scenegen_sequence, n_frames=4)
+    tracker = trackers.make("annealed", n_particles=20, n_layers=n_layers, schedule=schedule,
+                            alpha=alpha, beta_ratio=beta_ratio, lam=lam, rng=seed)
+    result = trackers.track(tracker, frames, boxes)
+    beta = result.extras["beta"][1:]
+    assert beta.shape == (3, 2, n_layers)
+    assert np.all((beta > 0) & (beta <= 1)) and np.all(beta[..., -1] == 1.0)
+    np.testing.assert_allclose(tracker.weights.sum(axis=1), 1.0, atol=1e-12)
+    h, w = frames.shape[1:3]
+    assert np.all((tracker.particles >= 0) & (tracker.particles <= [w, h]))
