@@ -42,7 +42,9 @@ class HybridPF(Tracker):
     sigma : float, optional
         Position noise added after the constant-velocity prediction, in pixels (>= 0).
     max_iter : int, optional
-        Mean-shift iterations per particle and frame.
+        Mean-shift iterations per particle and frame. The defaults (8 px, 10 iterations)
+        are measured on kams-a, seeds 0–9, λ = 1000: 9/10 runs tracked to the end; 7/10
+        with 5 iterations, 4/10 with 4 px.
     eps : float, optional
         Mean-shift stopping shift, in pixels.
     resampler : str, optional
