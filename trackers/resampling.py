@@ -71,12 +71,18 @@ def _check_sizes(sizes, n):
     return sizes
 
 
-def _normalise_groups(weights, sizes, name):
+def _checked_weights(weights, name):
+    """``weights`` as float64 (N,), checked finite and non-negative."""
     w = np.asarray(weights, dtype=np.float64)
     if w.ndim != 1 or w.size < 1:
         raise ValueError(f"{name} must have shape (N,) with N >= 1, got {w.shape}")
     if not _finite_non_negative(w):
         raise ValueError(f"{name} must be finite and non-negative")
+    return w
+
+
+def _normalise_groups(weights, sizes, name):
+    w = _checked_weights(weights, name)
     totals = np.add.reduceat(w, group_starts(sizes))
     if totals.min() <= 0:
         raise ValueError(f"{name} must have a positive sum in every group, got sums "
@@ -228,11 +234,16 @@ def weighted_resample_groups(
     if gv.size and not _finite_non_negative(gv):
         raise ValueError("g must be finite and non-negative")
     sizes = _check_sizes(sizes, w.shape[0] if w.ndim == 1 else -1)
-    pi = _normalise_groups(w, sizes, "weights")
-    rho = _normalise_groups(pi * gv, sizes, "weights * g")
-    idx = _resample_normalised(rho, sizes, method, rng)
-    # rho[idx] > 0: an index of zero probability is never drawn.
-    new = pi[idx] / rho[idx]
+    # ρ ∝ π g per group; the new weight π_k / ρ_k = (Σ_c π g) / g_k is 1 / g_k up to the
+    # group's constant, which the final normalisation removes. Drawn ancestors have
+    # ρ_k > 0, hence g_k > 0.
+    rho = _checked_weights(w, "weights") * gv
+    totals = np.add.reduceat(rho, group_starts(sizes))
+    if not totals.min() > 0:
+        raise ValueError(f"weights * g must have a positive sum in every group, got sums "
+                         f"{totals.tolist()}")
+    idx = _resample_normalised(rho / np.repeat(totals, sizes), sizes, method, rng)
+    new = 1.0 / gv[idx]
     return idx, new / np.repeat(np.add.reduceat(new, group_starts(sizes)), sizes)
 
 
