@@ -157,20 +157,28 @@ def _check_fits(min_size: int, margin: float, width: int, height: int, what: str
 # in failure reports, round-trip through JSON and shrink to round values.
 
 
-def _hundredths(lo: float, hi: float) -> SearchStrategy[float]:
-    """Floats in [lo, hi] on a 0.01 grid; shrinks towards the value nearest 0."""
-    return st.integers(math.ceil(lo * 100), math.floor(hi * 100)).map(lambda i: i / 100)
+# The internal helpers take ``draw`` and are plain functions, not strategies: building
+# strategies inside a draw costs more than the draw itself (every draw of a scene would
+# validate dozens of new strategy objects).
 
 
-def _appearances(width: SearchStrategy[int], height: SearchStrategy[int]) -> Any:
-    return st.builds(
-        Appearance,
-        shape=st.sampled_from(_SHAPES),
-        size=st.tuples(width, height),
-        pattern=st.sampled_from(_PATTERNS),
-        colors=st.lists(st.sampled_from(_COLORS), min_size=1, max_size=4).map(tuple),
-        stripe_width=st.integers(1, 6),
-        texture_sigma=_hundredths(0, 40),
+def _hundredths(draw: Any, lo: float, hi: float) -> float:
+    """A float in [lo, hi] on a 0.01 grid; shrinks towards the value nearest 0."""
+    return draw(st.integers(math.ceil(lo * 100), math.floor(hi * 100))) / 100
+
+
+def _draw_appearance(draw: Any, sizes_w: tuple[int, int], sizes_h: tuple[int, int]) -> Appearance:
+    shape = draw(st.sampled_from(_SHAPES))
+    size = (draw(st.integers(*sizes_w)), draw(st.integers(*sizes_h)))
+    pattern = draw(st.sampled_from(_PATTERNS))
+    colors = tuple(draw(st.lists(st.sampled_from(_COLORS), min_size=1, max_size=4)))
+    return Appearance(
+        shape=shape,
+        size=size,
+        pattern=pattern,
+        colors=colors,
+        stripe_width=draw(st.integers(1, 6)),
+        texture_sigma=_hundredths(draw, 0, 40),
     )
 
 
@@ -209,12 +217,14 @@ def ar2_params(
     return _ar2_params(bounds, sig, m)
 
 
-@st.composite
-def _ar2_params(draw: Any, boundaries: tuple[str, ...], max_sigma: float, margin: float) -> AR2:
+def _draw_ar2(draw: Any, boundaries: tuple[str, ...], max_sigma: float, margin: float) -> AR2:
     boundary = draw(st.sampled_from(boundaries))
-    d = draw(_hundredths(0, 1))
-    sigma = draw(_hundredths(0, max_sigma))
+    d = _hundredths(draw, 0, 1)
+    sigma = _hundredths(draw, 0, max_sigma)
     return AR2(boundary=boundary, a1=1.0 + d, a2=-d, sigma=sigma, margin=margin)
+
+
+_ar2_params = st.composite(_draw_ar2)
 
 
 # --------------------------------------------------------------------------------------
@@ -288,19 +298,16 @@ def entity_specs(
     m = _check_margin(margin, BOUNDARIES if ex else ())
     nz = _check_bool("noise", noise)
     _check_fits(lo, m, w, h, "canvas")
-    return _entity_specs(
-        w, h, t, name, st.sampled_from(role_choices), lo, hi, speed, sig, m, nz, ex, True
-    )
+    return _entity_specs(w, h, t, name, role_choices, lo, hi, speed, sig, m, nz, ex, True)
 
 
-@st.composite
-def _entity_specs(
+def _draw_entity(
     draw: Any,
     width: int,
     height: int,
     n_frames: int,
     name: str,
-    roles: SearchStrategy[str],
+    roles: tuple[str, ...],
     min_size: int,
     max_size: int,
     max_speed: float,
@@ -310,40 +317,33 @@ def _entity_specs(
     exits: bool,
     may_start_outside: bool,
 ) -> EntitySpec:
-    role = draw(roles)
+    role = draw(st.sampled_from(roles))
     span_w = max(1, min(max_size, int(width - 2 * margin)))
     span_h = max(1, min(max_size, int(height - 2 * margin)))
-    app = draw(
-        _appearances(
-            st.integers(min(min_size, span_w), span_w), st.integers(min(min_size, span_h), span_h)
-        )
-    )
+    app = _draw_appearance(draw, (min(min_size, span_w), span_w), (min(min_size, span_h), span_h))
     ew, eh = app.size
     # The centre starts inside the allowed area; with exits it may start half outside.
     slack_x = ew / 2 if exits and may_start_outside else 0.0
     slack_y = eh / 2 if exits and may_start_outside else 0.0
-    x = draw(_hundredths(margin + ew / 2 - slack_x, width - margin - ew / 2 + slack_x))
-    y = draw(_hundredths(margin + eh / 2 - slack_y, height - margin - eh / 2 + slack_y))
+    x = _hundredths(draw, margin + ew / 2 - slack_x, width - margin - ew / 2 + slack_x)
+    y = _hundredths(draw, margin + eh / 2 - slack_y, height - margin - eh / 2 + slack_y)
     boundaries = BOUNDARIES if exits else BOUNDARIES[:2]
-    axis = ar2_params(boundaries=boundaries, max_sigma=max_sigma, margin=margin)
-    motion = draw(
-        st.one_of(
-            st.none(),
-            st.builds(
-                Motion,
-                x=axis,
-                y=axis,
-                velocity=st.tuples(
-                    _hundredths(-max_speed, max_speed), _hundredths(-max_speed, max_speed)
-                ),
+    motion = None
+    if draw(st.booleans()):  # shrinks to a static entity
+        motion = Motion(
+            x=_draw_ar2(draw, boundaries, max_sigma, margin),
+            y=_draw_ar2(draw, boundaries, max_sigma, margin),
+            velocity=(
+                _hundredths(draw, -max_speed, max_speed),
+                _hundredths(draw, -max_speed, max_speed),
             ),
         )
-    )
-    position_noise = draw(_hundredths(0, _MAX_POSITION_NOISE)) if noise else 0.0
+    position_noise = _hundredths(draw, 0, _MAX_POSITION_NOISE) if noise else 0.0
     appear, disappear = 0, None
     if exits:
         appear = draw(st.integers(0, n_frames - 1))
-        disappear = draw(st.one_of(st.none(), st.integers(appear + 1, n_frames)))
+        if draw(st.booleans()):
+            disappear = draw(st.integers(appear + 1, n_frames))
     return EntitySpec(
         name=name,
         role=role,
@@ -354,6 +354,9 @@ def _entity_specs(
         appear=appear,
         disappear=disappear,
     )
+
+
+_entity_specs = st.composite(_draw_entity)
 
 
 # --------------------------------------------------------------------------------------
@@ -383,7 +386,8 @@ def scene_configs(
 ) -> SearchStrategy[SceneConfig]:
     """Whole scenes: canvas, background, entities (targets first), clutter, noise.
 
-    The first entity is always a target present at frame 0 (trackers start from it). The
+    The first entity is always a target present at frame 0, without position noise
+    (trackers start from it). The
     others are targets unless a switch allows another role. Entities get distinct constant
     depths; occluders lie in front of everything, clutter behind. A switch allows a
     feature — examples with and without it are drawn, and failures shrink to scenes without
@@ -460,8 +464,7 @@ def scene_configs(
     return _scene_configs((w0, w1), (h0, h1), (t0, t1), (e0, e1), (s0, s1), speed, sig, m, switches)
 
 
-@st.composite
-def _occluders(
+def _draw_occluder(
     draw: Any, name: str, over: EntitySpec, cfg: tuple[int, int, int], margin: float
 ) -> EntitySpec:
     width, height, n_frames = cfg
@@ -471,8 +474,8 @@ def _occluders(
     ow = max(1, min(tw + 2 * pad, int(width - 2 * margin)))
     oh = max(1, min(th + 2 * pad, int(height - 2 * margin)))
     ox, oy = cast(tuple[float, float], over.position)  # targets always have a position
-    dx = draw(_hundredths(-ow / 2, ow / 2))
-    dy = draw(_hundredths(-oh / 2, oh / 2))
+    dx = _hundredths(draw, -ow / 2, ow / 2)
+    dy = _hundredths(draw, -oh / 2, oh / 2)
     x = min(max(ox + dx, margin + ow / 2), width - margin - ow / 2)
     y = min(max(oy + dy, margin + oh / 2), height - margin - oh / 2)
     return EntitySpec(
@@ -488,8 +491,7 @@ def _occluders(
     )
 
 
-@st.composite
-def _distractors(
+def _draw_distractor(
     draw: Any,
     name: str,
     targets: list[EntitySpec],
@@ -502,39 +504,36 @@ def _distractors(
     model = draw(st.sampled_from(targets))
     mw, mh = model.appearance.size
     boundaries = BOUNDARIES if exits else BOUNDARIES[:2]
-    axis = ar2_params(boundaries=boundaries, max_sigma=max_sigma, margin=margin)
     return EntitySpec(
         name=name,
         role="distractor",
         mimic=model.name,
-        mimic_offset=(draw(_hundredths(-mw, mw)), draw(_hundredths(-mh, mh))),
-        color_jitter=draw(_hundredths(0, 10)),
+        mimic_offset=(_hundredths(draw, -mw, mw), _hundredths(draw, -mh, mh)),
+        color_jitter=_hundredths(draw, 0, 10),
         motion=Motion(
-            x=draw(axis),
-            y=draw(axis),
+            x=_draw_ar2(draw, boundaries, max_sigma, margin),
+            y=_draw_ar2(draw, boundaries, max_sigma, margin),
             velocity=(
-                draw(_hundredths(-max_speed, max_speed)),
-                draw(_hundredths(-max_speed, max_speed)),
+                _hundredths(draw, -max_speed, max_speed),
+                _hundredths(draw, -max_speed, max_speed),
             ),
         ),
         appear=draw(st.integers(0, n_frames - 1)),
     )
 
 
-@st.composite
-def _backgrounds(draw: Any, noise: bool) -> Background:
+def _draw_background(draw: Any, noise: bool) -> Background:
     kind = draw(st.sampled_from(("uniform", "noise", "texture"))) if noise else "uniform"
     color = draw(st.sampled_from(_BACKGROUND_COLORS))
     if kind == "uniform":
         return Background(kind="uniform", color=color)
     low = draw(st.integers(0, 255))
     high = draw(st.integers(low, 255))
-    scale = draw(_hundredths(0.5, 8))
+    scale = _hundredths(draw, 0.5, 8)
     return Background(kind=kind, color=color, low=low, high=high, scale=scale)
 
 
-@st.composite
-def _clutter(draw: Any, width: int, height: int, min_size: int, margin: float) -> ClutterSpec:
+def _draw_clutter(draw: Any, width: int, height: int, min_size: int, margin: float) -> ClutterSpec:
     side = max(min_size, min(width, height) // 4)
     size = draw(st.integers(min_size, side))
     region = None
@@ -586,22 +585,21 @@ def _scene_configs(
         counts[role] += 1
         name = f"{role}{counts[role]}"
         if role == "target":
-            spec = draw(
-                _entity_specs(
-                    width, height, n_frames, name, st.just("target"), sizes[0], sizes[1],
-                    max_speed, max_sigma, margin, noise, exits, i > 0,
-                )
+            spec = _draw_entity(
+                draw, width, height, n_frames, name, ("target",), sizes[0], sizes[1],
+                max_speed, max_sigma, margin, noise, exits, i > 0,
             )  # fmt: skip
             if i == 0:
-                spec = replace(spec, appear=0, disappear=None)
+                # Trackers start from it: present at frame 0 whatever the noise draws.
+                spec = replace(spec, appear=0, disappear=None, position_noise=0.0)
             targets.append(spec)
         elif role == "distractor":
             others.append(
-                draw(_distractors(name, targets, n_frames, max_speed, max_sigma, margin, exits))
+                _draw_distractor(draw, name, targets, n_frames, max_speed, max_sigma, margin, exits)
             )
         else:
             over = draw(st.sampled_from(targets))
-            others.append(draw(_occluders(name, over, (width, height, n_frames), margin)))
+            others.append(_draw_occluder(draw, name, over, (width, height, n_frames), margin))
     # Distinct depths: occluders in front, the rest in a drawn order (shrinks to id order).
     front = [e for e in others if e.role == "occluder"]
     rest = targets + [e for e in others if e.role != "occluder"]
@@ -613,13 +611,13 @@ def _scene_configs(
     ordered = tuple(by_name[e.name] for e in targets + others)
     clutter = ()
     if switches["clutter"] and draw(st.booleans()):
-        clutter = (draw(_clutter(width, height, sizes[0], margin)),)
-    sensor_noise = draw(_hundredths(0, _MAX_SENSOR_NOISE)) if noise else 0.0
+        clutter = (_draw_clutter(draw, width, height, sizes[0], margin),)
+    sensor_noise = _hundredths(draw, 0, _MAX_SENSOR_NOISE) if noise else 0.0
     return SceneConfig(
         width=width,
         height=height,
         n_frames=n_frames,
-        background=draw(_backgrounds(noise)),
+        background=_draw_background(draw, noise),
         entities=ordered,
         clutter=clutter,
         sensor_noise=sensor_noise,
