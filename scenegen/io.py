@@ -93,6 +93,7 @@ their chunk index (a fixed array) stays small whatever the frame count, so writi
 _WRITE_OPTIONS: dict[str, Any] = {"libver": LIBVER, "rdcc_nbytes": 0}
 _STR = h5py.string_dtype("utf-8")
 _BLOCK = 64  # frames per write call, at most
+_READ_ATTEMPTS = 5  # reads of a path that atomic writers keep replacing
 _TEMP_NAME = re.compile(r"^\.(?P<target>.+)\.(?P<kind>tmp|old)-(?P<pid>\d+)@(?P<host>[\w.]*)-")
 
 
@@ -573,9 +574,18 @@ def describe_read_error(err: BaseException) -> str:
     return first
 
 
-def _stamp(path: str) -> tuple[int, int, int]:
-    st = os.stat(path)
+def _stamp(f: h5py.File) -> tuple[int, int, int]:
+    """Identity of the file actually open (inode, size, mtime): atomic writers replace a
+    path with a new inode, so a stamp tells which version of a path was read."""
+    try:
+        st = os.fstat(f.id.get_vfd_handle())
+    except (OSError, TypeError, ValueError, RuntimeError):  # a driver without a descriptor
+        st = os.stat(f.filename)
     return st.st_ino, st.st_size, st.st_mtime_ns
+
+
+class _Replaced(DataError):
+    """The path now names another file than the one read first."""
 
 
 def _key_text(key: Any) -> str:
@@ -600,33 +610,43 @@ class LazyArray:
     path : str or Path
     dataset : str
         Path of the dataset inside the file.
+    stamp : tuple of int, optional
+        Identity (inode, size, mtime) of the file version this array must read; by
+        default the version found when it is first opened.
+
+    Raises
+    ------
+    DataError
+        When the file cannot be opened, is not the expected version, or a read fails.
     """
 
-    def __init__(self, path: str | Path, dataset: str) -> None:
+    def __init__(
+        self, path: str | Path, dataset: str, *, stamp: tuple[int, int, int] | None = None
+    ) -> None:
         self.path = str(path)
         self.dataset = dataset
         self._file: h5py.File | None = None
-        self._stamp: tuple[int, int, int] | None = None
+        self._stamp = stamp
         ds = self._ds()
         self.shape: tuple[int, ...] = tuple(ds.shape)
         self.dtype = ds.dtype
 
     def _ds(self) -> h5py.Dataset:
         if self._file is None or not self._file.id.valid:
+            if not os.path.exists(self.path):
+                raise DataError(f"{self.path}: no longer exists")
             try:
-                stamp = _stamp(self.path)
-            except OSError:
-                raise DataError(f"{self.path}: no longer exists") from None
+                f = h5py.File(self.path, "r")
+            except OSError as err:
+                raise DataError(describe_open_error(self.path, err)) from None
+            stamp = _stamp(f)
             if self._stamp is not None and stamp != self._stamp:
-                raise DataError(
+                f.close()
+                raise _Replaced(
                     f"{self.path}: the file was replaced or changed since it was read; "
                     "read it again"
                 )
-            try:
-                self._file = h5py.File(self.path, "r")
-            except OSError as err:
-                raise DataError(describe_open_error(self.path, err)) from None
-            self._stamp = stamp
+            self._file, self._stamp = f, stamp
         return self._file[self.dataset]
 
     def __getstate__(self) -> dict[str, Any]:
@@ -746,15 +766,26 @@ def read(path: str | Path, name: str | None = None) -> Sequence:
     Returns
     -------
     Sequence
-        Ground truth, entities and templates in memory (O(T K)); pixels lazy.
+        Ground truth, entities and templates in memory (O(T K)); pixels lazy, pinned to
+        the same version of the file (if a writer replaces it meanwhile, the lazy arrays
+        keep reading the version whose ground truth was read).
 
     Raises
     ------
     DataError
         If the file is not a valid scenegen file, is damaged, or has no such sequence.
     """
-    p = Path(path)
+    for _ in range(_READ_ATTEMPTS - 1):
+        try:
+            return _read_once(Path(path), name)
+        except _Replaced:  # replaced by an atomic writer between two opens: read again
+            continue
+    return _read_once(Path(path), name)
+
+
+def _read_once(p: Path, name: str | None) -> Sequence:
     with open_checked(p) as f:
+        stamp = _stamp(f)
         seqs = list(f.get("sequences", {}).keys())
         if not seqs:
             raise DataError(f"{p}: holds no sequences")
@@ -775,8 +806,10 @@ def read(path: str | Path, name: str | None = None) -> Sequence:
             gt = GroundTruth(**{k: g[f"gt/{k}"][()].astype(dt) for k, dt in GT_FIELDS.items()})
             templates = {int(k): v[()] for k, v in g["templates"].items()}
             seed, preset = int(g.attrs["seed"]), str(g.attrs["preset"])
-            frames = LazyArray(p, f"sequences/{name}/frames")
-            labels = LazyArray(p, f"sequences/{name}/labels")
+            frames = LazyArray(p, f"sequences/{name}/frames", stamp=stamp)
+            labels = LazyArray(p, f"sequences/{name}/labels", stamp=stamp)
+        except _Replaced:
+            raise
         except (KeyError, ValueError, TypeError, OSError, RuntimeError, ConfigError) as err:
             raise DataError(
                 f"{p}: sequence {name!r} is damaged: {describe_read_error(err)}"

@@ -18,6 +18,7 @@ import h5py
 import numpy as np
 import pytest
 
+from scenegen import io
 from scenegen.config import from_dict
 from scenegen.errors import DataError
 from scenegen.export import export_mot
@@ -104,6 +105,30 @@ def test_an_open_sequence_keeps_reading_the_file_it_opened(tmp_path):
     old.frames.close()
     with pytest.raises(DataError, match="was replaced or changed since it was read"):
         old.frames[0]
+
+
+def test_a_replacement_between_ground_truth_and_pixels_is_never_mixed(tmp_path, monkeypatch):
+    """The file is replaced after ``read`` has read the ground truth but before it opens
+    the pixels: it reads again, and returns the new version consistently."""
+    target = tmp_path / "s.h5"
+    cfg = from_dict({**SCENE, "n_frames": 4})
+    write_scenario(target, plan(cfg, 1))
+    real = io.LazyArray.__init__
+    calls = []
+
+    def replace_first(self, *args, **kwargs):
+        if not calls:
+            write_scenario(target, plan(cfg, 2))
+        calls.append(args)
+        real(self, *args, **kwargs)
+
+    monkeypatch.setattr(io.LazyArray, "__init__", replace_first)
+    seq = read(target)
+    assert len(calls) == 3  # the first attempt failed at its first lazy array
+    new = plan(cfg, 2).render()
+    assert seq.seed == 2
+    np.testing.assert_array_equal(seq.frames[3], new.frames[3])
+    np.testing.assert_array_equal(seq.gt.box, new.gt["box"])
 
 
 def test_a_file_held_open_for_writing_is_refused_in_one_line(tmp_path, capsys):
