@@ -28,7 +28,7 @@ DEMO_PLAN: dict[str, tuple[int, bool]] = {
     "dps-synthetic": (3, False),
     "dps-occlusion": (3, False),
     "kams-accuracy": (2, False),
-    "kams-robustness": (12, False),
+    "kams-robustness": (20, False),
     "shm-depth": (3, False),
 }
 
