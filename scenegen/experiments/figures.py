@@ -52,6 +52,7 @@ def _dps_synthetic(res: dict[str, Any], out: Path) -> list[str]:
         axes = fig.subplots(1 + min(n_comp, 2), 1, squeeze=False)[:, 0]
         _bars(axes[0], objs, {s: methods[s]["uniqueness"] for s in shown}, "uniqueness %")
         axes[0].set_title(f"DPS Fig. 4 on our sequence (λ={v0}): per object")
+        axes[0].set_ylim(0, 122)
         for c in range(min(n_comp, 2)):
             series = {}
             for s in shown:
@@ -60,7 +61,7 @@ def _dps_synthetic(res: dict[str, Any], out: Path) -> list[str]:
             name = f"eff. dynamics {'uv'[c]} %" if n_comp > 1 else "eff. dynamics (u, v mean) %"
             _bars(axes[1 + c], objs, series, name)
         axes[-1].set_xlabel("object")
-        axes[0].legend(fontsize=8, ncol=4)
+        axes[0].legend(fontsize=8, ncol=4, loc="upper center")
         fig.tight_layout()
         files.append(_save(fig, out / "fig4_uniqueness_effective_dynamics.png"))
     fig = Figure(figsize=(10, 4))
@@ -82,10 +83,11 @@ def _dps_synthetic(res: dict[str, Any], out: Path) -> list[str]:
     groups = [f"λ={v}" for v in lams]
     _bars(ax1, groups, rec, "recovery rate %")
     ax1.set_title("object 1 (distracted): recovery")
-    ax1.legend(fontsize=8)
     _bars(ax2, groups, succ, "success rate %")
     ax2.set_title("objects 2–7: success")
-    ax2.legend(fontsize=8)
+    for ax in (ax1, ax2):
+        ax.set_ylim(0, 122)
+        ax.legend(fontsize=8, ncol=4, loc="upper center")
     fig.tight_layout()
     files.append(_save(fig, out / "success_recovery.png"))
     return files
@@ -101,7 +103,8 @@ def _dps_occlusion(res: dict[str, Any], out: Path) -> list[str]:
         "recovery": [rows[m]["hard"]["recovery"] for m in labels],
     }, "% of runs")
     ax.set_title(f"occluded object ({res['summary']['hard_target']}): success and recovery")
-    ax.legend(fontsize=8)
+    ax.set_ylim(0, 115)
+    ax.legend(fontsize=8, ncol=2, loc="upper center")
     fig.tight_layout()
     files = [_save(fig, out / "success_recovery.png")]
     if labels and "uniqueness" in rows[labels[0]]:
@@ -113,7 +116,8 @@ def _dps_occlusion(res: dict[str, Any], out: Path) -> list[str]:
               "uniqueness %")
         ax.set_xlabel("object")
         ax.set_title("uniqueness per object (DPS Fig. 8)")
-        ax.legend(fontsize=8)
+        ax.set_ylim(0, 122)
+        ax.legend(fontsize=8, ncol=len(labels), loc="upper center")
         fig.tight_layout()
         files.append(_save(fig, out / "uniqueness.png"))
     return files
