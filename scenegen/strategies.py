@@ -163,8 +163,14 @@ def _check_fits(min_size: int, margin: float, width: int, height: int, what: str
 
 
 def _hundredths(draw: Any, lo: float, hi: float) -> float:
-    """A float in [lo, hi] on a 0.01 grid; shrinks towards the value nearest 0."""
-    return draw(st.integers(math.ceil(lo * 100), math.floor(hi * 100))) / 100
+    """A float in [lo, hi] on a 0.01 grid; shrinks towards the value nearest 0.
+
+    An interval narrower than the grid step (an odd margin) gives its midpoint.
+    """
+    a, b = math.ceil(lo * 100), math.floor(hi * 100)
+    if a > b:
+        return (lo + hi) / 2
+    return draw(st.integers(a, b)) / 100
 
 
 def _draw_appearance(draw: Any, sizes_w: tuple[int, int], sizes_h: tuple[int, int]) -> Appearance:

@@ -208,3 +208,15 @@ def test_bad_drawn_seed_is_reported():
 
     with pytest.raises(InvalidArgument, match="non-negative"):
         draw()
+
+
+@settings(max_examples=20)
+@given(
+    config=scene_configs(
+        min_width=10, max_width=11, min_height=10, max_height=11, margin=0.002, min_size=9,
+        max_size=10, occlusion=True,
+    )
+)  # fmt: skip
+def test_tight_odd_margins_still_draw_valid_scenes(config):
+    seq = generate(config, seed=0)
+    assert seq.gt.present[0, 0]
