@@ -215,7 +215,8 @@ def scenegen_sequence(request: pytest.FixtureRequest) -> Callable[..., Any]:
     from scenegen.generator import _resolve, generate
     from scenegen.io import read, write
 
-    cache = request.config.cache
+    # No disk cache when pytest runs without its cache plugin (-p no:cacheprovider).
+    cache = getattr(request.config, "cache", None)
     folder = Path(cache.mkdir("scenegen")) if cache is not None else None
     memo: dict[str, Any] = {}
 

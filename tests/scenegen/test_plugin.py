@@ -63,6 +63,8 @@ def test_sequence_factory_generates_caches_and_freezes(pytester):
     from scenegen.io import read
 
     by_seed = {read(p).seed: read(p) for p in cached}
+    # Without pytest's cache plugin the factory still works, from memory only.
+    pytester.runpytest("-q", "-p", "no:cacheprovider").assert_outcomes(passed=3)
     np.testing.assert_array_equal(np.asarray(by_seed[1].frames), generate(SMALL, seed=1).frames)
 
 
