@@ -194,7 +194,7 @@ def _edge_cases() -> list[FixtureDef]:
                 role="target",
                 appearance=replace(disc, shape="rect", pattern="checker", stripe_width=3),
                 position=(-8.0, 40.0),
-                motion=Motion(x=still, y=still, velocity=(4.0, 0.0)),
+                motion=Motion(x=still, y=still, velocity=(9.0, 0.0)),
                 depth=((0, 1),),
             ),
         ),
@@ -291,7 +291,7 @@ def _edge_cases() -> list[FixtureDef]:
     return [
         FixtureDef(
             "enter-leave",
-            "one target leaves the frame at constant speed while another enters it",
+            "a tracked target leaves the frame; another object enters and leaves it",
             enter_leave,
             seed=1,
         ),
