@@ -223,14 +223,15 @@ def scenegen_sequence(request: pytest.FixtureRequest) -> Callable[..., Any]:
     def factory(source: Any, seed: int = 0, frames: int | None = None) -> Any:
         if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
             raise ConfigError(f"seed must be a non-negative integer, got {seed!r}")
-        cfg, _ = _resolve(source)
+        cfg, preset = _resolve(source)
         if frames is not None:
             if isinstance(frames, bool) or not isinstance(frames, (int, np.integer)):
                 raise ConfigError(f"frames must be an integer, got {frames!r}")
             if frames < 1:
                 raise ConfigError(f"frames must be >= 1, got {frames}")
             cfg = replace(cfg, n_frames=int(frames))
-        key = cache_key(cfg, int(seed))
+        # The preset name is recorded in the sequence, so it is part of the key.
+        key = cache_key(cfg, int(seed)) + (f"-{preset}" if preset else "")
         if key in memo:
             return memo[key]
         path = folder / f"{key}.h5" if folder is not None else None

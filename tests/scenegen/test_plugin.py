@@ -49,22 +49,29 @@ def test_sequence_factory_generates_caches_and_freezes(pytester):
             assert seq.gt.box.shape == (3, 1, 4)
             assert not seq.gt.box.flags.writeable
 
+        def test_preset_name_is_kept(scenegen_sequence):
+            from scenegen import presets
+            a = scenegen_sequence("kams-a", seed=3, frames=2)
+            b = scenegen_sequence(presets.get("kams-a"), seed=3, frames=2)
+            assert a.preset == "kams-a" and b.preset == ""
+            np.testing.assert_array_equal(a.frames, b.frames)
+
         def test_bad_seed(scenegen_sequence):
             from scenegen.errors import ConfigError
             with pytest.raises(ConfigError, match="seed"):
                 scenegen_sequence(CONFIG, seed=-1)
         """
     )
-    pytester.runpytest("-q").assert_outcomes(passed=3)
+    pytester.runpytest("-q").assert_outcomes(passed=4)
     cached = sorted((pytester.path / ".pytest_cache" / "d" / "scenegen").glob("*.h5"))
-    assert len(cached) == 2
+    assert len(cached) == 3
     # The second session reads the cache: same contents as a fresh generation.
-    pytester.runpytest("-q").assert_outcomes(passed=3)
+    pytester.runpytest("-q").assert_outcomes(passed=4)
     from scenegen.io import read
 
-    by_seed = {read(p).seed: read(p) for p in cached}
+    by_seed = {read(p).seed: read(p) for p in cached if not p.stem.endswith("kams-a")}
     # Without pytest's cache plugin the factory still works, from memory only.
-    pytester.runpytest("-q", "-p", "no:cacheprovider").assert_outcomes(passed=3)
+    pytester.runpytest("-q", "-p", "no:cacheprovider").assert_outcomes(passed=4)
     np.testing.assert_array_equal(np.asarray(by_seed[1].frames), generate(SMALL, seed=1).frames)
 
 
