@@ -18,6 +18,7 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from scenegen.config import from_dict
@@ -26,8 +27,10 @@ from scenegen.generator import plan
 from scenegen.io import (
     atomic_path,
     clean_temp_files,
+    read,
     temp_file_owner,
     temp_prefix,
+    write,
     write_scenario,
 )
 from scenegen.validate import check_file
@@ -236,3 +239,14 @@ def test_clean_temp_files_removes_only_stale_leftovers(tmp_path):
     assert clean_temp_files(tmp_path, "a.h5") == sorted([stale, stale_dir])
     assert clean_temp_files(tmp_path) == [other_target]
     assert sorted(tmp_path.iterdir()) == sorted([live, own, other_host])
+
+
+def test_rewriting_a_file_from_its_own_lazy_read(tmp_path, small_file):
+    """``write(p, read(p))``: the lazy frames keep reading the old file while the new one
+    is written beside it, then the new one replaces it."""
+    seq = read(small_file)
+    frames = np.asarray(seq.frames)
+    write(small_file, seq, compression="lzf")
+    back = read(small_file)
+    np.testing.assert_array_equal(np.asarray(back.frames), frames)
+    assert check_file(small_file) == [] and temps(small_file.parent, small_file.name) == []
