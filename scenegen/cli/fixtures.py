@@ -74,7 +74,10 @@ def cmd_verify(args: argparse.Namespace) -> int:
         print(f"scenegen: mismatch: {line}", file=sys.stderr)
     took = time.perf_counter() - start
     if problems:
-        print(f"{folder}: {len(problems)} mismatches ({took:.1f} s)")
+        print(
+            f"{folder}: {len(problems)} mismatches ({took:.1f} s); if the changes are "
+            "intended, run `scenegen fixtures regen` and commit the folder"
+        )
         return 1
     print(f"{folder}: fixtures and tracker outputs match ({took:.1f} s)")
     return 0
