@@ -7,8 +7,10 @@ instead of attempted, and small valid outcomes plan and render.
 
 from __future__ import annotations
 
+import contextlib
 import copy
 import dataclasses
+import io
 import json
 import math
 
@@ -18,6 +20,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from scenegen import presets
+from scenegen.cli import main
 from scenegen.config import (
     AR2,
     MAX_BLUR,
@@ -38,6 +41,7 @@ from scenegen.config import (
 )
 from scenegen.errors import ConfigError
 from scenegen.generator import plan
+from scenegen.validate import check_file
 
 # A small config that uses every feature: scale motion, pose variation, a mimic that
 # appears late, depth keyframes, a disappearing occluder, grid clutter in a region.
@@ -273,3 +277,21 @@ def test_limits_hold_for_python_objects_and_frame_overrides():
         dataclasses.replace(cfg, sensor_noise=MAX_MAGNITUDE * 10)
     with pytest.raises(ConfigError, match="width: must be <= 8192"):
         SceneConfig(width=MAX_SIDE + 1, height=10, n_frames=1)
+
+
+@settings(max_examples=20)
+@given(data=mutated_configs())
+def test_generate_cli_on_mutated_configs_exits_0_or_2_with_one_line(folder, data):
+    config, out = folder / "cli.json", folder / "cli.h5"
+    config.write_text(json.dumps(data))
+    out.unlink(missing_ok=True)
+    stderr = io.StringIO()
+    with contextlib.redirect_stderr(stderr), contextlib.redirect_stdout(io.StringIO()):
+        code = main(["generate", "--config", str(config), "--frames", "2", "--seed", "0",
+                     "-o", str(out)])  # fmt: skip
+    err = stderr.getvalue()
+    if code == 2:
+        assert len(err.splitlines()) == 1 and err.startswith("scenegen: error: ")
+        assert not out.exists()
+    else:
+        assert code == 0 and check_file(out) == []
