@@ -26,8 +26,18 @@ Integrity
 Lazy reads
     Frames and labels are stored one frame per chunk, so reading a frame range costs in
     proportion to the range; :func:`read` returns lazy arrays that read only what is
-    indexed. Writing streams a chunk of frames at a time, so memory stays bounded
+    indexed. Writing streams a block of frames at a time (:data:`BLOCK_BYTES`) with no
+    chunk cache and a compact chunk index (:data:`LIBVER`), so memory stays bounded
     whatever the sequence length.
+
+Concurrent readers
+    Because writers only ever rename complete files into place, a reader opens either the
+    old complete file or the new one. :func:`read` pins its lazy arrays to the version
+    whose ground truth it read (and reads again if a writer replaced the file in between);
+    an open lazy array keeps reading its version, and one reopened after the file was
+    replaced raises :class:`DataError`. HDF5 SWMR is not used: a file that another
+    program holds open for writing is refused with "is being written by another process",
+    and a temporary file is refused as "an unfinished temporary file".
 """
 
 from __future__ import annotations
