@@ -92,7 +92,11 @@ def check_file(path: str | Path, *, check_pixels: bool = True, isolate: bool = F
 
 def _child(path: str, check_pixels: bool, conn: Connection) -> None:
     faulthandler.disable()  # a crash is reported by the parent, in one line
-    conn.send(check_file(path, check_pixels=check_pixels))
+    try:
+        problems = check_file(path, check_pixels=check_pixels)
+    except Exception as err:  # whatever else a damaged file provokes: one line, no traceback
+        problems = [f"{path}: could not be checked ({type(err).__name__}: {_one_line(err)})"]
+    conn.send(problems)
     conn.close()
 
 

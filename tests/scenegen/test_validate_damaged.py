@@ -385,6 +385,16 @@ def test_a_crash_of_the_hdf5_library_becomes_one_line(copy, monkeypatch):
     ]
 
 
+def test_an_unexpected_error_in_the_isolated_check_is_one_line(copy, monkeypatch, capfd):
+    def fail(*args, **kwargs):
+        raise MemoryError("simulated")
+
+    monkeypatch.setattr(validate, "_check_open_file", fail)
+    p = copy()
+    assert check_file(p, isolate=True) == [f"{p}: could not be checked (MemoryError: simulated)"]
+    assert "Traceback" not in capfd.readouterr().err
+
+
 def test_random_byte_damage_never_raises(copy):
     """Seeded random flips anywhere in the file (metadata included): the isolated check
     always returns problem lines (or none, for flips in unused bytes), never raises."""
