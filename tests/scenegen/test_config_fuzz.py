@@ -270,9 +270,12 @@ def test_absurd_sizes_are_rejected_not_attempted(data, field, needle):
 
 
 def test_limits_hold_for_python_objects_and_frame_overrides():
-    cfg = presets.get("kams-d")  # 601 entities
-    with pytest.raises(ConfigError, match="n_frames: 40000 frames x 601 entities exceeds"):
-        dataclasses.replace(cfg, n_frames=40_000)
+    cfg = presets.get("kams-d")  # hundreds of clutter items
+    k = len(cfg.entities) + sum(c.count for c in cfg.clutter)
+    frames = MAX_FRAME_ENTITIES // k + 1
+    with pytest.raises(ConfigError, match=f"n_frames: {frames} frames x {k} entities exceeds"):
+        dataclasses.replace(cfg, n_frames=frames)
+    assert dataclasses.replace(cfg, n_frames=frames - 1).n_frames == frames - 1
     with pytest.raises(ConfigError, match=r"sensor_noise: must be at most 1e\+09"):
         dataclasses.replace(cfg, sensor_noise=MAX_MAGNITUDE * 10)
     with pytest.raises(ConfigError, match="width: must be <= 8192"):
