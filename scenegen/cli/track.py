@@ -55,6 +55,8 @@ def run_tracker(seq: Any, name: str, params: dict[str, Any], seed: int, progress
     try:
         tracker = trackers.make(name, rng=seed, **params)
         result = trackers.track(tracker, seq.frames, init, progress=progress)
+    except DataError:
+        raise  # a damaged file (DataError is a ValueError): exit 1, not 2
     except ValueError as err:
         raise ConfigError(str(err)) from None
     orderings = getattr(tracker, "orderings", None)
