@@ -2,20 +2,9 @@
 touches files.
 
 Atomic writes
-    Every write goes to a temporary file in the target's folder, named
-    ``.NAME.tmp-PID@HOST-XXXXXXXX``, which is flushed to disk and renamed onto the target
-    only when complete. A crash or a SIGKILL therefore never leaves a half-written file at
-    the target path and never damages an earlier file there; a reader sees either the old
-    complete file or the new complete one. Concurrent writers never collide: every write
-    has its own temporary name, and when several processes write the same target the last
-    rename wins with a complete file.
-
-Leftover temporary files
-    A killed writer leaves its temporary file behind. Such files start with a dot, so
-    shell globs such as ``*.h5`` skip them, and :func:`clean_temp_files` removes those
-    whose writing process (on this host) no longer runs. Every atomic write first cleans
-    the stale leftovers of its own target, so rerunning a killed command tidies up after
-    it. Files written by other hosts (shared folders) are left alone.
+    Every write goes through :func:`scenegen.atomic.atomic_path` (a temporary file in
+    the target's folder, renamed onto the target only when complete); see
+    :mod:`scenegen.atomic` for the naming and the clean-up of leftovers.
 
 Integrity
     Frames, labels, ground truth and templates are stored with the Fletcher-32 checksum
@@ -42,13 +31,9 @@ Concurrent readers
 
 from __future__ import annotations
 
-import contextlib
 import json
 import os
 import re
-import shutil
-import socket
-import tempfile
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -58,6 +43,13 @@ import h5py
 import numpy as np
 from numpy.typing import NDArray
 
+from scenegen.atomic import (
+    atomic_path,
+    clean_temp_files,
+    describe_temp_file,
+    temp_file_owner,
+    temp_prefix,
+)
 from scenegen.config import from_dict, to_dict
 from scenegen.errors import ConfigError, DataError
 from scenegen.sequence import GT_FIELDS, Entities, GroundTruth, Sequence
@@ -104,189 +96,12 @@ _WRITE_OPTIONS: dict[str, Any] = {"libver": LIBVER, "rdcc_nbytes": 0}
 _STR = h5py.string_dtype("utf-8")
 _BLOCK = 64  # frames per write call, at most
 _READ_ATTEMPTS = 5  # reads of a path that atomic writers keep replacing
-_TEMP_NAME = re.compile(r"^\.(?P<target>.+)\.(?P<kind>tmp|old)-(?P<pid>\d+)@(?P<host>[\w.]*)-")
 
 
 def _version() -> str:
     from scenegen import __version__
 
     return __version__
-
-
-# ---------------------------------------------------------------------------------------
-# Temporary files and atomic replacement
-
-
-def _host() -> str:
-    return re.sub(r"[^\w.]", "_", socket.gethostname(), flags=re.ASCII)
-
-
-def temp_prefix(name: str, kind: str = "tmp") -> str:
-    """The prefix of this process's temporary files for a target called ``name``.
-
-    Parameters
-    ----------
-    name : str
-        The target's file or folder name (no directory).
-    kind : {'tmp', 'old'}
-        ``tmp`` for a file or folder being written, ``old`` for a folder being replaced.
-
-    Returns
-    -------
-    str
-        ``.NAME.KIND-PID@HOST-``; a random part follows it in the actual name.
-
-    Example
-    -------
-    >>> temp_prefix("a.h5").startswith(".a.h5.tmp-")
-    True
-    """
-    return f".{name}.{kind}-{os.getpid()}@{_host()}-"
-
-
-def temp_file_owner(path: str | Path) -> tuple[str, int, str] | None:
-    """Parse the name of a temporary file written by :func:`atomic_path`.
-
-    Parameters
-    ----------
-    path : str or Path
-
-    Returns
-    -------
-    (target, pid, host) or None
-        The target's name, and the process and host that write(s) it; None if ``path``
-        is not named like a temporary file.
-
-    Example
-    -------
-    >>> temp_file_owner(".a.h5.tmp-123@box-x1y2z3")
-    ('a.h5', 123, 'box')
-    """
-    m = _TEMP_NAME.match(Path(path).name)
-    if m is None:
-        return None
-    return m["target"], int(m["pid"]), m["host"]
-
-
-def _running(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:  # someone else's live process
-        return True
-    return True
-
-
-def _stale(path: Path) -> bool:
-    owner = temp_file_owner(path)
-    if owner is None:
-        return False
-    _, pid, host = owner
-    return host == _host() and pid != os.getpid() and not _running(pid)
-
-
-def clean_temp_files(folder: str | Path, name: str | None = None) -> list[Path]:
-    """Remove stale temporary files and folders left in ``folder`` by killed writers.
-
-    A temporary file is stale when it was written on this host by a process that no
-    longer runs. Files of running processes and of other hosts are never touched.
-
-    Parameters
-    ----------
-    folder : str or Path
-    name : str, optional
-        Only the leftovers of this target name (default: of every target).
-
-    Returns
-    -------
-    list of Path
-        What was removed.
-    """
-    d = Path(folder)
-    pattern = f".{_glob_escape(name)}.*-*@*-*" if name is not None else ".*.*-*@*-*"
-    removed = []
-    for p in sorted(d.glob(pattern)):
-        if not _stale(p):
-            continue
-        with contextlib.suppress(OSError):
-            if p.is_dir() and not p.is_symlink():
-                shutil.rmtree(p)
-            else:
-                p.unlink()
-            removed.append(p)
-    return removed
-
-
-def _glob_escape(text: str) -> str:
-    # Path.glob treats *, ? and [ specially.
-    return re.sub(r"([*?\[])", r"[\1]", text)
-
-
-def _fsync(path: Path) -> None:
-    fd = os.open(path, os.O_RDONLY)
-    try:
-        os.fsync(fd)
-    finally:
-        os.close(fd)
-
-
-def _fsync_dir(folder: Path) -> None:
-    # Makes the rename itself durable; not every file system allows it.
-    with contextlib.suppress(OSError):
-        _fsync(folder)
-
-
-def _target_folder(target: Path) -> Path:
-    folder = target.parent if str(target.parent) else Path(".")
-    if not folder.is_dir():
-        raise ConfigError(f"{target}: folder {folder} does not exist")
-    if target.is_dir():
-        raise ConfigError(f"{target}: is a folder, expected a file name")
-    return folder
-
-
-@contextlib.contextmanager
-def atomic_path(path: str | Path, suffix: str = "") -> Iterator[Path]:
-    """Yield a temporary path beside ``path``; rename it onto ``path`` on success.
-
-    The temporary file is named ``.NAME.tmp-PID@HOST-XXXXXXXX`` + ``suffix`` (unique per
-    call, so concurrent writers never collide) and is flushed to disk before the rename.
-    On any exception it is removed and ``path`` is left untouched; if the process is
-    killed it stays behind, and the next atomic write of the same target (or
-    :func:`clean_temp_files`) removes it.
-
-    Parameters
-    ----------
-    path : str or Path
-        The target file; its folder must exist.
-    suffix : str
-        Ending of the temporary name (lets writers that pick a format by extension work).
-
-    Raises
-    ------
-    ConfigError
-        If the folder does not exist or the target is a folder.
-    """
-    target = Path(path)
-    folder = _target_folder(target)
-    clean_temp_files(folder, target.name)
-    fd, tmp = tempfile.mkstemp(prefix=temp_prefix(target.name), suffix=suffix, dir=folder)
-    os.close(fd)
-    tmp_path = Path(tmp)
-    # mkstemp makes the file private; give it the permissions a plain open() would.
-    umask = os.umask(0)
-    os.umask(umask)
-    os.chmod(tmp_path, 0o666 & ~umask)
-    try:
-        yield tmp_path
-        _fsync(tmp_path)
-        os.replace(tmp_path, target)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            tmp_path.unlink()
-        raise
-    _fsync_dir(folder)
 
 
 # ---------------------------------------------------------------------------------------
@@ -506,29 +321,6 @@ def write_scenario(
 
 # ---------------------------------------------------------------------------------------
 # Reading
-
-
-def describe_temp_file(path: str | Path) -> str | None:
-    """One line saying that ``path`` is a temporary file of an atomic write, or None.
-
-    Parameters
-    ----------
-    path : str or Path
-
-    Returns
-    -------
-    str or None
-        ``"PATH: an unfinished temporary file of a write to 'NAME' (process PID on HOST,
-        running)"`` (or ``no longer running``; the state is only known on this host).
-    """
-    owner = temp_file_owner(path)
-    if owner is None:
-        return None
-    target, pid, host = owner
-    where = f"process {pid} on {host or '?'}"
-    if host == _host():
-        where += ", running" if _running(pid) else ", no longer running"
-    return f"{path}: an unfinished temporary file of a write to {target!r} ({where})"
 
 
 def describe_open_error(path: str | Path, err: OSError) -> str:
