@@ -249,8 +249,10 @@ def test_dps_distractor_starts_on_object1():
     assert not seq.gt.present[:3, d].any() and seq.gt.present[3:9, d].all()
     assert not seq.gt.present[9:, d].any()
     np.testing.assert_allclose(seq.gt.center[3, d], seq.gt.center[3, o], atol=1.0)
+    # By its last frame it has drifted ~40 px away: far enough that a track that followed
+    # it no longer overlaps object 1 (30x30), so object 1 must be re-acquired.
     gap = np.linalg.norm(seq.gt.center[8, d] - seq.gt.center[8, o])
-    assert gap > 15
+    assert gap > 30
     assert seq.gt.depth[3, d] == 0
 
 
