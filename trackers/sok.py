@@ -10,6 +10,9 @@ from trackers.meanshift import ColourTargets, check_kernel_bins, check_mean_shif
 
 __all__ = ["SOK"]
 
+# Confidences closer than this are equal: their difference is rounding.
+_TIE = 1e-9
+
 # The 8 cells around the centre of a 3x3 grid, in units of the target's box size.
 _OCTAL = np.array([(-1, -1), (0, -1), (1, -1), (-1, 0), (1, 0), (-1, 1), (0, 1), (1, 1)],
                   dtype=np.float64)
@@ -22,7 +25,8 @@ class SOK(Tracker):
     C_t = 1 − d (KAMS eq. 8). If C_t < ``threshold``, eight more mean-shift trackers with
     the same model start on the other cells of a 3x3 grid centred on that estimate (cell
     spacing ``spacing`` times the target's box size; KAMS Fig. 2), all in one call; the
-    most confident of the nine results is kept. Deterministic: ``rng`` is accepted for the
+    most confident of the nine results is kept (of confidences equal to 1e-9, the one
+    nearest the primary estimate). Deterministic: ``rng`` is accepted for the
     common protocol.
 
     Parameters
@@ -97,10 +101,17 @@ class SOK(Tracker):
             keep_inside(starts, frame.shape)
             extra = self.targets.shift(obs, starts, max_iter=self.max_iter, eps=self.eps,
                                        which=low)
-            best = np.argmax(1.0 - extra.distances, axis=1)
-            better = 1.0 - extra.distances[np.arange(low.size), best] > confidence[low]
-            centres[low[better]] = extra.centres[better, best[better]]
-            confidence[low[better]] = 1.0 - extra.distances[better, best[better]]
+            cand = np.concatenate([centres[low, None, :], extra.centres], axis=1)
+            cand_conf = np.concatenate([confidence[low, None], 1.0 - extra.distances], axis=1)
+            # The most confident of the nine; confidences equal up to rounding are a tie,
+            # won by the candidate nearest the primary estimate (the primary itself first),
+            # so that rounding never decides between two equally good windows.
+            tied = cand_conf >= cand_conf.max(axis=1, keepdims=True) - _TIE
+            gap = np.round(np.hypot(*(cand - centres[low, None, :]).transpose(2, 0, 1)), 6)
+            pick = np.argmin(np.where(tied, gap, np.inf), axis=1)
+            rows = np.arange(low.size)
+            centres[low] = cand[rows, pick]
+            confidence[low] = cand_conf[rows, pick]
         keep_inside(centres, frame.shape)
         self.centres = centres
         return Estimate(self.targets.boxes(centres[:, None, :])[:, 0],
