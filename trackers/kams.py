@@ -33,7 +33,12 @@ class KAMS(AnnealedPF):
         5).
     eps : float, optional
         Mean-shift stopping shift, in pixels.
-    n_layers, lam, sigma, sigma_decay, schedule, alpha, beta_ratio, estimate, resampler
+    alpha : float, optional
+        Survival rate of the adaptive β schedule, as for ``AnnealedPF``. **(open)** Default
+        0.8, not 0.5: mean shift already concentrates the particles, so a flatter weighting
+        keeps more of the alternatives alive (kams on kams-b, seeds 0–9: 8/10 runs tracked
+        to the end at 0.8, 4/10 at 0.5, 5/10 at 0.2; kams-a 10/10 at 0.5 and 0.8).
+    n_layers, lam, sigma, sigma_decay, schedule, beta_ratio, estimate, resampler
         As for ``AnnealedPF``.
     kernel, bins, rng
         As for ``AnnealedPF``.
@@ -53,7 +58,7 @@ class KAMS(AnnealedPF):
 
     def __init__(self, *, n_particles: int = 40, n_layers: int = 3, lam: float = 1000.0,
                  sigma: float | Sequence[float] = 12.0, sigma_decay: float = 0.5,
-                 schedule: str = "adaptive", alpha: float = 0.5, beta_ratio: float = 0.5,
+                 schedule: str = "adaptive", alpha: float = 0.8, beta_ratio: float = 0.5,
                  estimate: str = "mean", max_iter: int = 5, eps: float = 0.5,
                  resampler: str = "systematic", kernel: str = "cone", bins: int = 10,
                  rng: RngLike = None) -> None:

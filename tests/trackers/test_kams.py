@@ -16,7 +16,8 @@ def sequence(scenegen_sequence, n_frames):
 @pytest.mark.parametrize("schedule", ["adaptive", "geometric"])
 def test_zero_mean_shift_iterations_is_the_annealed_filter(scenegen_sequence, schedule):
     frames, boxes = sequence(scenegen_sequence, 15)
-    common = {"n_particles": 40, "n_layers": 3, "sigma": 10.0, "schedule": schedule, "rng": 21}
+    common = {"n_particles": 40, "n_layers": 3, "sigma": 10.0, "schedule": schedule,
+              "alpha": 0.6, "rng": 21}
     kams = trackers.track(trackers.make("kams", max_iter=0, **common), frames, boxes)
     annealed = trackers.track(trackers.make("annealed", **common), frames, boxes)
     np.testing.assert_array_equal(kams.boxes, annealed.boxes)
