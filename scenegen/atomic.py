@@ -2,7 +2,7 @@
 
 Atomic writes
     Every write goes to a temporary file in the target's folder, named
-    ``.NAME.tmp-PID@HOST-XXXXXXXX``, which is flushed to disk and renamed onto the target
+    ``.NAME.tmp-PID@HOST-RANDOM``, which is flushed to disk and renamed onto the target
     only when complete. A crash or a SIGKILL therefore never leaves a half-written file at
     the target path and never damages an earlier file there; a reader sees either the old
     complete file or the new complete one. Concurrent writers never collide: every write
@@ -174,7 +174,7 @@ def _target_folder(target: Path) -> Path:
 def atomic_path(path: str | Path, suffix: str = "") -> Iterator[Path]:
     """Yield a temporary path beside ``path``; rename it onto ``path`` on success.
 
-    The temporary file is named ``.NAME.tmp-PID@HOST-XXXXXXXX`` + ``suffix`` (unique per
+    The temporary file is named ``.NAME.tmp-PID@HOST-RANDOM`` + ``suffix`` (unique per
     call, so concurrent writers never collide) and is flushed to disk before the rename.
     On any exception it is removed and ``path`` is left untouched; if the process is
     killed it stays behind, and the next atomic write of the same target (or

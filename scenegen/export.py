@@ -7,7 +7,7 @@ MOT17: 1 target (pedestrian), 8 distractor, 9 occluder. Clutter is not exported.
 are written as lossless PNG so that pixels stay exact.
 
 The folder is written atomically: everything goes to a temporary folder beside the target
-(``.NAME.tmp-PID@HOST-XXXXXXXX``, see :mod:`scenegen.atomic`), which then replaces the target
+(``.NAME.tmp-PID@HOST-RANDOM``, see :mod:`scenegen.atomic`), which then replaces the target
 in one step (Linux ``renameat2(RENAME_EXCHANGE)``; elsewhere two renames in quick
 succession). A process killed while exporting leaves the earlier folder untouched and its
 temporary folder behind, which the next export to the same target removes. Frames are read
