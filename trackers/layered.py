@@ -158,6 +158,11 @@ class LayeredMatcher:
         h, w = frame.shape[:2]
         tl = np.round(b[:, :2]).astype(np.int64)
         size = np.maximum(np.round(b[:, 2:]).astype(np.int64), 1)  # (w, h)
+        # A box that overlaps the frame by less than a pixel can round to a template wholly
+        # outside it; moving the rounded corner by under a pixel keeps one row/column in,
+        # so every template has at least one pixel inside the frame.
+        tl[:, 0] = np.clip(tl[:, 0], 1 - size[:, 0], w - 1)
+        tl[:, 1] = np.clip(tl[:, 1], 1 - size[:, 1], h - 1)
         th_max, tw_max = int(size[:, 1].max()), int(size[:, 0].max())
         self.templates = np.zeros((m, th_max, tw_max, 3), dtype=np.uint8)
         self.support = np.zeros((m, th_max, tw_max), dtype=bool)
@@ -170,9 +175,8 @@ class LayeredMatcher:
             rows = np.arange(y0, y0 + th)
             cols = np.arange(x0, x0 + tw)
             inside = ((rows >= 0) & (rows < h))[:, None] & ((cols >= 0) & (cols < w))[None, :]
-            sup &= inside
-            if not sup.any():
-                raise ValueError(f"box {k} {b[k].tolist()} has no pixel inside the frame")
+            # A sliver box whose shape support misses the frame falls back to its box pixels.
+            sup = sup & inside if (sup & inside).any() else inside
             rr = np.clip(rows, 0, h - 1)
             cc = np.clip(cols, 0, w - 1)
             self.templates[k, :th, :tw] = frame[rr[:, None], cc[None, :]]

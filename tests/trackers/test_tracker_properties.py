@@ -143,26 +143,7 @@ _SLIVER = (
     ),
     np.array([[12.0, -7.5, 19.0625, 7.9375]]),
 )
-KNOWN_BOX_FAILURES = {
-    n: (
-        "kalman, shm and shm-fast (trackers/layered.py, LayeredMatcher init) raise "
-        "ValueError 'box 0 [12.0, -7.5, 19.0625, 7.9375] has no pixel inside the frame' "
-        "for boxes that trackers.base.check_boxes accepts: the template is rounded to whole "
-        "pixels and intersected with its shape support before checking"
-    )
-    for n in ("kalman", "shm", "shm-fast")
-}
-
-
-@pytest.mark.parametrize(
-    "name",
-    [
-        pytest.param(n, marks=pytest.mark.xfail(strict=True, reason=KNOWN_BOX_FAILURES[n]))
-        if n in KNOWN_BOX_FAILURES
-        else n
-        for n in NAMES
-    ],
-)
+@pytest.mark.parametrize("name", NAMES)
 @settings(max_examples=15)
 @example(case=_SLIVER, seed=0)
 @given(case=scenes_and_boxes(), seed=seeds)
