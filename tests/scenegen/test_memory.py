@@ -19,31 +19,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from scenegen.bench.reliability import SCENE as BENCH_SCENE
 from scenegen.config import from_dict
 from scenegen.generator import plan
 from scenegen.io import frames_per_block, read, write, write_scenario
 
-SCENE = {
-    "name": "long", "width": 640, "height": 480, "n_frames": 100,
-    "background": {"kind": "uniform", "color": [200, 220, 255]},
-    "entities": [
-        {"name": "t1", "role": "target", "position": [100, 100], "depth": 0,
-         "appearance": {"shape": "ellipse", "size": [40, 60], "pattern": "rings",
-                        "colors": [[255, 0, 0], [0, 255, 0]]},
-         "motion": {"x": {"boundary": "reflect", "sigma": 2, "a1": 1.9, "a2": -0.9},
-                    "y": {"boundary": "reflect", "sigma": 2, "a1": 1.9, "a2": -0.9},
-                    "velocity": [3, 2]}},
-        {"name": "t2", "role": "target", "position": [500, 300], "depth": 1,
-         "appearance": {"shape": "rect", "size": [50, 50], "pattern": "stripes",
-                        "colors": [[0, 0, 255], [255, 255, 0]]},
-         "motion": {"x": {"boundary": "reflect", "sigma": 2, "a1": 1.9, "a2": -0.9},
-                    "y": {"boundary": "reflect", "sigma": 2, "a1": 1.9, "a2": -0.9},
-                    "velocity": [-3, 1]}},
-        {"name": "wall", "role": "occluder", "position": [320, 240], "depth": 2,
-         "appearance": {"size": [60, 200], "colors": [[80, 80, 80]]}},
-    ],
-    "clutter": [{"count": 30, "appearance": {"shape": "ellipse", "size": [16, 16]}}],
-}  # fmt: skip
+# The bench's long 640x480 scene (two targets, an occluder, 30 clutter items), 100 frames.
+SCENE = {**BENCH_SCENE, "n_frames": 100}
 MB = 2**20
 
 
