@@ -109,6 +109,58 @@ def test_region_histograms_equal_per_patch_numpy(seed, height, width, model, bin
                                rtol=0, atol=1e-7)
 
 
+@settings(max_examples=30)
+@given(seed=st.integers(0, 2**32 - 1), height=st.integers(5, 60), width=st.integers(5, 60),
+       bins=st.integers(1, 6), n_parts=st.integers(1, 3), n_refs=st.integers(1, 3),
+       spread=st.floats(0.5, 30.0), sparsity=st.floats(0.0, 0.95))
+def test_distance_paths_agree_with_per_patch_numpy(seed, height, width, bins, n_parts, n_refs,
+                                                   spread, sparsity):
+    """The integral and direct paths of the uniform kernel, and "auto", give the oracle's
+    distances: clustered and scattered boxes, boxes cut by the border or wholly outside,
+    thinner than a band, and references that are zero on most bins."""
+    rng = np.random.default_rng(seed)
+    frame = _frame(seed, height, width)
+    bin_img, n_bins = quantize_rgb(frame, bins), bins ** 3
+    n = 40
+    centre = rng.uniform(0, [width, height])
+    size = rng.uniform(0.3, 0.8 * max(width, height), 2)
+    boxes = np.column_stack([centre + rng.normal(0.0, spread, (n, 2)) - size / 2,
+                             size * np.exp(rng.normal(0.0, 0.2, (n, 2)))])
+    boxes[0] = [-3.0, -2.0, 8.0, 7.0]
+    boxes[1] = [width + 1.0, 1.0, 5.0, 5.0]
+    boxes[2] = [1.2, 1.2, 4.0, 0.8]
+    refs = rng.dirichlet(np.ones(n_bins * n_parts), n_refs)
+    refs *= rng.random(refs.shape) >= sparsity
+    refs[:, 0] += 1e-3
+    refs /= refs.sum(axis=1, keepdims=True)
+    index = rng.integers(0, n_refs, n)
+    expected = bhattacharyya_distance(
+        np.stack([_reference_histogram(bin_img, b, n_bins, KERNEL_UNIFORM, n_parts)
+                  for b in boxes]), refs[index])
+    for method in ("direct", "integral", "auto"):
+        dist = region_distances(bin_img, boxes, refs, index, KERNEL_UNIFORM, n_parts,
+                                method=method)
+        np.testing.assert_allclose(dist, expected, rtol=0, atol=1e-7, err_msg=method)
+
+
+def test_integral_path_is_taken_for_particle_clouds_and_matches_direct():
+    """A tracker's cloud: 300 boxes around each of 3 objects on a noise frame."""
+    rng = np.random.default_rng(0)
+    frame = rng.integers(0, 256, (120, 160, 3), dtype=np.uint8)
+    bin_img = quantize_rgb(frame)
+    truth = np.array([[20.0, 20.0, 30.0, 30.0], [90.0, 30.0, 30.0, 30.0],
+                      [60.0, 80.0, 30.0, 30.0]])
+    refs = region_histograms(bin_img, truth, 1000, KERNEL_UNIFORM)
+    boxes = np.repeat(truth, 300, axis=0)
+    boxes[:, :2] += rng.normal(0.0, 4.0, (900, 2))
+    index = np.repeat(np.arange(3), 300)
+    direct = region_distances(bin_img, boxes, refs, index, KERNEL_UNIFORM, method="direct")
+    for method in ("integral", "auto"):
+        np.testing.assert_allclose(region_distances(bin_img, boxes, refs, index,
+                                                    KERNEL_UNIFORM, method=method),
+                                   direct, rtol=0, atol=1e-12)
+
+
 def test_empty_region_is_uniform():
     bins = np.zeros((10, 10), dtype=np.int32)
     hist = region_histograms(bins, np.array([[20.0, 20.0, 5.0, 5.0], [3.2, 3.2, 0.2, 0.2]]),
@@ -145,6 +197,46 @@ def test_quantize_hsv_equals_integer_reference(seed, hb, sb, vb, s_min, v_min):
     out = quantize_hsv(frame, hb, sb, vb, s_min, v_min)
     np.testing.assert_array_equal(out, _reference_hsv(frame, hb, sb, vb, s_min, v_min))
     assert out.min() >= 0 and out.max() < hsv_n_bins(hb, sb, vb)
+
+
+_ALL_COLOURS = None
+
+
+def _all_colours():
+    """Every 8-bit RGB colour once, as a (4096, 4096, 3) frame."""
+    global _ALL_COLOURS
+    if _ALL_COLOURS is None:
+        c = np.arange(2**24, dtype=np.uint32)
+        _ALL_COLOURS = np.stack([c >> 16, (c >> 8) & 255, c & 255], axis=-1).astype(
+            np.uint8).reshape(4096, 4096, 3)
+    return _ALL_COLOURS
+
+
+@pytest.mark.parametrize("hb, sb, vb, s_min, v_min", [(10, 10, 10, 0.1, 0.2)])
+def test_quantize_hsv_exact_on_every_colour(hb, sb, vb, s_min, v_min):
+    """The float32 divisions of the kernel give the exact integer floors on all 2**24
+    colours (the default model; more bin counts in the slow suite)."""
+    frame = _all_colours()
+    for rows in range(0, 4096, 512):  # in slices: the int64 reference is memory-hungry
+        part = frame[rows:rows + 512]
+        np.testing.assert_array_equal(quantize_hsv(part, hb, sb, vb, s_min, v_min),
+                                      _reference_hsv(part, hb, sb, vb, s_min, v_min))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("hb, sb, vb, s_min, v_min", [
+    (1, 1, 1, 0.0, 0.0), (8, 8, 8, 0.3, 0.1), (37, 91, 5, 0.55, 0.9),
+    (256, 255, 256, 1.0, 1.0)])
+def test_quantize_hsv_exact_on_every_colour_slow(hb, sb, vb, s_min, v_min):
+    test_quantize_hsv_exact_on_every_colour(hb, sb, vb, s_min, v_min)
+
+
+def test_quantize_rgb_exact_on_every_colour():
+    frame = _all_colours()[::4]  # every colour's channels appear in a quarter of the rows
+    for bins in (10, 7, 256):
+        b = frame.astype(np.int64) * bins // 256
+        np.testing.assert_array_equal(quantize_rgb(frame, bins),
+                                      (b[..., 0] * bins + b[..., 1]) * bins + b[..., 2])
 
 
 def test_quantize_hsv_agrees_with_skimage():
@@ -197,5 +289,8 @@ def test_kernel_rejects_bad_input():
     with pytest.raises(ValueError, match="ref_index"):
         region_distances(bins, np.array([[1.0, 1.0, 2.0, 3.0]]), np.full((1, 4), 0.25),
                          np.array([1]), KERNEL_UNIFORM)
+    with pytest.raises(ValueError, match="unknown method 'fast'; valid: auto, direct, integral"):
+        region_distances(bins, np.array([[1.0, 1.0, 2.0, 3.0]]), np.full((1, 4), 0.25),
+                         np.array([0]), KERNEL_UNIFORM, method="fast")
     with pytest.raises(ValueError, match="observe"):
         ColourModel("rgb").observe(np.zeros((4, 4, 3), dtype=np.uint8))
