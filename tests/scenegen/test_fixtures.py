@@ -157,7 +157,8 @@ def test_downsized_scales_geometry_and_clutter():
     assert small.entities[0].appearance.size == (15, 15)
     assert small.entities[0].position == (35.0, 60.0)
     assert small.entities[0].position_noise == pytest.approx(7.0)
-    assert small.clutter[0].count == 60 and small.clutter[0].min_size == 8
+    assert small.clutter[0].count == 60 and small.clutter[0].min_size == 4
+    assert small.clutter[0].appearance.size == (8, 8)
     assert downsized(cfg, factor=0.5, n_frames=4).clutter[0].count == 150
     for bad in ({"factor": 0.0, "n_frames": 4}, {"factor": 1.5, "n_frames": 4},
                 {"factor": 0.5, "n_frames": 0}):  # fmt: skip

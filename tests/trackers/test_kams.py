@@ -54,21 +54,25 @@ def tracked_fractions(scenegen_sequence, preset, name, seeds, **params):
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason=(
-    "measured 0/10 runs tracked to the end on kams-d (seeds 0-9; mean tracked fraction "
-    "0.15): its 600 clutter discs of the target's own palette leave 5% of the frame white, "
-    "~1 in 10 has the target's four colours in equal parts (its histogram), and the "
-    "mean-shift basin there is ~6 px against per-frame jumps of ~20-40 px (σ = 14)"))
 def test_kams_with_40_particles_tracks_kams_d_to_the_end_in_most_runs(scenegen_sequence):
+    # Measured: 8/10 runs tracked to the end on seeds 0-9 (16/20 on seeds 0-19; mean
+    # tracked fraction 0.85). The other trackers of the family track none of seeds 0-9.
     fractions = tracked_fractions(scenegen_sequence, "kams-d", "kams", range(10),
                                   n_particles=40)
     assert np.mean(fractions == 1.0) >= 0.5
 
 
+def test_kams_tracks_kams_d_to_the_end_on_three_seeds(scenegen_sequence):
+    # The fast suite's share of the test above: seeds where kams tracks to the end.
+    fractions = tracked_fractions(scenegen_sequence, "kams-d", "kams", range(3),
+                                  n_particles=40)
+    assert np.all(fractions == 1.0), fractions
+
+
 @pytest.mark.slow
 def test_kams_tracks_kams_d_longer_than_the_annealed_filter(scenegen_sequence):
     # The paper's robustness claim, with the same 40 particles and 3 layers (measured
-    # mean tracked fraction over seeds 0-7: kams 0.17, annealed 0.02).
+    # mean tracked fraction over seeds 0-7: kams 0.81, annealed 0.22).
     seeds = range(8)
     kams = tracked_fractions(scenegen_sequence, "kams-d", "kams", seeds, n_particles=40)
     annealed = tracked_fractions(scenegen_sequence, "kams-d", "annealed", seeds,

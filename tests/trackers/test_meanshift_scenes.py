@@ -7,14 +7,11 @@ target's radius (15 px: the kams target is a 30 px disc) for 5 consecutive frame
 the last frame. A shorter excursion, e.g. onto a clutter disc for a frame or two, is not a
 failure.
 
-Measured with the default parameters on kams-a, scene seed = tracker seed = 0 … 9 (runs
-tracked to the end): meanshift 3/10, sok 8/10, annealed 7/10, hybrid 9/10, kams 10/10.
-The kams clutter is drawn from the target's own four-colour palette and about one disc in
-ten has four distinct colours, i.e. the target's colour histogram exactly, so a
-colour-histogram tracker can only keep to the target by staying close to it, and plain
-mean shift, with no search beyond its window, is lost on most sequences. So the test of
-every tracker pins scene seed 7, where all of them track to the end; kams, the paper's
-claim, is tested on five seeds.
+Measured with the default parameters, scene seed = tracker seed (runs tracked to the end):
+kams-a, seeds 0–9: meanshift, sok, annealed and hybrid 10/10 each; kams 20/20 on seeds
+0–19. On the harder sequences only kams keeps up (seeds 0–9): kams-b annealed 10/10,
+sok 1/10, meanshift and hybrid 0/10; kams-c and kams-d every other tracker at most 1/10
+(kams: test_kams.py). So kams-a is tested for every tracker on three seeds here.
 """
 
 import numpy as np
@@ -35,9 +32,10 @@ def run(scenegen_sequence, preset, seed, name, **params):
     return centre_error(result.boxes[:, 0], gt)
 
 
+@pytest.mark.parametrize("seed", [0, 1, 2])
 @pytest.mark.parametrize("name", ["meanshift", "sok", "annealed", "hybrid", "kams"])
-def test_every_tracker_tracks_kams_a_to_the_end(scenegen_sequence, name):
-    error = run(scenegen_sequence, "kams-a", 7, name)
+def test_every_tracker_tracks_kams_a_to_the_end(scenegen_sequence, name, seed):
+    error = run(scenegen_sequence, "kams-a", seed, name)
     assert failure_frame(error, RADIUS) == -1
     assert np.mean(error) < 5.0
 
