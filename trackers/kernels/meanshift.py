@@ -97,14 +97,28 @@ def _chord(ex, half_w, dy2, c0, c1):
 
 
 @njit(cache=True)
-def _window(bin_img, cx, cy, w, h, kernel, hist, totals, touched):
+def _row_weights(kbuf, ca, cb, ex, inv_hw, dy2, kernel):
+    """Kernel weights of pixels ca..cb-1 of one row into kbuf[0:cb-ca]; <= 0 outside the
+    ellipse. A loop without branches on the data, so it vectorises (square roots too)."""
+    if kernel == KERNEL_CONE:
+        for c in range(ca, cb):
+            dx = (c + 0.5 - ex) * inv_hw
+            kbuf[c - ca] = 1.0 - np.sqrt(dx * dx + dy2)
+    else:
+        for c in range(ca, cb):
+            dx = (c + 0.5 - ex) * inv_hw
+            kbuf[c - ca] = 1.0 - (dx * dx + dy2)
+
+
+@njit(cache=True)
+def _window(bin_img, cx, cy, w, h, kernel, hist, totals, touched, kbuf):
     """Accumulate the kernel-weighted histogram of the window of size (w, h) centred at
     (cx, cy) into ``hist`` (zero on entry), with ``region_histograms``' pixel rule: pixel
     centres inside the box and strictly inside its ellipse, positive weight.
 
     The bins that become non-zero are listed in ``touched`` so that the distance and the
     clearing cost the window's size, not the number of bins. ``totals[0]`` receives the
-    total weight. Returns the number of touched bins.
+    total weight; ``kbuf`` (W + 2,) is scratch. Returns the number of touched bins.
     """
     rows, cols = bin_img.shape
     x = cx - 0.5 * w
@@ -123,18 +137,14 @@ def _window(bin_img, cx, cy, w, h, kernel, hist, totals, touched):
         if dy2 >= 1.0:
             continue
         ca, cb = _chord(ex, 0.5 * w, dy2, c0, c1)
+        _row_weights(kbuf, ca, cb, ex, inv_hw, dy2, kernel)
+        row = bin_img[r]
         for c in range(ca, cb):
-            dx = (c + 0.5 - ex) * inv_hw
-            r2 = dx * dx + dy2
-            if r2 >= 1.0:
+            # r² >= 1 (outside the ellipse) gives k <= 0 for both kernels.
+            k = kbuf[c - ca]
+            if k <= 0.0:
                 continue
-            if kernel == KERNEL_CONE:
-                k = 1.0 - np.sqrt(r2)
-                if k <= 0.0:
-                    continue
-            else:
-                k = 1.0 - r2
-            b = bin_img[r, c]
+            b = row[c]
             if hist[b] == 0.0:
                 touched[n] = b
                 n += 1
@@ -235,6 +245,7 @@ def _mean_shift(bin_img, models, model_index, centres, sizes, kernel, max_iter, 
     totals = np.empty(1)
     touched = np.empty(n_bins, dtype=np.int64)
     weight = np.empty(n_bins)
+    kbuf = np.empty(bin_img.shape[1] + 2)
     eps2 = eps * eps
     for p in range(n_points):
         q = models[model_index[p]]
@@ -242,7 +253,7 @@ def _mean_shift(bin_img, models, model_index, centres, sizes, kernel, max_iter, 
         h = sizes[p, 1]
         x0 = centres[p, 0]
         y0 = centres[p, 1]
-        n = _window(bin_img, x0, y0, w, h, kernel, hist, totals, touched)
+        n = _window(bin_img, x0, y0, w, h, kernel, hist, totals, touched, kbuf)
         d0 = _distance(q, hist, totals, touched, n, n_bins)
         it = 0
         while it < max_iter and d0 > min_distance and totals[0] > 0.0:
@@ -252,7 +263,7 @@ def _mean_shift(bin_img, models, model_index, centres, sizes, kernel, max_iter, 
             if sw <= 0.0:
                 break
             _clear(hist, touched, n)
-            n = _window(bin_img, x1, y1, w, h, kernel, hist, totals, touched)
+            n = _window(bin_img, x1, y1, w, h, kernel, hist, totals, touched, kbuf)
             d1 = _distance(q, hist, totals, touched, n, n_bins)
             step2 = (x1 - x0) * (x1 - x0) + (y1 - y0) * (y1 - y0)
             halvings = 0
@@ -264,7 +275,7 @@ def _mean_shift(bin_img, models, model_index, centres, sizes, kernel, max_iter, 
                 y1 = 0.5 * (y0 + y1)
                 step2 *= 0.25
                 halvings += 1
-                n = _window(bin_img, x1, y1, w, h, kernel, hist, totals, touched)
+                n = _window(bin_img, x1, y1, w, h, kernel, hist, totals, touched, kbuf)
                 d1 = _distance(q, hist, totals, touched, n, n_bins)
             if d1 > d0:
                 # The similarity stopped improving: y0 is the converged point.
