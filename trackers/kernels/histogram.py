@@ -27,6 +27,10 @@ Conventions shared by every function here (CONTRACT.md "Coordinates"):
 - Weights are summed in 32.32 fixed point (each pixel's weight rounded to 2**-32), so a
   histogram is exact to about 1e-9 of its band's total weight, and the same pixels give
   bit-identical sums in any order.
+- No function here is compiled with ``fastmath``: a reassociated floating-point sum can
+  depend on the memory alignment of its arrays (vector loops peel a different number of
+  leading elements), which broke "same inputs, same bytes" between two processes. Every
+  floating-point sum runs in a fixed order.
 """
 
 from __future__ import annotations
@@ -265,7 +269,7 @@ def _lanes(dim):
     return 4 if dim <= _SMALL_BINS else 1
 
 
-@njit(cache=True, fastmath=True)
+@njit(cache=True)
 def _cone_weights(kbuf, c0, c1, cx, inv_hw, dy2):
     """Fixed-point cone weights 1 − r of pixels c0..c1-1 of one row (vectorised loop)."""
     for c in range(c0, c1):
@@ -274,7 +278,7 @@ def _cone_weights(kbuf, c0, c1, cx, inv_hw, dy2):
         kbuf[c - c0] = np.int64(max(1.0 - np.sqrt(dx * dx + dy2), 0.0) * _ONE + 0.5)
 
 
-@njit(cache=True, fastmath=True)
+@njit(cache=True)
 def _epanechnikov_weights(kbuf, tbuf, n, wr):
     """kbuf[i] = max(wr − tbuf[i], 0) for i < n (fixed point; vectorised loop)."""
     for i in range(n):
@@ -409,7 +413,7 @@ def _region_histograms(bin_img, boxes, n_bins, kernel, n_parts, lanes):
     return out
 
 
-@njit(cache=True, fastmath=True)
+@njit(cache=True)
 def _band_rho(hist, dim, lanes, sqrt_q, nz, i0, i1, scale):
     """Σ sqrt(h_b · scale) sqrt(q_b) over the bins nz[i0:i1] (those where q_b > 0)."""
     acc = 0.0
@@ -458,7 +462,7 @@ def _band_rows(y, h, n_parts, r0, r1, bounds):
             bounds[j] = r + 1
 
 
-@njit(cache=True, fastmath=True)
+@njit(cache=True)
 def _corner_rho(i11, i01, i10, i00, sq, scale):
     """Σ_t sqrt((i11 − i01 − i10 + i00)[t] · scale) · sq[t] (vectorised loop)."""
     acc = 0.0
