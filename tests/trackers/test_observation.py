@@ -296,3 +296,37 @@ def test_kernel_rejects_bad_input():
                          np.array([0]), KERNEL_UNIFORM, method="fast")
     with pytest.raises(ValueError, match="observe"):
         ColourModel("rgb").observe(np.zeros((4, 4, 3), dtype=np.uint8))
+
+
+_DETERMINISM_SCRIPT = """
+import hashlib, sys
+import numpy as np
+junk = [np.empty(int(n)) for n in sys.argv[1:]]  # a different heap in each process
+from trackers.kernels.histogram import (KERNEL_CONE, KERNEL_EPANECHNIKOV, KERNEL_UNIFORM,
+                                        quantize_rgb, region_distances, region_histograms)
+rng = np.random.default_rng(0)
+frame = rng.integers(0, 256, (120, 160, 3), dtype=np.uint8)
+bins = quantize_rgb(frame)
+truth = np.array([[20.0, 20.0, 30.0, 30.0], [90.0, 30.0, 30.0, 30.0]])
+boxes = np.repeat(truth, 200, axis=0)
+boxes[:, :2] += rng.normal(0.0, 4.0, (400, 2))
+index = np.repeat(np.arange(2), 200)
+h = hashlib.sha256()
+for kernel in (KERNEL_UNIFORM, KERNEL_EPANECHNIKOV, KERNEL_CONE):
+    refs = region_histograms(bins, truth, 1000, kernel)
+    h.update(refs.tobytes())
+    for method in ("direct", "integral"):
+        h.update(region_distances(bins, boxes, refs, index, kernel, method=method).tobytes())
+print(h.hexdigest())
+"""
+
+
+def test_distances_are_the_same_bytes_in_another_process():
+    """Same inputs, same bytes, whatever the heap (and so the arrays' alignment) is."""
+    import subprocess
+    import sys
+
+    digests = {subprocess.run([sys.executable, "-c", _DETERMINISM_SCRIPT, *sizes],
+                              capture_output=True, text=True, check=True).stdout
+               for sizes in ([], ["1", "3", "1001"], ["17", "4099", "5"])}
+    assert len(digests) == 1, digests
