@@ -31,10 +31,12 @@ from numpy.typing import NDArray
 
 from trackers.kernels.histogram import (
     KERNELS,
+    PreparedReferences,
     hsv_n_bins,
+    prepare_references,
+    prepared_distances,
     quantize_hsv,
     quantize_rgb,
-    region_distances,
     region_histograms,
 )
 
@@ -123,7 +125,7 @@ class ColourModel:
         self.n_bins = hsv_n_bins(self.bins, self.bins, self.bins) if kind == "hsv" else (
             self.bins ** 3)
         self.dim = self.n_parts * self.n_bins
-        self.references: NDArray[np.float64] | None = None
+        self._prepared: PreparedReferences | None = None
 
     def quantize(self, frame: NDArray[np.uint8]) -> NDArray[np.int32]:
         """Bin-index image (H, W) int32 of an RGB frame (H, W, 3) uint8."""
@@ -137,6 +139,18 @@ class ColourModel:
         return region_histograms(self.quantize(frame), boxes, self.n_bins,
                                  KERNELS[self.kernel], self.n_parts)
 
+    @property
+    def references(self) -> NDArray[np.float64] | None:
+        """The objects' template histograms (K, dim), or None before ``set_references``."""
+        return None if self._prepared is None else self._prepared.refs
+
+    @references.setter
+    def references(self, refs: NDArray[np.floating]) -> None:
+        if np.shape(refs)[-1:] != (self.dim,):
+            raise ValueError(f"references must have shape (K, {self.dim}), got "
+                             f"{np.shape(refs)}")
+        self._prepared = prepare_references(refs, self.n_parts)
+
     def set_references(self, frame: NDArray[np.uint8], boxes: NDArray[np.floating]) -> None:
         """Take the histograms of ``boxes`` (K, 4) in ``frame`` as the objects' templates."""
         self.references = self.histograms(frame, boxes)
@@ -149,7 +163,7 @@ class ColourModel:
         ValueError
             If ``set_references`` was not called.
         """
-        if self.references is None:
+        if self._prepared is None:
             raise ValueError("ColourModel.observe: call set_references() first")
         return FrameObservation(self, self.quantize(frame))
 
@@ -186,8 +200,9 @@ class FrameObservation:
             d in [0, 1].
         """
         m = self.model
-        return region_distances(self.bin_img, boxes, m.references, objects,
-                                KERNELS[m.kernel], m.n_parts, check_bins=False)
+        # The bin image is the model's own quantisation of the frame: in range.
+        return prepared_distances(self.bin_img, boxes, m._prepared, objects,
+                                  KERNELS[m.kernel])
 
     def log_likelihoods(self, boxes: NDArray[np.floating], objects: NDArray[np.integer]
                         ) -> NDArray[np.float64]:

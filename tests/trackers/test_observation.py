@@ -13,6 +13,8 @@ from trackers.kernels.histogram import (
     KERNEL_UNIFORM,
     bhattacharyya_distance,
     hsv_n_bins,
+    prepare_references,
+    prepared_distances,
     quantize_hsv,
     quantize_rgb,
     region_distances,
@@ -330,3 +332,31 @@ def test_distances_are_the_same_bytes_in_another_process():
                               capture_output=True, text=True, check=True).stdout
                for sizes in ([], ["1", "3", "1001"], ["17", "4099", "5"])}
     assert len(digests) == 1, digests
+
+
+def test_prepared_distances_equal_region_distances_and_check_their_input():
+    rng = np.random.default_rng(4)
+    frame = _frame(4, 40, 50)
+    bin_img = quantize_hsv(frame)
+    n_bins = hsv_n_bins()
+    refs = rng.dirichlet(np.ones(2 * n_bins), 3) * (rng.random((3, 2 * n_bins)) > 0.5)
+    refs /= refs.sum(axis=1, keepdims=True)
+    boxes = np.column_stack([rng.uniform(-5, 45, 30), rng.uniform(-5, 35, 30),
+                             rng.uniform(2, 20, 30), rng.uniform(2, 20, 30)])
+    index = rng.integers(0, 3, 30)
+    prepared = prepare_references(refs, 2)
+    for kernel in KERNELS:
+        np.testing.assert_array_equal(
+            prepared_distances(bin_img, boxes, prepared, index, kernel),
+            region_distances(bin_img, boxes, refs, index, kernel, 2))
+    bad = boxes.copy()
+    bad[3, 2] = np.nan
+    with pytest.raises(ValueError, match="finite with positive width"):
+        prepared_distances(bin_img, bad, prepared, index, KERNEL_UNIFORM)
+    with pytest.raises(ValueError, match=r"ref_index must lie in \[0, 3\)"):
+        prepared_distances(bin_img, boxes, prepared, index + 1, KERNEL_UNIFORM)
+    with pytest.raises(ValueError, match="n_parts must be a positive divisor"):
+        prepare_references(refs, 7)
+    model = ColourModel("hsv")
+    with pytest.raises(ValueError, match=r"references must have shape \(K, 220\)"):
+        model.references = refs[:, :100]

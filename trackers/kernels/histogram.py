@@ -35,6 +35,8 @@ Conventions shared by every function here (CONTRACT.md "Coordinates"):
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
 from numpy.typing import NDArray
@@ -45,9 +47,12 @@ __all__ = [
     "KERNEL_UNIFORM",
     "KERNELS",
     "METHODS",
+    "PreparedReferences",
     "bhattacharyya_coefficient",
     "bhattacharyya_distance",
     "hsv_n_bins",
+    "prepare_references",
+    "prepared_distances",
     "quantize_hsv",
     "quantize_rgb",
     "region_distances",
@@ -780,26 +785,112 @@ def region_distances(
     >>> np.round(d, 6).tolist()
     [0.0]
     """
-    if method not in METHODS:
-        raise ValueError(f"unknown method {method!r}; valid: {', '.join(METHODS)}")
+    prepared = prepare_references(refs, n_parts)
+    img, bx, _, _, _ = _check_region_args(bin_img, boxes, prepared.n_bins, kernel,
+                                          prepared.n_parts, check_bins)
+    return prepared_distances(img, bx, prepared, ref_index, kernel, method=method)
+
+
+class PreparedReferences(NamedTuple):
+    """Reference histograms with what ``region_distances`` derives from them once.
+
+    Build with ``prepare_references``; pass to ``prepared_distances`` to score many sets
+    of boxes against the same references (a tracker, every frame) without redoing it.
+    """
+
+    refs: NDArray[np.float64]
+    """(R, n_parts * n_bins) reference histograms."""
+    sqrt_refs: NDArray[np.float64]
+    """(R, n_parts * n_bins) their square roots."""
+    nz: NDArray[np.int64]
+    """(R, n_parts * n_bins) each reference's bins with q > 0, first, in order."""
+    nz_start: NDArray[np.int64]
+    """(R, n_parts + 1) where each band's bins start in ``nz``."""
+    empty_rho: NDArray[np.float64]
+    """(R, n_parts) ρ of a band with no pixel (the uniform histogram)."""
+    n_bins: int
+    n_parts: int
+
+
+def prepare_references(refs: NDArray[np.floating], n_parts: int = 1) -> PreparedReferences:
+    """Check reference histograms and precompute their supports and square roots.
+
+    Parameters
+    ----------
+    refs : ndarray of shape (R, n_parts * n_bins)
+        Reference histograms (each summing to 1), one per object.
+    n_parts : int, optional
+        Horizontal bands, as in ``region_histograms``.
+
+    Raises
+    ------
+    ValueError
+        For a bad shape, or ``n_parts`` not dividing the number of bins.
+    """
     q = np.ascontiguousarray(refs, dtype=np.float64)
     if q.ndim != 2 or q.shape[0] < 1 or q.shape[1] < 1:
         raise ValueError(f"refs must have shape (R, n_parts * n_bins), got {q.shape}")
     if int(n_parts) != n_parts or n_parts < 1 or q.shape[1] % n_parts:
         raise ValueError(f"n_parts must be a positive divisor of refs.shape[1] = "
                          f"{q.shape[1]}, got {n_parts!r}")
-    img, bx, n_bins, kernel, n_parts = _check_region_args(bin_img, boxes,
-                                                          q.shape[1] // int(n_parts),
-                                                          kernel, n_parts, check_bins)
+    n_parts = int(n_parts)
+    nz, nz_start, empty_rho = _support(q, n_parts)
+    return PreparedReferences(q, np.sqrt(q), nz, nz_start, empty_rho, q.shape[1] // n_parts,
+                              n_parts)
+
+
+def prepared_distances(
+    bin_img: NDArray[np.integer],
+    boxes: NDArray[np.floating],
+    prepared: PreparedReferences,
+    ref_index: NDArray[np.integer],
+    kernel: int,
+    *,
+    method: str = "auto",
+) -> NDArray[np.float64]:
+    """``region_distances`` against prepared references, with the per-call checks cut to
+    what keeps the kernel in bounds.
+
+    ``bin_img`` is trusted: a contiguous uint8, uint16 or int32 (H, W) array of bin indices
+    in [0, ``prepared.n_bins``), as ``quantize_rgb`` / ``quantize_hsv`` give (an index out
+    of range reads out of bounds). Boxes must be finite with positive sizes and
+    ``ref_index`` must index ``prepared.refs``: both are checked.
+
+    Returns
+    -------
+    ndarray of shape (P,)
+        As ``region_distances``.
+
+    Raises
+    ------
+    ValueError
+        For boxes that are not (P, 4), finite and of positive size, a ``ref_index`` of the
+        wrong shape or out of range, an unknown kernel or method.
+    """
+    if method not in METHODS:
+        raise ValueError(f"unknown method {method!r}; valid: {', '.join(METHODS)}")
+    if kernel not in KERNELS.values():
+        raise ValueError(f"kernel must be one of {sorted(KERNELS.values())} "
+                         f"({', '.join(KERNELS)}), got {kernel!r}")
+    bx = np.ascontiguousarray(boxes, dtype=np.float64)
+    if bx.ndim != 2 or bx.shape[1] != 4:
+        raise ValueError(f"boxes must have shape (P, 4), got {bx.shape}")
+    # A NaN or an infinity makes the sum non-finite.
+    if bx.size and not (np.isfinite(bx.sum()) and bx[:, 2:].min() > 0):
+        raise ValueError("boxes must be finite with positive width and height")
     idx = np.ascontiguousarray(ref_index, dtype=np.int64)
+    n_refs = prepared.refs.shape[0]
     if idx.shape != (bx.shape[0],):
         raise ValueError(f"ref_index must have shape ({bx.shape[0]},), got {idx.shape}")
-    if idx.size and (idx.min() < 0 or idx.max() >= q.shape[0]):
-        raise ValueError(f"ref_index must lie in [0, {q.shape[0]}), got "
+    if idx.size and (idx.min() < 0 or idx.max() >= n_refs):
+        raise ValueError(f"ref_index must lie in [0, {n_refs}), got "
                          f"[{idx.min()}, {idx.max()}]")
-    nz, nz_start, empty_rho = _support(q, n_parts)
-    return _region_distances(img, bx, np.sqrt(q), idx, nz, nz_start, empty_rho, n_bins,
-                             kernel, n_parts, _lanes(q.shape[1]), METHODS[method])
+    return _region_distances(bin_img, bx, prepared.sqrt_refs, idx, prepared.nz,
+                             prepared.nz_start, prepared.empty_rho, prepared.n_bins,
+                             int(kernel), prepared.n_parts, _lanes(prepared.refs.shape[1]),
+                             METHODS[method])
+
+
 
 
 def bhattacharyya_coefficient(
