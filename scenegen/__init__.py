@@ -11,8 +11,8 @@ __version__ = "0.1.0"
 from scenegen import presets
 from scenegen.config import SceneConfig, from_dict, load_config
 from scenegen.errors import ConfigError, DataError
-from scenegen.generator import generate, plan
 from scenegen.io import read, write
+from scenegen.render.plan import generate, plan
 from scenegen.sequence import Entities, GroundTruth, Sequence
 
 __all__ = [

@@ -135,9 +135,18 @@ class Sequence:
         """Ids of the targets, shape (M,)."""
         return self.entities.id[self.target_indices()]
 
+    def initial_targets(self, frame: int = 0) -> NDArray[np.intp]:
+        """Indices (into K) of the targets present at ``frame``: the ones a tracker follows.
+
+        This is the one definition of "which targets are tracked": ``scenegen track``, the
+        experiments and the fixtures all start from these.
+        """
+        idx = self.target_indices()
+        return idx[np.asarray(self.gt.present[frame, idx], dtype=bool)]
+
     def init_boxes(self, frame: int = 0) -> NDArray[np.float64]:
-        """Amodal boxes (M, 4) of the targets at ``frame``: what trackers start from."""
-        return np.asarray(self.gt.box[frame, self.target_indices()], dtype=np.float64)
+        """Amodal boxes (M, 4) of :meth:`initial_targets` at ``frame``: what trackers start from."""
+        return np.asarray(self.gt.box[frame, self.initial_targets(frame)], dtype=np.float64)
 
     def __repr__(self) -> str:
         t, h, w = self.n_frames, self.height, self.width

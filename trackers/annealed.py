@@ -14,9 +14,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from trackers.base import Estimate, RngLike, Tracker
+from trackers.filters.resampling import RESAMPLERS, resample_groups
 from trackers.meanshift import ColourTargets, check_kernel_bins, keep_inside
-from trackers.observation import FrameObservation
-from trackers.resampling import RESAMPLERS, resample_groups
+from trackers.models.observation import FrameObservation
 
 __all__ = [
     "ESTIMATES",
@@ -185,7 +185,7 @@ class AnnealedPF(Tracker):
         target and a distractor (kams on kams-b, seeds 0–9: 4/10 runs tracked to the end
         with "mean", 6/10 with "mode").
     resampler : str, optional
-        Resampling method, by name (``trackers.resampling``).
+        Resampling method, by name (``trackers.filters.resampling``).
     kernel : str, optional
         Histogram kernel: ``"cone"`` (KAMS) or ``"epanechnikov"``.
     bins : int, optional

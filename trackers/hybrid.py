@@ -48,7 +48,7 @@ class HybridPF(Tracker):
     eps : float, optional
         Mean-shift stopping shift, in pixels.
     resampler : str, optional
-        Resampling method, by name (``trackers.resampling``).
+        Resampling method, by name (``trackers.filters.resampling``).
     kernel : str, optional
         ``"cone"`` (KAMS) or ``"epanechnikov"``.
     bins : int, optional

@@ -10,7 +10,7 @@ from numpy.typing import NDArray
 from trackers.annealed import AnnealedPF
 from trackers.base import RngLike
 from trackers.meanshift import check_mean_shift
-from trackers.observation import FrameObservation
+from trackers.models.observation import FrameObservation
 
 __all__ = ["KAMS"]
 

@@ -14,7 +14,7 @@ from numpy.typing import NDArray
 from trackers.base import Estimate, RngLike, Tracker
 from trackers.kernels.histogram import KERNELS
 from trackers.kernels.meanshift import MEAN_SHIFT_KERNELS, MeanShiftResult, mean_shift
-from trackers.observation import ColourModel, FrameObservation
+from trackers.models.observation import ColourModel, FrameObservation
 
 __all__ = [
     "ColourTargets",

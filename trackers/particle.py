@@ -1,8 +1,8 @@
 """Particle filters for multiple objects: Condensation, joint PF, PS and DPS (DPS paper).
 
-All four share the observation model (``trackers.observation``: colour histograms, one
+All four share the observation model (``trackers.models.observation``: colour histograms, one
 compiled call per sampling stage for every particle of every object), the AR2 dynamics of
-(u, v, a) (``trackers.dynamics``) and the resamplers (``trackers.resampling``); they
+(u, v, a) (``trackers.models.dynamics``) and the resamplers (``trackers.filters.resampling``); they
 differ only in how they sample the joint state (ALGORITHMS.md §3):
 
 - ``Condensation`` ("condensation"): one independent single-object filter per target
@@ -17,7 +17,7 @@ differ only in how they sample the joint state (ALGORITHMS.md §3):
 Every step starts by resampling the set by the previous step's weights, so after a step
 ``self.particles`` (N, K, 3) and ``self.weights`` are the weighted set that represents
 the posterior; its weighted mean per object is the estimate. ``Estimate.extras`` carries
-``uniqueness`` (K,) and ``effective_dynamics`` (K,) (``trackers.diagnostics``; the
+``uniqueness`` (K,) and ``effective_dynamics`` (K,) (``trackers.filters.diagnostics``; the
 latter averages u and v). Initialisation: the reference histograms are taken from the
 frame-0 boxes and every particle starts on its initial box with zero velocity.
 
@@ -43,10 +43,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from trackers.base import Estimate, RngLike, Tracker
-from trackers.diagnostics import effective_dynamics, uniqueness
-from trackers.dynamics import AR2, boxes_from_states, states_from_boxes
-from trackers.observation import ColourModel, FrameObservation
-from trackers.resampling import RESAMPLERS, resample, weighted_resample_groups
+from trackers.filters.diagnostics import effective_dynamics, uniqueness
+from trackers.filters.resampling import RESAMPLERS, resample, weighted_resample_groups
+from trackers.models.dynamics import AR2, boxes_from_states, states_from_boxes
+from trackers.models.observation import ColourModel, FrameObservation
 
 __all__ = [
     "ASSIGNMENTS",
@@ -89,7 +89,7 @@ class _ParticleTracker(Tracker):
     lam : float, optional
         λ of the likelihood exp(−λ d²).
     model : {"hsv", "rgb"}, optional
-        Observation model (``trackers.observation``).
+        Observation model (``trackers.models.observation``).
     bins : int, optional
         Histogram bins per colour channel.
     n_parts : int or None, optional

@@ -21,7 +21,7 @@ _REGISTRY: dict[str, str] = {
     "hybrid": "trackers.hybrid:HybridPF",
     "sok": "trackers.sok:SOK",
     "kams": "trackers.kams:KAMS",
-    "kalman": "trackers.kalman_tracker:KalmanTracker",
+    "kalman": "trackers.kalman:KalmanTracker",
     "shm": "trackers.shm:SHMTracker",
     "shm-fast": "trackers.shm:FastSHMTracker",
 }

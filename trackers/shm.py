@@ -6,10 +6,10 @@ to occlusion adaptive joint tracking" (IJCAI 2007); ALGORITHMS.md §5.
 Model (§2.2). ``M`` objects, ``L = M!`` depth orderings ``s_t`` (``self.orderings``, each
 row nearest first). ``s_t`` is a first-order Markov chain (eq. 1) that stays with
 probability ``p_stay`` and otherwise moves uniformly to another ordering (**open**). The
-joint state ``x_t`` stacks the objects' motion states (``trackers.kalman.MotionModel``,
+joint state ``x_t`` stacks the objects' motion states (``trackers.filters.kalman.MotionModel``,
 constant velocity or AR2), linear Gaussian (eq. 2). Every frame gives ``L`` hypothesized
 measurements ``y^j`` with squared-difference means ``e^{j,m}`` (§3.1,
-``trackers.layered``): under the true ordering ``j``, ``y^j = H x + v`` with
+``trackers.models.layered``): under the true ordering ``j``, ``y^j = H x + v`` with
 ``v ~ N(0, R^j)``, ``R^{j,m} = (r_floor + r_gain e^{j,m}) I₂`` (proportional to ``e``, §3.1,
 plus a floor); the other orderings' measurements are uniform (eq. 3), so they cancel.
 
@@ -71,14 +71,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from trackers.base import Estimate, RngLike, Tracker
-from trackers.kalman import KalmanFilter
-from trackers.kalman_tracker import (
+from trackers.filters.kalman import KalmanFilter
+from trackers.kalman import (
     boxes_at,
     check_noise,
     measurement_cov,
     motion_model,
 )
-from trackers.layered import LayeredMatcher, check_matcher_params, orderings
+from trackers.models.layered import LayeredMatcher, check_matcher_params, orderings
 
 __all__ = ["EVIDENCES", "FastSHMTracker", "SHMTracker", "transition_matrix"]
 
@@ -221,7 +221,7 @@ class SHMTracker(_SHMBase):
     ----------
     motion, process_std, a1, a2, velocity_std, r_gain, r_floor, search_radius, step, \
 min_visible, support, blur
-        As for ``trackers.kalman_tracker.KalmanTracker``.
+        As for ``trackers.kalman.KalmanTracker``.
     p_stay : float
         Probability that the depth ordering stays the same from one frame to the next
         (**open**). The order cannot be observed while the objects are apart and may

@@ -18,15 +18,15 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def cmd_bench(args: argparse.Namespace) -> int:
-    from scenegen.bench import format_table, run_all
     from scenegen.errors import ConfigError
+    from scenegen.lab.bench import format_table, run_all
 
     if args.repeats < 1:
         raise ConfigError(f"--repeats must be >= 1, got {args.repeats}")
     rows = run_all(args.repeats, only=args.only, log=lambda m: print(m, file=sys.stderr))
     sizes = []
-    if args.only is None or args.only in "scenegen.bench.generation":
-        from scenegen.bench.generation import sizes as measure_sizes
+    if args.only is None or args.only in "scenegen.lab.bench.generation":
+        from scenegen.lab.bench.generation import sizes as measure_sizes
 
         sizes = measure_sizes()
     if args.json:

@@ -87,8 +87,8 @@ def load_source(preset: str | None, config: Path | None) -> tuple[Any, str]:
 
 
 def cmd_generate(args: argparse.Namespace) -> int:
-    from scenegen.generator import plan
     from scenegen.io import COMPRESSIONS, write_scenario
+    from scenegen.render.plan import plan
 
     if args.compression not in COMPRESSIONS:
         raise ConfigError(
@@ -169,7 +169,7 @@ def cmd_inspect(args: argparse.Namespace) -> int:
 def cmd_validate(args: argparse.Namespace) -> int:
     import sys
 
-    from scenegen.validate import check_file
+    from scenegen.io.validate import check_file
 
     problems = check_file(args.file, isolate=True)
     if problems:
@@ -188,7 +188,7 @@ def _read(path: Path, name: str | None) -> Any:
 
 def cmd_preview(args: argparse.Namespace) -> int:
     from scenegen.io import read_result
-    from scenegen.preview import write_preview
+    from scenegen.io.preview import write_preview
 
     seq = _read(args.file, args.sequence)
     boxes = None
@@ -205,7 +205,7 @@ def cmd_preview(args: argparse.Namespace) -> int:
 
 
 def cmd_export(args: argparse.Namespace) -> int:
-    from scenegen.export import export_mot
+    from scenegen.io.export import export_mot
 
     seq = _read(args.file, args.sequence)
     export_mot(seq, args.output)

@@ -28,9 +28,9 @@ def _say(msg: str) -> None:
 def generate_presets(out: Path, seed: int) -> list[Path]:
     """Generate every preset into ``out/presets/`` with a PNG sheet and a GIF each."""
     from scenegen import presets
-    from scenegen.generator import generate
     from scenegen.io import write
-    from scenegen.preview import write_preview
+    from scenegen.io.preview import write_preview
+    from scenegen.render.plan import generate
 
     folder = out / "presets"
     folder.mkdir(parents=True, exist_ok=True)
@@ -48,7 +48,7 @@ def generate_presets(out: Path, seed: int) -> list[Path]:
 
 def cmd_demo(args: argparse.Namespace) -> int:
     from scenegen.errors import ConfigError
-    from scenegen.report import build_report, run_demo_experiments
+    from scenegen.lab.report import build_report, run_demo_experiments
 
     if args.runs < 1 or args.jobs < 1:
         raise ConfigError(f"--runs and --jobs must be >= 1, got {args.runs} and {args.jobs}")

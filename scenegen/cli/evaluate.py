@@ -27,7 +27,7 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
         target count or ids), naming the mismatch and the files.
     """
     from scenegen.errors import DataError
-    from scenegen.evaluate import evaluate, format_table, to_json
+    from scenegen.evaluation.evaluate import evaluate, format_table, to_json
     from scenegen.io import read, read_result
 
     seq = read(args.file, args.sequence)

@@ -10,7 +10,7 @@ __all__ = ["cmd_experiment", "register"]
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    from scenegen.experiments import names
+    from scenegen.lab.experiments import names
 
     p = sub.add_parser(
         "experiment",
@@ -42,7 +42,7 @@ def cmd_experiment(args: argparse.Namespace) -> int:
         Unknown experiment or method (listing the valid ones), bad --runs/--jobs/--seed,
         or an unreachable scheduler (within 10 s, naming the address).
     """
-    from scenegen.experiments import get, run_experiment
+    from scenegen.lab.experiments import get, run_experiment
 
     get(args.name)
     results = run_experiment(

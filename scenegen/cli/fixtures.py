@@ -51,7 +51,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def _count(args: argparse.Namespace) -> int:
     import trackers
-    from scenegen.fixtures import definitions
+    from scenegen.testing.fixtures import definitions
 
     n_fix = len(args.fixture) if args.fixture else len(definitions())
     n_trk = len(args.tracker) if args.tracker else len(trackers.names())
@@ -59,7 +59,8 @@ def _count(args: argparse.Namespace) -> int:
 
 
 def cmd_verify(args: argparse.Namespace) -> int:
-    from scenegen.fixtures import default_dir, verify
+    from scenegen.lab.regen import verify
+    from scenegen.testing.fixtures import default_dir
 
     folder = args.dir if args.dir is not None else default_dir()
     start = time.perf_counter()
@@ -84,7 +85,8 @@ def cmd_verify(args: argparse.Namespace) -> int:
 
 
 def cmd_regen(args: argparse.Namespace) -> int:
-    from scenegen.fixtures import default_dir, regen
+    from scenegen.lab.regen import regen
+    from scenegen.testing.fixtures import default_dir
 
     folder = args.dir if args.dir is not None else default_dir()
     with bar(_count(args), "fixtures regen", unit="run") as pb:

@@ -6,12 +6,10 @@ import argparse
 import json
 from typing import Any
 
-import numpy as np
-
 from scenegen.cli.progress import bar
-from scenegen.errors import ConfigError, DataError
+from scenegen.errors import ConfigError
 
-__all__ = ["parse_params", "register", "run_tracker"]
+__all__ = ["parse_params", "register"]
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -42,43 +40,9 @@ def parse_params(items: list[str]) -> dict[str, Any]:
     return out
 
 
-def run_tracker(seq: Any, name: str, params: dict[str, Any], seed: int, progress: Any = None):
-    """Track the targets present at frame 0 of ``seq``; returns a ``TrackerResult``."""
-    import trackers
-    from scenegen.io import TrackerResult
-
-    targets = seq.target_indices()
-    targets = targets[seq.gt.present[0, targets]]
-    if targets.size == 0:
-        raise DataError(f"sequence {seq.name!r} has no target present at frame 0")
-    init = np.asarray(seq.gt.box[0, targets], dtype=np.float64)
-    try:
-        tracker = trackers.make(name, rng=seed, **params)
-        result = trackers.track(tracker, seq.frames, init, progress=progress)
-    except DataError:
-        raise  # a damaged file (DataError is a ValueError): exit 1, not 2
-    except ValueError as err:
-        raise ConfigError(str(err)) from None
-    orderings = getattr(tracker, "orderings", None)
-    order_prob = result.extras.get("order_prob")
-    if order_prob is not None:
-        order_prob = order_prob.copy()
-        # Frame 0 is the initialisation: every ordering equally likely.
-        order_prob[0] = 1.0 / order_prob.shape[1]
-    return TrackerResult(
-        tracker=name,
-        params=params,
-        seed=seed,
-        sequence=seq.name,
-        target_ids=seq.entities.id[targets],
-        boxes=result.boxes.astype(np.float32),
-        orderings=None if orderings is None else np.asarray(orderings, dtype=np.int16),
-        order_prob=None if order_prob is None else order_prob.astype(np.float32),
-    )
-
-
 def cmd_track(args: argparse.Namespace) -> int:
     from scenegen.io import read, write_result
+    from scenegen.lab.run import run_tracker
 
     if args.seed < 0:
         raise ConfigError(f"--seed must be >= 0, got {args.seed}")

@@ -40,8 +40,8 @@ from scenegen.config import (
     to_dict,
 )
 from scenegen.errors import ConfigError
-from scenegen.generator import plan
-from scenegen.validate import check_file
+from scenegen.io.validate import check_file
+from scenegen.render.plan import plan
 
 # A small config that uses every feature: scale motion, pose variation, a mimic that
 # appears late, depth keyframes, a disappearing occluder, grid clutter in a region.

@@ -7,8 +7,8 @@ from hypothesis import strategies as st
 
 import trackers
 from trackers.annealed import survival_beta, survival_rate, weighted_estimate
-from trackers.observation import ColourModel
-from trackers.resampling import resample_groups
+from trackers.filters.resampling import resample_groups
+from trackers.models.observation import ColourModel
 
 
 def first_frames_and_boxes(scenegen_sequence, n_frames=12):

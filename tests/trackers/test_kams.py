@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import trackers
-from scenegen.metrics import centre_error, tracked_fraction
+from scenegen.evaluation.metrics import centre_error, tracked_fraction
 
 
 def sequence(scenegen_sequence, n_frames):

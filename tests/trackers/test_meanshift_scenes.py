@@ -1,7 +1,7 @@
 """The mean-shift family on the KAMS accuracy sequences (scenegen presets kams-a … kams-d).
 
 "Tracks to the end" (ALGORITHMS §4.6, "a run fails when the error stays above a
-threshold"): ``scenegen.metrics.failure_frame(error, 15, persist=5) == -1``, i.e. the
+threshold"): ``scenegen.evaluation.metrics.failure_frame(error, 15, persist=5) == -1``, i.e. the
 distance between the estimated and the true centre of the target never stays above the
 target's radius (15 px: the kams target is a 30 px disc) for 5 consecutive frames, up to
 the last frame. A shorter excursion, e.g. onto a clutter disc for a frame or two, is not a
@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 import trackers
-from scenegen.metrics import centre_error, failure_frame
+from scenegen.evaluation.metrics import centre_error, failure_frame
 
 RADIUS = 15.0
 

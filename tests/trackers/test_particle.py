@@ -7,8 +7,8 @@ import pytest
 
 import trackers
 from scenegen.config import AR2, Motion
-from scenegen.generator import generate
 from scenegen.presets import get
+from scenegen.render.plan import generate
 from trackers.particle import (
     Condensation,
     DistributedPartitionedSampling,

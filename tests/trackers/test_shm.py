@@ -9,8 +9,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import trackers
-from scenegen.metrics import box_area, intersection_area
-from trackers.layered import orderings
+from scenegen.evaluation.metrics import box_area, intersection_area
+from trackers.models.layered import orderings
 from trackers.shm import transition_matrix
 
 

@@ -1,4 +1,4 @@
-"""Properties every tracker must have, checked on scenes drawn by ``scenegen.strategies``.
+"""Properties every tracker must have, checked on scenes drawn by ``scenegen.testing.strategies``.
 
 For each name in ``trackers.names()``:
 
@@ -35,8 +35,8 @@ from hypothesis import strategies as st
 
 import trackers
 from scenegen.config import AR2, Appearance, EntitySpec, Motion, SceneConfig
-from scenegen.generator import generate
-from scenegen.strategies import boxes, scene_configs, sequences
+from scenegen.render.plan import generate
+from scenegen.testing.strategies import boxes, scene_configs, sequences
 from trackers.registry import parameters
 
 NAMES = trackers.names()

@@ -76,7 +76,7 @@ def inverse_cdf_groups(
     ----------
     weights : ndarray of shape (N,)
         Non-negative weights with a positive sum in every group (not checked here: the
-        callers in ``trackers.resampling`` validate).
+        callers in ``trackers.filters.resampling`` validate).
     sizes : ndarray of shape (C,)
         Group lengths, summing to N.
     counts : ndarray of shape (C,)

@@ -1,0 +1,742 @@
+"""HDF5 reading and writing (schema ``scenegen/1``, CONTRACT.md). The only module that
+touches files.
+
+Atomic writes
+    Every write goes through :func:`scenegen.io.atomic.atomic_path` (a temporary file in
+    the target's folder, renamed onto the target only when complete); see
+    :mod:`scenegen.io.atomic` for the naming and the clean-up of leftovers.
+
+Integrity
+    Frames, labels, ground truth and templates are stored with the Fletcher-32 checksum
+    filter (besides the chosen compression), so a flipped byte in any chunk makes reading
+    it fail instead of returning silently wrong pixels; :mod:`scenegen.io.validate` reports
+    such chunks. Read errors of damaged files surface as :class:`DataError` with one line.
+
+Lazy reads
+    Frames and labels are stored one frame per chunk, so reading a frame range costs in
+    proportion to the range; :func:`read` returns lazy arrays that read only what is
+    indexed. Writing streams a block of frames at a time (:data:`BLOCK_BYTES`) with no
+    chunk cache and a compact chunk index (:data:`LIBVER`), so memory stays bounded
+    whatever the sequence length.
+
+Concurrent readers
+    Because writers only ever rename complete files into place, a reader opens either the
+    old complete file or the new one. :func:`read` pins its lazy arrays to the version
+    whose ground truth it read (and reads again if a writer replaced the file in between);
+    an open lazy array keeps reading its version, and one reopened after the file was
+    replaced raises :class:`DataError`. HDF5 SWMR is not used: a file that another
+    program holds open for writing is refused with "is being written by another process",
+    and a temporary file is refused as "an unfinished temporary file".
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import h5py
+import numpy as np
+from numpy.typing import NDArray
+
+from scenegen.config import from_dict, to_dict
+from scenegen.errors import ConfigError, DataError
+from scenegen.io.atomic import (
+    atomic_path,
+    clean_temp_files,
+    describe_temp_file,
+    temp_file_owner,
+    temp_prefix,
+)
+from scenegen.sequence import GT_FIELDS, Entities, GroundTruth, Sequence
+
+__all__ = [
+    "BLOCK_BYTES",
+    "COMPRESSIONS",
+    "LIBVER",
+    "SCHEMA",
+    "LazyArray",
+    "TrackerResult",
+    "atomic_path",
+    "clean_temp_files",
+    "describe_open_error",
+    "describe_read_error",
+    "describe_temp_file",
+    "filter_options",
+    "frames_per_block",
+    "open_checked",
+    "read",
+    "read_result",
+    "sequence_names",
+    "temp_file_owner",
+    "temp_prefix",
+    "write",
+    "write_result",
+    "write_scenario",
+]
+
+SCHEMA = "scenegen/1"
+COMPRESSIONS = ("gzip", "lzf", "none")
+BLOCK_BYTES = 32 * 2**20
+"""Upper bound on the pixel bytes (frames + labels) of one block rendered and written at
+once: long or large sequences are written a block at a time in bounded memory."""
+
+LIBVER = ("v110", "v110")
+"""HDF5 file-format bounds of written files: readable by HDF5 1.10 and later (2016), and
+their chunk index (a fixed array) stays small whatever the frame count, so writing
+20,000 frames does not grow memory the way the 1.8 format's B-tree index does."""
+
+# Writers write whole chunks once and never read them back, so the chunk cache (8 MiB per
+# dataset by default in HDF5 2) would only hold memory: it is switched off.
+_WRITE_OPTIONS: dict[str, Any] = {"libver": LIBVER, "rdcc_nbytes": 0}
+_STR = h5py.string_dtype("utf-8")
+_BLOCK = 64  # frames per write call, at most
+_READ_ATTEMPTS = 5  # reads of a path that atomic writers keep replacing
+
+
+def _version() -> str:
+    from scenegen import __version__
+
+    return __version__
+
+
+# ---------------------------------------------------------------------------------------
+# Writing
+
+
+def filter_options(compression: str) -> dict[str, Any]:
+    """h5py dataset options for ``compression``, always with the Fletcher-32 checksum.
+
+    Parameters
+    ----------
+    compression : {'gzip', 'lzf', 'none'}
+
+    Returns
+    -------
+    dict
+        Keyword arguments for ``create_dataset``.
+
+    Raises
+    ------
+    ConfigError
+        For another compression name.
+    """
+    if compression not in COMPRESSIONS:
+        raise ConfigError(
+            f"compression must be one of {', '.join(COMPRESSIONS)}; got {compression!r}"
+        )
+    if compression == "gzip":
+        return {"compression": "gzip", "compression_opts": 4, "fletcher32": True}
+    if compression == "lzf":
+        return {"compression": "lzf", "fletcher32": True}
+    return {"fletcher32": True}
+
+
+def frames_per_block(height: int, width: int, limit: int = _BLOCK) -> int:
+    """Frames rendered and written at once: at most ``limit`` and :data:`BLOCK_BYTES`.
+
+    Parameters
+    ----------
+    height, width : int
+        Frame size in pixels.
+    limit : int
+        Upper bound on the block length.
+
+    Returns
+    -------
+    int
+        At least 1.
+    """
+    per_frame = height * width * 5  # RGB uint8 + uint16 label
+    return max(1, min(limit, BLOCK_BYTES // max(per_frame, 1)))
+
+
+def _write_header(f: h5py.File) -> None:
+    f.attrs["schema"] = SCHEMA
+    f.attrs["generator_version"] = _version()
+
+
+def _create_sequence_group(
+    f: h5py.File, seq_meta: dict[str, Any], entities: Entities, compression: str
+) -> tuple[h5py.Group, h5py.Dataset, h5py.Dataset]:
+    name = seq_meta["name"]
+    if f"sequences/{name}" in f:
+        raise ConfigError(f"two sequences are named {name!r}: names must be unique in a file")
+    g = f.require_group("sequences").create_group(name)
+    t, h, w = seq_meta["n_frames"], seq_meta["height"], seq_meta["width"]
+    g.attrs["seed"] = int(seq_meta["seed"])
+    g.attrs["config"] = json.dumps(seq_meta["config"], sort_keys=True)
+    g.attrs["preset"] = seq_meta["preset"]
+    g.attrs["n_frames"] = t
+    g.attrs["height"] = h
+    g.attrs["width"] = w
+    filt = filter_options(compression)
+    frames = g.create_dataset("frames", (t, h, w, 3), np.uint8, chunks=(1, h, w, 3), **filt)
+    labels = g.create_dataset("labels", (t, h, w), np.uint16, chunks=(1, h, w), **filt)
+    e = g.create_group("entities")
+    e.create_dataset("id", data=entities.id.astype(np.int32))
+    e.create_dataset("role", data=entities.role.astype(object), dtype=_STR)
+    e.create_dataset("name", data=entities.name.astype(object), dtype=_STR)
+    return g, frames, labels
+
+
+def _gt_shape(key: str, t: int, k: int) -> tuple[int, ...]:
+    return {"box": (t, k, 4), "visible_box": (t, k, 4), "center": (t, k, 2)}.get(key, (t, k))
+
+
+def _create_gt(g: h5py.Group, t: int, k: int, rows: int) -> dict[str, h5py.Dataset]:
+    """Empty ground-truth datasets, chunked by ``rows`` frames, checksummed."""
+    grp = g.create_group("gt")
+    out = {}
+    for key, dtype in GT_FIELDS.items():
+        shape = _gt_shape(key, t, k)
+        if k == 0:  # nothing to checksum; HDF5 chunks cannot have a zero side
+            out[key] = grp.create_dataset(key, shape, dtype)
+        else:
+            chunks = (max(1, min(rows, t)), *shape[1:])
+            out[key] = grp.create_dataset(key, shape, dtype, chunks=chunks, fletcher32=True)
+    return out
+
+
+def _write_gt(g: h5py.Group, gt: dict[str, NDArray[Any]]) -> None:
+    t, k = np.shape(gt["present"])[:2]
+    for key, ds in _create_gt(g, t, k, _BLOCK).items():
+        if ds.size:
+            ds[...] = np.asarray(gt[key], dtype=GT_FIELDS[key])
+
+
+def _write_templates(g: h5py.Group, templates: dict[int, NDArray[np.uint8]]) -> None:
+    grp = g.create_group("templates")
+    for eid, tpl in templates.items():
+        arr = np.asarray(tpl, dtype=np.uint8)
+        if arr.size:
+            grp.create_dataset(str(int(eid)), data=arr, chunks=arr.shape, fletcher32=True)
+        else:
+            grp.create_dataset(str(int(eid)), data=arr)
+
+
+def _meta(seq: Sequence) -> dict[str, Any]:
+    return {
+        "name": seq.name,
+        "seed": seq.seed,
+        "config": to_dict(seq.config),
+        "preset": seq.preset,
+        "n_frames": seq.n_frames,
+        "height": seq.height,
+        "width": seq.width,
+    }
+
+
+def write(path: str | Path, *sequences: Sequence, compression: str = "gzip") -> None:
+    """Write sequences to one HDF5 file (atomically).
+
+    Parameters
+    ----------
+    path : str or Path
+    *sequences : Sequence
+        At least one; names must be unique. Lazy frames (from :func:`read`) are copied a
+        block at a time, so memory stays bounded.
+    compression : {'gzip', 'lzf', 'none'}
+        Filter for frames and labels (one frame per chunk).
+
+    Raises
+    ------
+    ConfigError
+        No sequence, duplicate names, a bad compression or a missing folder.
+    """
+    if not sequences:
+        raise ConfigError("write needs at least one sequence")
+    filter_options(compression)
+    with atomic_path(path) as tmp, h5py.File(tmp, "w", **_WRITE_OPTIONS) as f:
+        _write_header(f)
+        for seq in sequences:
+            g, frames, labels = _create_sequence_group(f, _meta(seq), seq.entities, compression)
+            # Blocks of whole chunks: bounded memory for lazy inputs, few h5py calls.
+            block = frames_per_block(seq.height, seq.width)
+            for t in range(0, seq.n_frames, block):
+                stop = min(t + block, seq.n_frames)
+                frames[t:stop] = np.asarray(seq.frames[t:stop])
+                labels[t:stop] = np.asarray(seq.labels[t:stop])
+            _write_gt(g, seq.gt.as_dict())
+            _write_templates(g, seq.templates)
+
+
+def write_scenario(
+    path: str | Path,
+    scenario: Any,
+    *,
+    compression: str = "gzip",
+    chunk: int = _BLOCK,
+    progress: Callable[[int], None] | None = None,
+) -> None:
+    """Render ``scenario`` (:class:`scenegen.render.plan.Scenario`) straight into a file.
+
+    Frames and their ground truth are rendered and written a block at a time (at most
+    ``chunk`` frames and :data:`BLOCK_BYTES` of pixels), so memory stays bounded whatever
+    the sequence length; the file appears at ``path`` only when complete.
+
+    Parameters
+    ----------
+    path : str or Path
+    scenario : Scenario
+    compression : {'gzip', 'lzf', 'none'}
+    chunk : int
+        Upper bound on the frames rendered at once.
+    progress : callable, optional
+        Called with the number of frames written so far.
+    """
+    cfg = scenario.config
+    meta = {
+        "name": cfg.name,
+        "seed": scenario.seed,
+        "config": to_dict(cfg),
+        "preset": scenario.preset,
+        "n_frames": cfg.n_frames,
+        "height": cfg.height,
+        "width": cfg.width,
+    }
+    filter_options(compression)
+    block = frames_per_block(cfg.height, cfg.width, max(1, int(chunk)))
+    with atomic_path(path) as tmp, h5py.File(tmp, "w", **_WRITE_OPTIONS) as f:
+        _write_header(f)
+        g, frames, labels = _create_sequence_group(f, meta, scenario.entities(), compression)
+        gt = _create_gt(g, cfg.n_frames, scenario.n_entities, block)
+        for c in scenario.chunks(block):
+            stop = c.start + c.frames.shape[0]
+            # Chunk-aligned writes: h5py writes whole chunks without reading them back.
+            frames[c.start : stop] = c.frames
+            labels[c.start : stop] = c.labels
+            for key, ds in gt.items():
+                if ds.size:
+                    ds[c.start : stop] = c.gt[key]
+            if progress is not None:
+                progress(stop)
+            del c  # else this block stays alive while the next one renders: twice the memory
+        _write_templates(g, scenario.template_images())
+
+
+# ---------------------------------------------------------------------------------------
+# Reading
+
+
+def describe_open_error(path: str | Path, err: OSError) -> str:
+    """One line saying why HDF5 could not open ``path``.
+
+    Parameters
+    ----------
+    path : str or Path
+    err : OSError
+        What ``h5py.File`` raised.
+
+    Returns
+    -------
+    str
+        ``"PATH: ..."``: truncated (with the byte counts), being written by another
+        process, not HDF5 at all, or otherwise damaged.
+    """
+    p = Path(path)
+    text = str(err)
+    temp = describe_temp_file(p)
+    if temp is not None:
+        return temp
+    if "unable to lock file" in text:
+        return f"{p}: is being written by another process (the HDF5 file is locked)"
+    m = re.search(r"truncated file: eof = (\d+).*stored_eof = (\d+)", text)
+    if m:
+        return f"{p}: truncated HDF5 file ({m[1]} of {m[2]} bytes)"
+    if "file signature not found" in text:
+        return f"{p}: not an HDF5 file"
+    if "errno = 13" in text or isinstance(err, PermissionError):
+        return f"{p}: cannot read the file (permission denied)"
+    first = text.strip().splitlines()[0] if text.strip() else type(err).__name__
+    return f"{p}: not a readable HDF5 file (truncated or corrupted: {first})"
+
+
+def describe_read_error(err: BaseException) -> str:
+    """One line for an error h5py raised while reading a dataset.
+
+    Parameters
+    ----------
+    err : BaseException
+
+    Returns
+    -------
+    str
+        ``"checksum or decompression failed"`` for a damaged chunk, else the error's
+        first line.
+    """
+    text = str(err).strip().splitlines()
+    first = text[0] if text else type(err).__name__
+    if "filter returned failure" in first:
+        return "checksum or decompression failed"
+    return first
+
+
+def _stamp(f: h5py.File) -> tuple[int, int, int]:
+    """Identity of the file actually open (inode, size, mtime): atomic writers replace a
+    path with a new inode, so a stamp tells which version of a path was read."""
+    try:
+        st = os.fstat(f.id.get_vfd_handle())
+    except (OSError, TypeError, ValueError, RuntimeError):  # a driver without a descriptor
+        st = os.stat(f.filename)
+    return st.st_ino, st.st_size, st.st_mtime_ns
+
+
+class _Replaced(DataError):
+    """The path now names another file than the one read first."""
+
+
+def _key_text(key: Any) -> str:
+    if isinstance(key, slice):
+        return f"{'' if key.start is None else key.start}:{'' if key.stop is None else key.stop}"
+    if isinstance(key, tuple):
+        return ", ".join(_key_text(k) for k in key)
+    return "..." if key is Ellipsis else str(key)
+
+
+class LazyArray:
+    """A read-only view of an HDF5 dataset that reads only what is indexed.
+
+    Supports ``shape``, ``dtype``, ``len()``, integer/slice indexing and ``np.asarray``.
+    The file is opened on first access and reopened after pickling, so lazy arrays can be
+    sent to worker processes. Reopening checks that the file is still the one first
+    opened (atomic writers replace files whole), and a damaged chunk raises
+    :class:`DataError` naming the file, dataset and index.
+
+    Parameters
+    ----------
+    path : str or Path
+    dataset : str
+        Path of the dataset inside the file.
+    stamp : tuple of int, optional
+        Identity (inode, size, mtime) of the file version this array must read; by
+        default the version found when it is first opened.
+
+    Raises
+    ------
+    DataError
+        When the file cannot be opened, is not the expected version, or a read fails.
+    """
+
+    def __init__(
+        self, path: str | Path, dataset: str, *, stamp: tuple[int, int, int] | None = None
+    ) -> None:
+        self.path = str(path)
+        self.dataset = dataset
+        self._file: h5py.File | None = None
+        self._stamp = stamp
+        ds = self._ds()
+        self.shape: tuple[int, ...] = tuple(ds.shape)
+        self.dtype = ds.dtype
+
+    def _ds(self) -> h5py.Dataset:
+        if self._file is None or not self._file.id.valid:
+            if not os.path.exists(self.path):
+                raise DataError(f"{self.path}: no longer exists")
+            try:
+                f = h5py.File(self.path, "r")
+            except OSError as err:
+                raise DataError(describe_open_error(self.path, err)) from None
+            stamp = _stamp(f)
+            if self._stamp is not None and stamp != self._stamp:
+                f.close()
+                raise _Replaced(
+                    f"{self.path}: the file was replaced or changed since it was read; "
+                    "read it again"
+                )
+            self._file, self._stamp = f, stamp
+        return self._file[self.dataset]
+
+    def __getstate__(self) -> dict[str, Any]:
+        state = self.__dict__.copy()
+        state["_file"] = None
+        return state
+
+    def __len__(self) -> int:
+        return self.shape[0]
+
+    @property
+    def ndim(self) -> int:
+        return len(self.shape)
+
+    def _get(self, key: Any) -> NDArray[Any]:
+        try:
+            return self._ds()[key]
+        except (OSError, RuntimeError) as err:
+            raise DataError(
+                f"{self.path}: {self.dataset}[{_key_text(key)}] is unreadable "
+                f"(damaged file: {describe_read_error(err)})"
+            ) from None
+
+    def __getitem__(self, key: Any) -> NDArray[Any]:
+        return self._get(key)
+
+    def __array__(self, dtype: Any = None, copy: Any = None) -> NDArray[Any]:
+        arr = self._get(())
+        return arr if dtype is None else arr.astype(dtype)
+
+    def __iter__(self) -> Iterator[NDArray[Any]]:
+        for t in range(self.shape[0]):
+            yield self[t]
+
+    def close(self) -> None:
+        if self._file is not None:
+            self._file.close()
+            self._file = None
+
+    def __repr__(self) -> str:
+        return f"LazyArray({self.path!r}, {self.dataset!r}, shape={self.shape}, dtype={self.dtype})"
+
+
+def open_checked(path: str | Path) -> h5py.File:
+    """Open an HDF5 file for reading and check its schema.
+
+    Parameters
+    ----------
+    path : str or Path
+
+    Returns
+    -------
+    h5py.File
+        Open for reading; the caller closes it.
+
+    Raises
+    ------
+    DataError
+        If the file is missing, a folder, a temporary file of an unfinished write, not
+        HDF5, truncated, being written by another process, or of another schema.
+    """
+    p = Path(path)
+    if not p.exists():
+        raise DataError(f"{p}: no such file")
+    if p.is_dir():
+        raise DataError(f"{p}: is a folder, not a scenegen file")
+    temp = describe_temp_file(p)
+    if temp is not None:  # incomplete by construction, even when HDF5 could open it
+        raise DataError(temp)
+    try:
+        f = h5py.File(p, "r")
+    except OSError as err:
+        raise DataError(describe_open_error(p, err)) from None
+    try:
+        schema = f.attrs.get("schema")
+    except (OSError, RuntimeError, KeyError):
+        f.close()
+        raise DataError(f"{p}: damaged HDF5 file (unreadable attributes)") from None
+    if isinstance(schema, bytes):
+        schema = schema.decode(errors="replace")
+    if schema != SCHEMA:
+        f.close()
+        if schema is None:
+            raise DataError(f"{p}: missing schema attribute (expected {SCHEMA!r})")
+        raise DataError(f"{p}: schema is {schema!r}, expected {SCHEMA!r}")
+    return f
+
+
+def sequence_names(path: str | Path) -> list[str]:
+    """Names of the sequences in a file.
+
+    Parameters
+    ----------
+    path : str or Path
+
+    Returns
+    -------
+    list of str
+    """
+    with open_checked(path) as f:
+        return list(f.get("sequences", {}).keys())
+
+
+def _str_array(ds: h5py.Dataset) -> NDArray[np.str_]:
+    return np.array([v.decode() if isinstance(v, bytes) else str(v) for v in ds[()]], dtype=str)
+
+
+def read(path: str | Path, name: str | None = None) -> Sequence:
+    """Read one sequence; frames and labels stay on disk as :class:`LazyArray`.
+
+    Parameters
+    ----------
+    path : str or Path
+    name : str, optional
+        The sequence to read; required when the file holds several.
+
+    Returns
+    -------
+    Sequence
+        Ground truth, entities and templates in memory (O(T K)); pixels lazy, pinned to
+        the same version of the file (if a writer replaces it meanwhile, the lazy arrays
+        keep reading the version whose ground truth was read).
+
+    Raises
+    ------
+    DataError
+        If the file is not a valid scenegen file, is damaged, or has no such sequence.
+    """
+    for _ in range(_READ_ATTEMPTS - 1):
+        try:
+            return _read_once(Path(path), name)
+        except _Replaced:  # replaced by an atomic writer between two opens: read again
+            continue
+    return _read_once(Path(path), name)
+
+
+def _read_once(p: Path, name: str | None) -> Sequence:
+    with open_checked(p) as f:
+        stamp = _stamp(f)
+        seqs = list(f.get("sequences", {}).keys())
+        if not seqs:
+            raise DataError(f"{p}: holds no sequences")
+        if name is None:
+            if len(seqs) > 1:
+                raise DataError(f"{p}: holds {len(seqs)} sequences; name one of {', '.join(seqs)}")
+            name = seqs[0]
+        if name not in seqs:
+            raise DataError(f"{p}: no sequence {name!r}; it holds {', '.join(seqs)}")
+        g = f[f"sequences/{name}"]
+        try:
+            config = from_dict(json.loads(g.attrs["config"]))
+            entities = Entities(
+                id=g["entities/id"][()].astype(np.int32),
+                role=_str_array(g["entities/role"]),
+                name=_str_array(g["entities/name"]),
+            )
+            gt = GroundTruth(**{k: g[f"gt/{k}"][()].astype(dt) for k, dt in GT_FIELDS.items()})
+            templates = {int(k): v[()] for k, v in g["templates"].items()}
+            seed, preset = int(g.attrs["seed"]), str(g.attrs["preset"])
+            frames = LazyArray(p, f"sequences/{name}/frames", stamp=stamp)
+            labels = LazyArray(p, f"sequences/{name}/labels", stamp=stamp)
+        except _Replaced:
+            raise
+        except (KeyError, ValueError, TypeError, OSError, RuntimeError, ConfigError) as err:
+            raise DataError(
+                f"{p}: sequence {name!r} is damaged: {describe_read_error(err)}"
+            ) from None
+    return Sequence(
+        name=name,
+        seed=seed,
+        config=config,
+        preset=preset,
+        frames=frames,
+        labels=labels,
+        entities=entities,
+        gt=gt,
+        templates=templates,
+    )
+
+
+# ---------------------------------------------------------------------------------------
+# Tracker result files
+
+
+@dataclass
+class TrackerResult:
+    """One tracker's result in a result file.
+
+    Attributes
+    ----------
+    tracker : str
+    params : dict
+    seed : int
+    sequence : str
+        The name of the sequence tracked.
+    target_ids : ndarray of shape (M,), int32
+    boxes : ndarray of shape (T, M, 4), float32
+    orderings : ndarray of shape (L, M), int16, or None
+        SHM trackers only: target positions nearest first, one row per ordering.
+    order_prob : ndarray of shape (T, L), float32, or None
+    """
+
+    tracker: str
+    params: dict[str, Any]
+    seed: int
+    sequence: str
+    target_ids: NDArray[np.int32]
+    boxes: NDArray[np.float32]
+    orderings: NDArray[np.int16] | None = None
+    order_prob: NDArray[np.float32] | None = None
+
+
+def write_result(path: str | Path, *results: TrackerResult) -> None:
+    """Write tracker results to a result file (atomically), one group per tracker.
+
+    Parameters
+    ----------
+    path : str or Path
+    *results : TrackerResult
+        At least one; at most one per tracker name.
+
+    Raises
+    ------
+    ConfigError
+        No result, two results of one tracker, or a missing folder.
+    """
+    if not results:
+        raise ConfigError("write_result needs at least one result")
+    with atomic_path(path) as tmp, h5py.File(tmp, "w", **_WRITE_OPTIONS) as f:
+        _write_header(f)
+        root = f.create_group("results")
+        for r in results:
+            if r.tracker in root:
+                raise ConfigError(f"two results for tracker {r.tracker!r} in one file")
+            g = root.create_group(r.tracker)
+            g.attrs["tracker"] = r.tracker
+            g.attrs["params"] = json.dumps(r.params, sort_keys=True, default=str)
+            g.attrs["seed"] = int(r.seed)
+            g.attrs["sequence"] = r.sequence
+            g.create_dataset("target_ids", data=np.asarray(r.target_ids, dtype=np.int32))
+            g.create_dataset("boxes", data=np.asarray(r.boxes, dtype=np.float32))
+            if r.orderings is not None and r.order_prob is not None:
+                g.create_dataset("orderings", data=np.asarray(r.orderings, dtype=np.int16))
+                g.create_dataset("order_prob", data=np.asarray(r.order_prob, dtype=np.float32))
+
+
+def read_result(path: str | Path, tracker: str | None = None) -> TrackerResult:
+    """Read one tracker's result (the only one if ``tracker`` is None).
+
+    Parameters
+    ----------
+    path : str or Path
+    tracker : str, optional
+
+    Returns
+    -------
+    TrackerResult
+
+    Raises
+    ------
+    DataError
+        If the file is not a result file, is damaged, or has no (or several, unnamed)
+        results.
+    """
+    p = Path(path)
+    with open_checked(p) as f:
+        if "results" not in f or not len(f["results"]):
+            raise DataError(f"{p}: holds no tracker results")
+        names = list(f["results"].keys())
+        if tracker is None:
+            if len(names) > 1:
+                raise DataError(f"{p}: holds results of {', '.join(names)}; name one")
+            tracker = names[0]
+        if tracker not in names:
+            raise DataError(f"{p}: no result for tracker {tracker!r}; it holds {', '.join(names)}")
+        g = f[f"results/{tracker}"]
+        try:
+            return TrackerResult(
+                tracker=str(g.attrs["tracker"]),
+                params=json.loads(g.attrs["params"]),
+                seed=int(g.attrs["seed"]),
+                sequence=str(g.attrs["sequence"]),
+                target_ids=g["target_ids"][()].astype(np.int32),
+                boxes=g["boxes"][()].astype(np.float32),
+                orderings=g["orderings"][()] if "orderings" in g else None,
+                order_prob=g["order_prob"][()] if "order_prob" in g else None,
+            )
+        except (KeyError, ValueError, TypeError, OSError, RuntimeError) as err:
+            raise DataError(
+                f"{p}: result {tracker!r} is damaged: {describe_read_error(err)}"
+            ) from None

@@ -1,0 +1,123 @@
+"""Benchmark rows of the generator and of HDF5 writing.
+
+Baselines measured in the same run: a plain numpy compositor (per entity, boolean-mask
+assignment) for rendering, and h5py writing the same arrays with the same filter for I/O.
+"""
+
+from __future__ import annotations
+
+import tempfile
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+from scenegen import presets
+from scenegen.io import COMPRESSIONS, filter_options, write, write_scenario
+from scenegen.lab.bench.core import BenchRow, median_time
+from scenegen.render.plan import generate, plan
+
+__all__ = ["numpy_render", "run", "sizes"]
+
+
+def numpy_render(scn) -> np.ndarray:
+    """Reference compositor in plain numpy: every entity, every frame, back to front."""
+    t_n, k_n = scn.cx.shape
+    h, w = scn.config.height, scn.config.width
+    out = np.empty((t_n, h, w, 3), dtype=np.uint8)
+    for t in range(t_n):
+        img = scn.background.copy()
+        for k in np.argsort(-scn.depth_value[t], kind="stable"):
+            if not scn.alive[t, k]:
+                continue
+            tpl = scn.templates[k]
+            th, tw = tpl.shape[:2]
+            x0 = int(np.floor(scn.cx[t, k] - tw / 2 + 0.5))
+            y0 = int(np.floor(scn.cy[t, k] - th / 2 + 0.5))
+            r0, r1 = max(0, y0), min(h, y0 + th)
+            c0, c1 = max(0, x0), min(w, x0 + tw)
+            if r0 >= r1 or c0 >= c1:
+                continue
+            sub = tpl[r0 - y0 : r1 - y0, c0 - x0 : c1 - x0]
+            mask = sub[..., 3] > 0
+            img[r0:r1, c0:c1][mask] = sub[..., :3][mask]
+        out[t] = img
+    return out
+
+
+def run(repeats: int = 5) -> list[BenchRow]:
+    rows: list[BenchRow] = []
+    for preset, goal in (("kams-d", 2000.0), ("dps-synthetic", 1000.0)):
+        t_n = presets.get(preset).n_frames
+        ours = median_time(lambda p=preset: generate(p, seed=0), repeats)
+        scn = plan(presets.get(preset), 0, preset=preset)
+        base = median_time(lambda s=scn: numpy_render(s), max(1, repeats // 2))
+        group = f"generate {preset} ({t_n} frames, file I/O excluded)"
+        name_b = "numpy compositor (baseline)"
+        rows.append(BenchRow(group, name_b, base / t_n, t_n / base, "frames/s"))
+        rows.append(
+            BenchRow(
+                group, "scenegen.generate", ours / t_n, t_n / ours, "frames/s",
+                baseline=name_b, ratio=base / ours,
+                goal=f">= {goal:.0f} frames/s", met=t_n / ours >= goal,
+            )
+        )  # fmt: skip
+    seq = generate("kams-d", seed=0)
+    t_n = seq.n_frames
+    with tempfile.TemporaryDirectory() as d:
+        for comp in COMPRESSIONS:
+            filt = filter_options(comp)
+
+            def raw(filt=filt):
+                # The same content written with plain h5py calls: frames and labels with
+                # the filter, ground truth and one dataset per template.
+                with h5py.File(Path(d) / "raw.h5", "w") as f:
+                    for key in ("frames", "labels"):
+                        arr = getattr(seq, key)
+                        f.create_dataset(key, data=arr, chunks=(1, *arr.shape[1:]), **filt)
+                    for key, arr in seq.gt.as_dict().items():
+                        f.create_dataset(f"gt/{key}", data=arr)
+                    for eid, tpl in seq.templates.items():
+                        f.create_dataset(f"templates/{eid}", data=tpl)
+
+            def ours(comp=comp):
+                write(Path(d) / "ours.h5", seq, compression=comp)
+
+            b = median_time(raw, max(1, repeats // 2))
+            o = median_time(ours, max(1, repeats // 2))
+            group = f"write kams-d (frames, labels, gt, 601 templates), {comp}"
+            name_b = "plain h5py, same content (baseline)"
+            rows.append(BenchRow(group, name_b, b / t_n, t_n / b, "frames/s"))
+            rows.append(
+                BenchRow(
+                    group, "scenegen.write (atomic)", o / t_n, t_n / o,
+                    "frames/s", baseline=name_b, ratio=b / o,
+                    goal="~1x baseline (no more than h5py's own cost)", met=b / o >= 0.8,
+                )
+            )  # fmt: skip
+    return rows
+
+
+def sizes() -> list[dict[str, object]]:
+    """Stored size of frames and labels per compression, for a noisy and a clean preset."""
+    out = []
+    with tempfile.TemporaryDirectory() as d:
+        for preset in ("dps-synthetic", "kams-d", "shm-crossing"):
+            seq = generate(preset, seed=0)
+            raw_frames, raw_labels = seq.frames.nbytes, seq.labels.nbytes
+            for comp in COMPRESSIONS:
+                path = Path(d) / f"{preset}-{comp}.h5"
+                write_scenario(path, plan(seq.config, 0, preset=preset), compression=comp)
+                with h5py.File(path) as f:
+                    g = f[f"sequences/{seq.name}"]
+                    fr = g["frames"].id.get_storage_size()
+                    lb = g["labels"].id.get_storage_size()
+                out.append(
+                    {
+                        "preset": preset,
+                        "compression": comp,
+                        "frames_ratio": raw_frames / fr,
+                        "labels_ratio": raw_labels / lb,
+                    }
+                )
+    return out

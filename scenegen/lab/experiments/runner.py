@@ -1,0 +1,459 @@
+"""Running an experiment's seeded runs on local processes or a Dask cluster, resumably.
+
+Every run is a :class:`Task`: (experiment, method, preset, swept value, run index) plus the
+base seed and the quick flag. Its seeds come from a SHA-256 hash of that key (never
+Python's ``hash``), so a run gives the same numbers whichever process or machine runs it.
+The worker generates the run's sequence itself (cached per process), runs the tracker and
+returns a small record of per-frame measures with floats rounded to fixed decimals. The
+parent stores each record as it arrives (one JSON file per run under ``DIR/runs/``,
+written to a temporary file in that folder and renamed into place), so running the same
+command again skips finished runs; a Dask worker lost mid-sweep only loses the task it was
+running, which the scheduler retries.
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import json
+import os
+from collections.abc import Callable, Iterable
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import asdict, dataclass
+from multiprocessing import get_context
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from scenegen.errors import ConfigError
+from scenegen.lab.experiments.definitions import Experiment, get
+
+__all__ = [
+    "SCHEDULER_TIMEOUT",
+    "Task",
+    "derive_seed",
+    "execute",
+    "load_record",
+    "plan_tasks",
+    "run_task",
+    "tracker_params",
+    "write_json_atomic",
+]
+
+SCHEDULER_TIMEOUT = 5.0
+"""Seconds to wait for a Dask scheduler before giving up (the contract allows 10)."""
+
+_DECIMALS = 6
+_MIN_OVERLAP = 0.1  # pairs overlapping less than this say nothing about depth order
+
+
+def derive_seed(*parts: Any) -> int:
+    """A 63-bit seed from the key ``parts``, stable across processes, runs and machines.
+
+    The parts are joined as text, hashed with SHA-256 and fed to ``np.random.SeedSequence``.
+
+    Example
+    -------
+    >>> derive_seed("dps-synthetic", "dps", "lam=20.0", 3) == derive_seed(
+    ...     "dps-synthetic", "dps", "lam=20.0", 3)
+    True
+    """
+    digest = hashlib.sha256("\x1f".join(str(p) for p in parts).encode("utf-8")).digest()
+    words = np.frombuffer(digest, dtype="<u4").tolist()
+    return int(np.random.SeedSequence(words).generate_state(1, dtype=np.uint64)[0] >> 1)
+
+
+@dataclass(frozen=True)
+class Task:
+    """One seeded run of one method on one sequence.
+
+    Attributes
+    ----------
+    experiment, method, preset : str
+        Names (``method`` is the method's slug).
+    param : str
+        The swept parameter ("" without a sweep).
+    value : float or None
+        Its value.
+    run : int
+        Run index r = 0..R-1.
+    seed : int
+        The experiment's base seed (``--seed``).
+    quick : bool
+        Scaled-down mode (fewer frames or particles).
+    """
+
+    experiment: str
+    method: str
+    preset: str
+    param: str
+    value: float | None
+    run: int
+    seed: int
+    quick: bool
+
+    @property
+    def sweep_label(self) -> str:
+        return f"{self.param}={self.value:g}" if self.param else ""
+
+    def scene_seed(self, exp: Experiment) -> int:
+        """Seed of the run's sequence: shared by every method (runs are paired)."""
+        which = self.run if exp.scene_per_run else "all"
+        return derive_seed(self.seed, self.experiment, "scene", self.preset, which)
+
+    def tracker_seed(self) -> int:
+        """Seed of the tracker's random stream for this run."""
+        return derive_seed(
+            self.seed, self.experiment, self.method, self.preset, self.sweep_label, self.run
+        )
+
+    def filename(self) -> str:
+        sweep = f"__{self.param}{self.value:g}" if self.param else ""
+        return f"{self.method}__{self.preset}{sweep}__r{self.run:03d}.json"
+
+    def key(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+def plan_tasks(
+    exp: Experiment,
+    *,
+    runs: int,
+    seed: int,
+    quick: bool,
+    methods: Iterable[str] | None = None,
+    values: Iterable[float] | None = None,
+) -> list[Task]:
+    """Every task of an experiment, in a fixed order.
+
+    ``methods`` (slugs or labels) and ``values`` (of the swept parameter) restrict the
+    sweep; by default every method runs at every value.
+
+    Raises
+    ------
+    ConfigError
+        For runs < 1, a negative seed, an unknown method or a value outside the sweep
+        (listing the valid ones).
+    """
+    if runs < 1:
+        raise ConfigError(f"runs must be >= 1, got {runs}")
+    if seed < 0:
+        raise ConfigError(f"seed must be a non-negative integer, got {seed}")
+    chosen = [exp.method(m) for m in methods] if methods else list(exp.methods)
+    sweep = exp.sweep_values(quick)
+    if values is not None:
+        wanted = [float(v) for v in values]
+        valid = [v for _, v in exp.sweep_values(False) if v is not None]
+        for v in wanted:
+            if v not in valid:
+                raise ConfigError(
+                    f"value {v:g} is not in the sweep of experiment {exp.name!r}; valid "
+                    f"values: {', '.join(f'{x:g}' for x in valid) or 'none (no sweep)'}"
+                )
+        sweep = [(p, v) for p, v in exp.sweep_values(False) if v in wanted]
+    tasks = []
+    for m in chosen:
+        for param, value in sweep:
+            for r in range(runs):
+                presets = [exp.presets[r % len(exp.presets)]] if exp.scene_per_run else list(
+                    exp.presets
+                )
+                for preset in presets:
+                    v = None if value is None else float(value)
+                    tasks.append(Task(exp.name, m.slug, preset, param, v, r, seed, quick))
+    return tasks
+
+
+@functools.lru_cache(maxsize=4)
+def _sequence(preset: str, seed: int, frames: int | None) -> Any:
+    import scenegen
+
+    return scenegen.generate(preset, seed=seed, frames=frames)
+
+
+def _round(x: Any) -> Any:
+    """Round floats (recursively) to fixed decimals; NaN and inf become None."""
+    if isinstance(x, dict):
+        return {str(k): _round(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_round(v) for v in x]
+    if isinstance(x, np.ndarray):
+        return _round(x.tolist())
+    if isinstance(x, (bool, np.bool_)):
+        return bool(x)
+    if isinstance(x, (int, np.integer)):
+        return int(x)
+    if isinstance(x, (float, np.floating)):
+        f = float(x)
+        return round(f, _DECIMALS) if np.isfinite(f) else None
+    return x
+
+
+def tracker_params(exp: Experiment, task: Task) -> dict[str, Any]:
+    """The keyword parameters of the task's tracker (without ``rng``)."""
+    params = exp.method(task.method).param_dict()
+    if task.param:
+        params[task.param] = task.value
+    if task.quick and "n_particles" in params:
+        params["n_particles"] = min(int(params["n_particles"]), exp.quick_particles)
+    return params
+
+
+def run_task(task: Task) -> dict[str, Any]:
+    """Run one task and return its record (JSON-ready, floats rounded).
+
+    The record holds the task's key, seeds, tracker and parameters, and per target the
+    per-frame track state, precision, recall, IoU and centre error; PF trackers add mean
+    uniqueness and effective dynamics per target, SHM trackers the ordering probabilities,
+    the true ordering per frame and the depth-order accuracy. Numba kernels run on one
+    thread here, so results do not depend on the executor.
+    """
+    from scenegen.evaluation import metrics
+    from scenegen.evaluation.evaluate import failure_threshold, frame_measures
+    from scenegen.lab.run import run
+
+    exp = get(task.experiment)
+    frames = exp.quick_frames if task.quick else None
+    seq = _sequence(task.preset, task.scene_seed(exp), frames)
+    params = tracker_params(exp, task)
+    method = exp.method(task.method)
+    done = run(seq, method.tracker, params, task.tracker_seed(), single_thread=True)
+    idx = done.targets
+    gt = np.asarray(seq.gt.box[:, idx], dtype=np.float64)
+    fm = frame_measures(np.asarray(done.result.boxes, dtype=np.float64), gt)
+    present = np.all(np.isfinite(gt), axis=-1)
+    names = np.asarray(seq.entities.name)[idx]
+    targets = []
+    for m in range(len(idx)):
+        state: list[int | None] = [
+            int(s) if p else None for s, p in zip(fm["state"][:, m], present[:, m], strict=True)
+        ]
+        targets.append(
+            {
+                "name": str(names[m]),
+                "state": state,
+                "precision": fm["precision"][:, m],
+                "recall": fm["recall"][:, m],
+                "iou": fm["iou"][:, m],
+                "centre_error": fm["centre_error"][:, m],
+            }
+        )
+    record: dict[str, Any] = {
+        "key": task.key(),
+        "tracker": method.tracker,
+        "params": params,
+        "scene_seed": task.scene_seed(exp),
+        "tracker_seed": task.tracker_seed(),
+        "n_frames": int(gt.shape[0]),
+        "failure_threshold": failure_threshold(gt),
+        "targets": targets,
+    }
+    extras = done.extras
+    if "uniqueness" in extras:
+        record["uniqueness"] = metrics.uniqueness_percent(extras["uniqueness"])
+    if "effective_dynamics" in extras:
+        ed = np.asarray(extras["effective_dynamics"], dtype=np.float64)
+        record["effective_dynamics"] = metrics.effective_dynamics_percent(
+            ed, components=ed.ndim == 3
+        )
+    orderings = getattr(done.tracker, "orderings", None)
+    if "order_prob" in extras and orderings is not None:
+        depth = np.asarray(seq.gt.depth)[:, idx]
+        record["order_prob"] = extras["order_prob"]
+        record["orderings"] = np.asarray(orderings).astype(int)
+        record["true_order"] = metrics.ordering_index(depth, orderings)
+        record["depth_order_accuracy"] = metrics.depth_order_accuracy(
+            extras["order_prob"], orderings, depth, gt, min_overlap=_MIN_OVERLAP
+        )
+        over = metrics.overlap_fraction(gt[:, :, None, :], gt[:, None, :, :])
+        off_diagonal = ~np.eye(len(idx), dtype=bool)
+        record["overlap"] = np.any((over >= _MIN_OVERLAP) & off_diagonal, axis=(1, 2))
+    return _round(record)
+
+
+def write_json_atomic(path: Path, data: Any, *, indent: int | None = None) -> None:
+    """Write ``data`` as JSON (sorted keys, no NaN) to ``path`` atomically.
+
+    Uses :func:`scenegen.io.atomic_path`: a temporary file in the same folder, flushed and
+    renamed into place, so a killed process never leaves a half-written file there.
+    """
+    from scenegen.io import atomic_path
+
+    text = json.dumps(data, sort_keys=True, allow_nan=False, indent=indent,
+                      separators=(",", ":") if indent is None else (",", ": "))
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with atomic_path(path, ".json") as tmp:
+        tmp.write_text(text + "\n", encoding="utf-8")
+
+
+def load_record(path: Path, task: Task) -> dict[str, Any] | None:
+    """The stored record of ``task`` at ``path``, or None if missing, unreadable or stale.
+
+    Stale means stored for another key (experiment, method, preset, value, run, seed,
+    quick) or with other tracker parameters.
+    """
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    if not isinstance(data, dict) or data.get("key") != _round(task.key()):
+        return None
+    # Parameters changed since the run was stored (a new version of the experiment).
+    if data.get("params") != _round(tracker_params(get(task.experiment), task)):
+        return None
+    return data
+
+
+async def _identity(address: str) -> dict[str, Any]:
+    from distributed.comm import connect
+
+    comm = await connect(address, timeout=SCHEDULER_TIMEOUT)
+    try:
+        await comm.write({"op": "identity", "reply": True})
+        return await comm.read()
+    finally:
+        await comm.close()
+
+
+def _probe(address: str) -> None:
+    """Check within :data:`SCHEDULER_TIMEOUT` seconds that a Dask scheduler answers.
+
+    Done before creating a ``Client``, whose failed construction can hang for longer (and
+    whose clean-up on garbage collection waits another 10 s).
+    """
+    import asyncio
+
+    try:
+        reply = asyncio.run(asyncio.wait_for(_identity(address), SCHEDULER_TIMEOUT))
+    except Exception as err:  # any failure to talk to it means: not a usable scheduler
+        why = (
+            "the peer does not speak the Dask protocol"
+            if isinstance(err, MemoryError)
+            else f"{type(err).__name__}: {str(err).splitlines()[0] if str(err) else 'no reply'}"
+        )
+        raise ConfigError(
+            f"cannot reach the Dask scheduler at {address!r} within {SCHEDULER_TIMEOUT:g} s: "
+            f"{why}"
+        ) from None
+    if not isinstance(reply, dict) or reply.get("type") != "Scheduler":
+        raise ConfigError(f"{address!r} answered, but it is not a Dask scheduler")
+
+
+def _connect(address: str) -> Any:
+    from distributed import Client
+
+    _probe(address)
+    try:
+        return Client(address, timeout=SCHEDULER_TIMEOUT, set_as_default=False)
+    except Exception as err:
+        raise ConfigError(
+            f"cannot reach the Dask scheduler at {address!r} within {SCHEDULER_TIMEOUT:g} s: "
+            f"{type(err).__name__}: {err}"
+        ) from None
+
+
+def execute(
+    tasks: list[Task],
+    runs_dir: Path,
+    *,
+    jobs: int | None = None,
+    scheduler: str | None = None,
+    progress: bool = True,
+    on_done: Callable[[Task], None] | None = None,
+) -> list[dict[str, Any]]:
+    """Run the tasks not yet stored under ``runs_dir`` and return every task's record.
+
+    Parameters
+    ----------
+    tasks : list of Task
+    runs_dir : Path
+        One JSON file per finished run; existing valid files are reused, not rerun.
+    jobs : int or None
+        Local worker processes (None: all cores; 1 runs in this process).
+    scheduler : str or None
+        Address of a ``dask.distributed`` scheduler; tasks then run on its workers (each
+        retried up to 3 times if a worker is lost).
+    progress : bool
+        Show a tqdm progress bar (on stderr).
+    on_done : callable, optional
+        Called with each task when its record has been stored.
+
+    Returns
+    -------
+    list of dict
+        Records in the order of ``tasks``.
+
+    Raises
+    ------
+    ConfigError
+        For jobs < 1 or an unreachable scheduler.
+    """
+    from tqdm import tqdm
+
+    if jobs is not None and jobs < 1:
+        raise ConfigError(f"jobs must be >= 1, got {jobs}")
+    runs_dir.mkdir(parents=True, exist_ok=True)
+    records: dict[Task, dict[str, Any]] = {}
+    todo = []
+    for t in tasks:
+        rec = load_record(runs_dir / t.filename(), t)
+        if rec is None:
+            todo.append(t)
+        else:
+            records[t] = rec
+    bar = tqdm(total=len(tasks), initial=len(records), disable=not progress, unit="run",
+               desc=tasks[0].experiment if tasks else "experiment", leave=False)
+
+    def store(t: Task, rec: dict[str, Any]) -> None:
+        write_json_atomic(runs_dir / t.filename(), rec)
+        records[t] = json.loads(json.dumps(rec, sort_keys=True))
+        bar.update(1)
+        if on_done is not None:
+            on_done(t)
+
+    try:
+        if todo and scheduler is not None:
+            _run_dask(todo, scheduler, store)
+        elif todo and (jobs or os.cpu_count() or 1) > 1 and len(todo) > 1:
+            _run_pool(todo, jobs or os.cpu_count() or 1, store)
+        else:
+            for t in todo:
+                store(t, run_task(t))
+    finally:
+        bar.close()
+    return [records[t] for t in tasks]
+
+
+def _run_pool(todo: list[Task], jobs: int, store: Callable[[Task, dict[str, Any]], None]) -> None:
+    # forkserver: never fork a parent whose numba threads may already be running.
+    ctx = get_context("forkserver")
+    with ProcessPoolExecutor(max_workers=min(jobs, len(todo)), mp_context=ctx) as pool:
+        futures = {pool.submit(run_task, t): t for t in todo}
+        try:
+            for fut in as_completed(futures):
+                store(futures[fut], fut.result())
+        except BaseException:
+            for fut in futures:
+                fut.cancel()
+            raise
+
+
+def _run_dask(
+    todo: list[Task], address: str, store: Callable[[Task, dict[str, Any]], None]
+) -> None:
+    from distributed import as_completed as dask_completed
+
+    client = _connect(address)
+    try:
+        futures = {}
+        for t in todo:
+            fut = client.submit(
+                run_task, t, key=f"scenegen-{t.experiment}-{t.filename()}", retries=3,
+                pure=False,
+            )
+            futures[fut.key] = (fut, t)
+        for fut in dask_completed([f for f, _ in futures.values()], loop=client.loop):
+            store(futures[fut.key][1], fut.result())
+    finally:
+        client.close()

@@ -1,0 +1,578 @@
+"""Scenario planning and rendering: config + seed -> frames, labels and ground truth.
+
+Data flows one way (STYLE.md): :func:`plan` turns a config and a seed into a
+:class:`Scenario` (trajectories, depths, templates: everything but pixels), and
+:meth:`Scenario.render` draws any frame range of it in one compiled call. The static
+layer (background, clutter and entities that never move and lie behind all others) is
+drawn once.
+
+Randomness: each entity draws from its own stream, keyed by the scenario seed and the
+entity's *name*, so adding, removing or reordering other entities never changes its
+trajectory or appearance. Per-frame sensor noise is keyed by the frame index, so rendering
+in chunks gives the same bytes as rendering at once.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from collections.abc import Iterator
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import cv2
+import numpy as np
+from numpy.typing import NDArray
+
+from scenegen.config import Background, EntitySpec, SceneConfig
+from scenegen.errors import ConfigError
+from scenegen.render import compose as kernels
+from scenegen.render.draw import draw_template, jitter_colors, paint_template, transform_template
+from scenegen.render.motion import ar2_path
+from scenegen.sequence import Entities, GroundTruth, Sequence
+
+__all__ = ["Chunk", "Scenario", "entity_rng", "generate", "plan", "resolve_seed"]
+
+_SCALE_LIMITS = (0.05, 20.0)
+
+
+def _key(name: str) -> int:
+    return int.from_bytes(hashlib.sha256(name.encode("utf-8")).digest()[:8], "little")
+
+
+def entity_rng(seed: int, name: str, *extra: int) -> np.random.Generator:
+    """The random stream of component ``name`` (an entity name, ``background``, ...)."""
+    return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(_key(name), *extra)))
+
+
+def resolve_seed(seed: int | np.integer | None) -> int:
+    """A non-negative int seed; ``None`` draws a fresh one from the OS."""
+    if seed is None:
+        return int(np.random.SeedSequence().generate_state(1, dtype=np.uint64)[0] >> 1)
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise ConfigError(f"seed must be a non-negative integer, got {seed!r}")
+    return int(seed)
+
+
+def _background(bg: Background, h: int, w: int, rng: np.random.Generator) -> NDArray[np.uint8]:
+    if bg.kind == "uniform":
+        out = np.empty((h, w, 3), dtype=np.uint8)
+        out[:] = bg.color
+        return out
+    noise = rng.integers(bg.low, bg.high + 1, size=(h, w, 3), dtype=np.uint8)
+    if bg.kind == "noise":
+        return noise
+    smooth = cv2.GaussianBlur(noise.astype(np.float32), (0, 0), bg.scale)
+    # Stretch the smoothed noise back to [low, high] and tint it with the colour.
+    lo, hi = float(smooth.min()), float(smooth.max())
+    smooth = (smooth - lo) / max(hi - lo, 1e-6)
+    tint = np.asarray(bg.color, dtype=np.float32) / 255.0
+    out = bg.low + smooth * (bg.high - bg.low) * tint
+    return np.clip(np.rint(out), 0, 255).astype(np.uint8)
+
+
+@dataclass
+class Chunk:
+    """Frames ``start:stop`` of a scenario with their ground truth (shapes as in
+    :class:`~scenegen.sequence.GroundTruth`, with F = stop - start frames)."""
+
+    start: int
+    frames: NDArray[np.uint8]
+    labels: NDArray[np.uint16]
+    gt: dict[str, NDArray[Any]]
+
+
+@dataclass
+class Scenario:
+    """Everything about a sequence but its pixels.
+
+    Attributes
+    ----------
+    config : SceneConfig
+    seed : int
+    preset : str
+    names, roles : list of str (K)
+    templates : list of ndarray (h, w, 4)
+        Base template of each entity.
+    cx, cy : ndarray of shape (T, K)
+        Drawn centre (motion plus position noise) before rounding to pixels.
+    scale, angle, shade : ndarray of shape (T, K)
+        Per-frame appearance transform.
+    alive : ndarray of shape (T, K), bool
+    depth_value : ndarray of shape (T, K), int64
+        Configured depth (smaller is nearer), clutter behind everything.
+    depth_rank : ndarray of shape (T, K), int16
+    in_static : ndarray of shape (K,), bool
+        Entities drawn once into the static layer.
+    background : ndarray of shape (H, W, 3), uint8
+    """
+
+    config: SceneConfig
+    seed: int
+    preset: str
+    names: list[str]
+    roles: list[str]
+    templates: list[NDArray[np.uint8]]
+    cx: NDArray[np.float64]
+    cy: NDArray[np.float64]
+    scale: NDArray[np.float64]
+    angle: NDArray[np.float64]
+    shade: NDArray[np.float64]
+    alive: NDArray[np.bool_]
+    depth_value: NDArray[np.int64]
+    depth_rank: NDArray[np.int16]
+    in_static: NDArray[np.bool_]
+    background: NDArray[np.uint8]
+    _static_cache: tuple[NDArray[Any], ...] | None = field(default=None, repr=False)
+
+    @property
+    def n_frames(self) -> int:
+        return self.config.n_frames
+
+    @property
+    def n_entities(self) -> int:
+        return len(self.names)
+
+    def entities(self) -> Entities:
+        k = self.n_entities
+        return Entities(
+            id=np.arange(1, k + 1, dtype=np.int32),
+            role=np.array(self.roles, dtype=str),
+            name=np.array(self.names, dtype=str),
+        )
+
+    # -- rendering ---------------------------------------------------------------------
+
+    def _varies(self) -> NDArray[np.bool_]:
+        return (
+            np.any(self.scale != 1.0, axis=0)
+            | np.any(self.angle != 0.0, axis=0)
+            | np.any(self.shade != 1.0, axis=0)
+        )
+
+    def _static_layer(self) -> tuple[NDArray[Any], ...]:
+        if self._static_cache is not None:
+            return self._static_cache
+        h, w = self.config.height, self.config.width
+        rgb = self.background.copy()
+        lab = np.zeros((h, w), dtype=np.uint16)
+        k_n = self.n_entities
+        tidx = np.full(k_n, -1, dtype=np.int64)
+        x0 = np.zeros(k_n, dtype=np.int64)
+        y0 = np.zeros(k_n, dtype=np.int64)
+        static = np.flatnonzero(self.in_static)
+        tbuf, toff, th, tw = _pack([self.templates[k] for k in static])
+        for k in static[np.argsort(-self.depth_value[0, static], kind="stable")]:
+            i = int(np.searchsorted(static, k))
+            tidx[k] = i
+            x0[k], y0[k] = _top_left(self.cx[0, k], self.cy[0, k], tw[i], th[i])
+            kernels.paint(rgb, lab, tbuf, toff[i], th[i], tw[i], x0[k], y0[k], k + 1)
+        box = np.zeros((k_n, 4), dtype=np.int64)
+        count = np.zeros(k_n, dtype=np.int64)
+        kernels.scan_static(lab, tidx, x0, y0, th, tw, box, count)
+        self._static_cache = (rgb, lab, box, count)
+        return self._static_cache
+
+    def render(self, start: int = 0, stop: int | None = None) -> Chunk:
+        """Render frames ``start:stop`` with their ground truth.
+
+        Returns
+        -------
+        Chunk
+        """
+        t_n = self.n_frames
+        stop = t_n if stop is None else stop
+        if not 0 <= start < stop <= t_n:
+            raise ValueError(f"frame range {start}:{stop} is outside 0:{t_n}")
+        f_n, k_n = stop - start, self.n_entities
+        h, w = self.config.height, self.config.width
+        s_rgb, s_lab, s_box, s_count = self._static_layer()
+        varies = self._varies()
+
+        templates: list[NDArray[np.uint8]] = list(self.templates)
+        tidx = np.full((f_n, k_n), -1, dtype=np.int64)
+        base_idx = np.arange(k_n, dtype=np.int64)
+        for f in range(f_n):
+            t = start + f
+            tidx[f] = np.where(self.alive[t], base_idx, -1)
+            for k in np.flatnonzero(varies & self.alive[t]):
+                templates.append(
+                    transform_template(
+                        self.templates[k],
+                        scale=float(self.scale[t, k]),
+                        angle=float(self.angle[t, k]),
+                        shade=float(self.shade[t, k]),
+                    )
+                )
+                tidx[f, k] = len(templates) - 1
+        tbuf, toff, th, tw = _pack(templates)
+        safe = np.maximum(tidx, 0)
+        x0 = np.floor(self.cx[start:stop] - tw[safe] / 2 + 0.5).astype(np.int64)
+        y0 = np.floor(self.cy[start:stop] - th[safe] / 2 + 0.5).astype(np.int64)
+        # Alive and overlapping the frame.
+        inside = (x0 < w) & (y0 < h) & (x0 + tw[safe] > 0) & (y0 + th[safe] > 0)
+        present = (tidx >= 0) & inside
+        tidx = np.where(present, tidx, -1)
+
+        dyn = np.flatnonzero(~self.in_static)
+        order = np.full((f_n, max(len(dyn), 1)), -1, dtype=np.int64)
+        if len(dyn):
+            dv = self.depth_value[start:stop][:, dyn]
+            order[:, : len(dyn)] = dyn[np.argsort(-dv, axis=1, kind="stable")]
+
+        out_rgb = np.empty((f_n, h, w, 3), dtype=np.uint8)
+        out_lab = np.empty((f_n, h, w), dtype=np.uint16)
+        out_rgb[:] = s_rgb
+        out_lab[:] = s_lab
+        out_box = np.zeros((f_n, k_n, 4), dtype=np.int64)
+        out_count = np.zeros((f_n, k_n), dtype=np.int64)
+        kernels.render_chunk(
+            s_rgb, s_lab, tbuf, toff, th, tw, order, tidx, x0, y0,
+            self.in_static, s_box, s_count, out_rgb, out_lab, out_box, out_count,
+        )  # fmt: skip
+        if self.config.sensor_noise > 0:
+            for f in range(f_n):
+                rng = entity_rng(self.seed, "sensor", start + f)
+                noisy = out_rgb[f] + rng.standard_normal((h, w, 3)) * self.config.sensor_noise
+                out_rgb[f] = np.clip(np.rint(noisy), 0, 255).astype(np.uint8)
+
+        gt = _ground_truth(tidx, x0, y0, th, tw, toff, tbuf, out_box, out_count)
+        gt["depth"] = self.depth_rank[start:stop].copy()
+        return Chunk(start=start, frames=out_rgb, labels=out_lab, gt=gt)
+
+    def chunks(self, size: int = 64) -> Iterator[Chunk]:
+        """Render the whole scenario in chunks of ``size`` frames (bounded memory)."""
+        for start in range(0, self.n_frames, size):
+            yield self.render(start, min(start + size, self.n_frames))
+
+    def template_images(self) -> dict[int, NDArray[np.uint8]]:
+        """Each entity's base template (RGBA), keyed by id."""
+        return {k + 1: tpl for k, tpl in enumerate(self.templates)}
+
+
+def _top_left(cx: float, cy: float, tw: int, th: int) -> tuple[int, int]:
+    return int(np.floor(cx - tw / 2 + 0.5)), int(np.floor(cy - th / 2 + 0.5))
+
+
+def _pack(
+    templates: list[NDArray[np.uint8]],
+) -> tuple[NDArray[np.uint8], NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
+    th = np.array([t.shape[0] for t in templates], dtype=np.int64)
+    tw = np.array([t.shape[1] for t in templates], dtype=np.int64)
+    sizes = th * tw * 4
+    toff = np.zeros(len(templates), dtype=np.int64)
+    if len(templates) > 1:
+        toff[1:] = np.cumsum(sizes)[:-1]
+    tbuf = (
+        np.concatenate([np.ascontiguousarray(t).ravel() for t in templates])
+        if templates
+        else np.zeros(0, dtype=np.uint8)
+    )
+    return tbuf, toff, th, tw
+
+
+def _ground_truth(tidx, x0, y0, th, tw, toff, tbuf, vbox, vcount) -> dict[str, NDArray[Any]]:
+    present = tidx >= 0
+    safe = np.maximum(tidx, 0)
+    w = tw[safe].astype(np.float32)
+    h = th[safe].astype(np.float32)
+    box = np.stack([x0.astype(np.float32), y0.astype(np.float32), w, h], axis=-1)
+    box[~present] = np.nan
+    center = np.stack([box[..., 0] + w / 2, box[..., 1] + h / 2], axis=-1)
+    alpha_count = np.array(
+        [
+            np.count_nonzero(tbuf[o + 3 : o + 4 * hh * ww : 4])
+            for o, hh, ww in zip(toff, th, tw, strict=True)
+        ],
+        dtype=np.float64,
+    )
+    amodal = np.where(present, alpha_count[safe], 1.0)
+    visibility = np.where(present, vcount / amodal, 0.0).astype(np.float32)
+    vb = np.stack(
+        [
+            vbox[..., 0],
+            vbox[..., 1],
+            vbox[..., 2] + 1 - vbox[..., 0],
+            vbox[..., 3] + 1 - vbox[..., 1],
+        ],
+        axis=-1,
+    ).astype(np.float32)
+    vb[vcount == 0] = np.nan
+    return {
+        "box": box,
+        "visible_box": vb,
+        "center": center.astype(np.float32),
+        "visibility": visibility,
+        "present": present,
+    }
+
+
+# ---------------------------------------------------------------------------------------
+# Planning
+
+
+def _entity_plan(
+    e: EntitySpec, cfg: SceneConfig, seed: int, tpl: NDArray[np.uint8], start: tuple[float, float]
+) -> tuple[NDArray[np.float64], ...]:
+    """Trajectory (T,) x, y, scale, angle, shade of one entity from its own stream."""
+    t_n = cfg.n_frames
+    rng = entity_rng(seed, e.name, 1)
+    th, tw = tpl.shape[:2]
+    if e.motion is None:
+        x = np.full(t_n, start[0])
+        y = np.full(t_n, start[1])
+        s = np.zeros(t_n)
+    else:
+        m = e.motion
+        x = ar2_path(
+            m.x, start[0], m.velocity[0], t_n, rng=rng,
+            lo=m.x.margin + tw / 2, hi=cfg.width - m.x.margin - tw / 2,
+        )  # fmt: skip
+        y = ar2_path(
+            m.y, start[1], m.velocity[1], t_n, rng=rng,
+            lo=m.y.margin + th / 2, hi=cfg.height - m.y.margin - th / 2,
+        )  # fmt: skip
+        if m.scale is not None:
+            lim = m.scale.margin if m.scale.margin > 0 else np.inf
+            s = ar2_path(m.scale, 0.0, 0.0, t_n, rng=rng, lo=-lim, hi=lim)
+        else:
+            s = np.zeros(t_n)
+    if e.position_noise > 0:
+        noise = rng.standard_normal((t_n, 2)) * e.position_noise
+        x = x + noise[:, 0]
+        y = y + noise[:, 1]
+    t = np.arange(t_n, dtype=np.float64)
+    if e.variation is not None:
+        v = e.variation
+        phase = np.sin(2 * np.pi * t / v.period + v.phase)
+        angle = v.rotation * phase
+        shade = 1.0 + v.shading * phase
+    else:
+        angle = np.zeros(t_n)
+        shade = np.ones(t_n)
+    scale = np.clip(np.exp(s), *_SCALE_LIMITS)
+    return x, y, scale, angle, shade
+
+
+def _clutter(cfg: SceneConfig, seed: int) -> list[tuple[str, NDArray[np.uint8], float, float]]:
+    items = []
+    for spec in cfg.clutter:
+        rng = entity_rng(seed, f"clutter:{spec.name}")
+        n = spec.count
+        if spec.region is None:
+            rx, ry, rw, rh = 0.0, 0.0, float(cfg.width), float(cfg.height)
+        else:
+            rx, ry, rw, rh = spec.region
+        bw, bh = spec.appearance.size
+        lo = spec.min_size if spec.min_size > 0 else min(bw, bh)
+        frac = rng.uniform(lo / min(bw, bh), 1.0, size=n)
+        pal = np.asarray(spec.palette, dtype=np.uint8)
+        cols = rng.integers(0, len(pal), size=(n, spec.n_colors))
+        if spec.placement == "grid":
+            g = int(np.ceil(np.sqrt(n))) if n else 1
+            gx, gy = np.meshgrid(np.arange(g), np.arange(g))
+            cell_w, cell_h = rw / g, rh / g
+            cx = rx + (gx.ravel()[:n] + rng.uniform(0.2, 0.8, n)) * cell_w
+            cy = ry + (gy.ravel()[:n] + rng.uniform(0.2, 0.8, n)) * cell_h
+        else:
+            cx = rx + rng.uniform(0, rw, n)
+            cy = ry + rng.uniform(0, rh, n)
+        app = spec.appearance
+        for j in range(n):
+            size = (max(1, int(round(bw * frac[j]))), max(1, int(round(bh * frac[j]))))
+            tpl = paint_template(
+                app.shape, app.pattern, size[0], size[1], pal[cols[j]],
+                stripe_width=app.stripe_width, texture_sigma=app.texture_sigma, rng=rng,
+            )  # fmt: skip
+            items.append((f"{spec.name}-{j}", tpl, float(cx[j]), float(cy[j])))
+    return items
+
+
+def plan(config: SceneConfig, seed: int | None = None, *, preset: str = "") -> Scenario:
+    """Plan a scenario: trajectories, depths, presence and templates of every entity.
+
+    Parameters
+    ----------
+    config : SceneConfig
+    seed : int or None
+        ``None`` draws a fresh seed (recorded in the result).
+    preset : str
+        The preset name to record ("" if none).
+    """
+    seed = resolve_seed(seed)
+    cfg = config
+    t_n, h, w = cfg.n_frames, cfg.height, cfg.width
+    by_name = {e.name: e for e in cfg.entities}
+    k_user = len(cfg.entities)
+
+    templates: dict[str, NDArray[np.uint8]] = {}
+    paths: dict[str, tuple[NDArray[np.float64], ...]] = {}
+    # Targets (and anything not mimicking) first: a mimic starts where its model is.
+    for e in sorted(cfg.entities, key=lambda e: e.mimic is not None):
+        app_rng = entity_rng(seed, e.name, 0)
+        app = e.appearance
+        if e.mimic is not None:
+            app = jitter_colors(by_name[e.mimic].appearance, e.color_jitter, rng=app_rng)
+        tpl = draw_template(app, rng=app_rng)
+        templates[e.name] = tpl
+        if e.position is not None:
+            start = (float(e.position[0]), float(e.position[1]))
+        else:
+            mx, my = paths[e.mimic][0], paths[e.mimic][1]
+            t0 = min(e.appear, t_n - 1)
+            start = (mx[t0] + e.mimic_offset[0], my[t0] + e.mimic_offset[1])
+        path = _entity_plan(e, cfg, seed, tpl, start)
+        if e.position is None and e.appear > 0:
+            # The mimic's own motion starts at its appear frame from the target's position.
+            shifted = []
+            for arr in path:
+                out = np.empty_like(arr)
+                out[e.appear :] = arr[: t_n - e.appear]
+                out[: e.appear] = arr[0]
+                shifted.append(out)
+            path = tuple(shifted)
+        paths[e.name] = path
+
+    clutter = _clutter(cfg, seed)
+    names = [e.name for e in cfg.entities] + [c[0] for c in clutter]
+    roles = [e.role for e in cfg.entities] + ["clutter"] * len(clutter)
+    tpls = [templates[e.name] for e in cfg.entities] + [c[1] for c in clutter]
+    k_n = len(names)
+
+    cx = np.empty((t_n, k_n))
+    cy = np.empty((t_n, k_n))
+    scale = np.ones((t_n, k_n))
+    angle = np.zeros((t_n, k_n))
+    shade = np.ones((t_n, k_n))
+    alive = np.zeros((t_n, k_n), dtype=bool)
+    for k, e in enumerate(cfg.entities):
+        cx[:, k], cy[:, k], scale[:, k], angle[:, k], shade[:, k] = paths[e.name]
+        stop = t_n if e.disappear is None else min(e.disappear, t_n)
+        alive[e.appear : stop, k] = True
+    for j, c in enumerate(clutter):
+        cx[:, k_user + j] = c[2]
+        cy[:, k_user + j] = c[3]
+        alive[:, k_user + j] = True
+
+    depth_value = np.empty((t_n, k_n), dtype=np.int64)
+    for k, e in enumerate(cfg.entities):
+        for f, d in e.depth:
+            depth_value[min(f, t_n) :, k] = d
+    base = (max((d for e in cfg.entities for _, d in e.depth), default=-1)) + 1
+    n_cl = len(clutter)
+    # Clutter lies behind every entity; later items are drawn over earlier ones.
+    depth_value[:, k_user:] = base + (n_cl - 1 - np.arange(n_cl))
+    depth_rank = _ranks(depth_value)
+
+    static = np.zeros(k_n, dtype=bool)
+    for k, e in enumerate(cfg.entities):
+        static[k] = (
+            e.motion is None
+            and e.position_noise == 0
+            and e.variation is None
+            and e.appear == 0
+            and e.disappear is None
+            and len(e.depth) == 1
+        )
+    static[k_user:] = True
+    dyn_depth = depth_value[:, ~static]
+    max_dyn = int(dyn_depth.max()) if dyn_depth.size else -1
+    in_static = static & (depth_value.min(axis=0) > max_dyn)
+
+    return Scenario(
+        config=cfg,
+        seed=seed,
+        preset=preset,
+        names=names,
+        roles=roles,
+        templates=tpls,
+        cx=cx,
+        cy=cy,
+        scale=scale,
+        angle=angle,
+        shade=shade,
+        alive=alive,
+        depth_value=depth_value,
+        depth_rank=depth_rank,
+        in_static=in_static,
+        background=_background(cfg.background, h, w, entity_rng(seed, "background")),
+    )
+
+
+def _ranks(depth_value: NDArray[np.int64]) -> NDArray[np.int16]:
+    """Rank of each entity per frame (0 = nearest), computed once per distinct row."""
+    t_n, k_n = depth_value.shape
+    out = np.empty((t_n, k_n), dtype=np.int16)
+    if t_n == 0:
+        return out
+    change = np.ones(t_n, dtype=bool)
+    change[1:] = np.any(depth_value[1:] != depth_value[:-1], axis=1)
+    starts = np.flatnonzero(change)
+    for i, s in enumerate(starts):
+        e = starts[i + 1] if i + 1 < len(starts) else t_n
+        rank = np.empty(k_n, dtype=np.int16)
+        rank[np.argsort(depth_value[s], kind="stable")] = np.arange(k_n, dtype=np.int16)
+        out[s:e] = rank
+    return out
+
+
+def _resolve(config: SceneConfig | str | dict[str, Any]) -> tuple[SceneConfig, str]:
+    from scenegen import presets
+    from scenegen.config import from_dict
+
+    if isinstance(config, SceneConfig):
+        return config, ""
+    if isinstance(config, str):
+        return presets.get(config), config
+    if isinstance(config, dict):
+        return from_dict(config), ""
+    raise ConfigError(
+        f"expected a SceneConfig, a preset name or a dict, got {type(config).__name__}"
+    )
+
+
+def generate(
+    config: SceneConfig | str | dict[str, Any],
+    *,
+    seed: int | None = None,
+    frames: int | None = None,
+) -> Sequence:
+    """Generate a whole sequence in memory.
+
+    Parameters
+    ----------
+    config : SceneConfig, str or dict
+        A config, a preset name (``scenegen.presets.names()``) or plain config data.
+    seed : int or None
+        Same config and seed give identical bytes; ``None`` draws a fresh seed.
+    frames : int, optional
+        Override the number of frames.
+
+    Returns
+    -------
+    Sequence
+        ``frames`` (T, H, W, 3) uint8, ``labels`` (T, H, W) uint16, ``gt`` and templates.
+
+    Example
+    -------
+    >>> seq = generate("kams-a", seed=1)
+    >>> seq.frames.shape
+    (140, 240, 320, 3)
+    """
+    cfg, preset = _resolve(config)
+    if frames is not None:
+        if frames < 1:
+            raise ConfigError(f"frames must be >= 1, got {frames}")
+        cfg = replace(cfg, n_frames=int(frames))
+    scn = plan(cfg, seed, preset=preset)
+    chunk = scn.render()
+    return Sequence(
+        name=cfg.name,
+        seed=scn.seed,
+        config=cfg,
+        preset=preset,
+        frames=chunk.frames,
+        labels=chunk.labels,
+        entities=scn.entities(),
+        gt=GroundTruth(**chunk.gt),
+        templates=scn.template_images(),
+    )

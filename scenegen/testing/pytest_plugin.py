@@ -1,0 +1,397 @@
+"""pytest plugin (entry point ``pytest11: scenegen``): generated scenes as fixtures.
+
+Installed with scenegen, it is active in every pytest run; nothing to import.
+
+Fixtures
+--------
+scenegen_sequence
+    Session-scoped factory ``scenegen_sequence(source, seed=0, frames=None) -> Sequence``
+    with ``source`` a preset name, a :class:`~scenegen.config.SceneConfig` or a config
+    dict. Sequences are cached in memory for the session and on disk across sessions (in
+    pytest's cache folder, ``.pytest_cache/d/scenegen``), keyed by the generator
+    fingerprint (version and source of the rendering modules), the resolved config, the
+    frame count and the seed; ``pytest --cache-clear`` empties it. Being session-scoped,
+    it can be used inside ``@given`` tests.
+scenegen_fixture
+    Session-scoped factory ``scenegen_fixture(name) -> Sequence`` reading the committed
+    regression fixture ``<fixtures>/<name>.h5``. If the folder holds a ``registry.json``
+    (as written by ``scenegen fixtures regen``), the arrays are checked against its
+    SHA-256 digests first.
+scenegen_expect
+    ``scenegen_expect(key, array, atol=None, rtol=None)`` compares ``array`` with the
+    stored expectation ``<fixtures>/expected/<key>.npy``: shapes must agree, NaN must
+    match NaN, and every other element must satisfy
+    ``|actual - expected| <= atol + rtol * |expected|`` (defaults: the test's
+    ``scenegen_tolerance`` marker, else 0 — exact). With ``--scenegen-regen`` it writes
+    the expectation instead (only if it changed) and the run ends with a list of what
+    was written.
+
+Every sequence the fixtures return holds in-memory, read-only numpy arrays (they are
+shared between tests).
+
+``<fixtures>`` is ``--scenegen-fixtures DIR``, else the ini option ``scenegen_fixtures``
+(relative to the rootdir), else ``<rootdir>/fixtures``.
+
+Markers
+-------
+scenegen
+    The test uses scenegen fixtures; added automatically to every test that requests one
+    of the fixtures above, so ``pytest -m scenegen`` selects them.
+scenegen_tolerance(atol=0.0, rtol=0.0)
+    Default tolerances of ``scenegen_expect`` in the marked test.
+
+Example
+-------
+::
+
+    def test_kams_regression(scenegen_sequence, scenegen_expect):
+        seq = scenegen_sequence("kams-a", seed=1, frames=8)
+        result = trackers.track(trackers.make("kams", rng=0), seq.frames, seq.init_boxes())
+        scenegen_expect("kams-a/kams", result.boxes, atol=0.01)
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from collections.abc import Callable
+from dataclasses import replace
+from functools import lru_cache
+from pathlib import Path, PurePosixPath
+from typing import Any
+
+import numpy as np
+import pytest
+from numpy.typing import NDArray
+
+__all__ = [
+    "FIXTURE_NAMES",
+    "assert_close_to_expected",
+    "cache_key",
+    "frozen",
+    "generator_fingerprint",
+]
+
+FIXTURE_NAMES = ("scenegen_sequence", "scenegen_fixture", "scenegen_expect")
+# Modules whose source decides the pixels and ground truth of a generated sequence.
+_GENERATOR_MODULES = (
+    "config.py",
+    "io/hdf5.py",
+    "presets.py",
+    "render/compose.py",
+    "render/draw.py",
+    "render/motion.py",
+    "render/plan.py",
+    "sequence.py",
+)
+_written_key = pytest.StashKey[list[tuple[str, str]]]()
+
+
+def pytest_addoption(parser: pytest.Parser) -> None:
+    group = parser.getgroup("scenegen", "scenegen generated scenes")
+    group.addoption(
+        "--scenegen-regen",
+        action="store_true",
+        default=False,
+        help="write the expectations of scenegen_expect instead of comparing with them",
+    )
+    group.addoption(
+        "--scenegen-fixtures",
+        default=None,
+        metavar="DIR",
+        help="folder of regression fixtures and expectations (default: <rootdir>/fixtures)",
+    )
+    parser.addini(
+        "scenegen_fixtures",
+        "folder of scenegen regression fixtures, relative to the rootdir",
+        default="fixtures",
+    )
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    config.addinivalue_line(
+        "markers", "scenegen: the test uses scenegen fixtures (added automatically)"
+    )
+    config.addinivalue_line(
+        "markers",
+        "scenegen_tolerance(atol=0.0, rtol=0.0): default tolerances of scenegen_expect",
+    )
+    config.stash[_written_key] = []
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    for item in items:
+        if set(getattr(item, "fixturenames", ())) & set(FIXTURE_NAMES):
+            item.add_marker(pytest.mark.scenegen)
+
+
+def pytest_terminal_summary(terminalreporter: Any, config: pytest.Config) -> None:
+    written = config.stash.get(_written_key, [])
+    if not written:
+        return
+    terminalreporter.section("scenegen --scenegen-regen")
+    for path, what in written:
+        terminalreporter.write_line(f"{what}: {path}")
+
+
+@lru_cache(maxsize=1)
+def generator_fingerprint() -> str:
+    """SHA-256 (hex, 16 chars) of the scenegen version and the source of the modules that
+    decide a generated sequence's contents; it changes whenever the generator may."""
+    import scenegen
+
+    h = hashlib.sha256(scenegen.__version__.encode())
+    folder = Path(scenegen.__file__).parent
+    for name in _GENERATOR_MODULES:
+        h.update(name.encode())
+        h.update((folder / name).read_bytes())
+    return h.hexdigest()[:16]
+
+
+def cache_key(config: Any, seed: int, frames: int | None = None) -> str:
+    """Stable key (hex, 20 chars) of (generator fingerprint, resolved config, seed, frames).
+
+    Parameters
+    ----------
+    config : SceneConfig
+        The resolved config (a preset already looked up).
+    seed : int
+    frames : int, optional
+        A frame-count override applied on top of ``config``.
+    """
+    from scenegen.config import to_dict
+
+    doc = json.dumps(
+        {
+            "generator": generator_fingerprint(),
+            "config": to_dict(config),
+            "seed": int(seed),
+            "frames": frames,
+        },
+        sort_keys=True,
+    )
+    return hashlib.sha256(doc.encode()).hexdigest()[:20]
+
+
+def frozen(seq: Any) -> Any:
+    """The sequence with in-memory, read-only frames, labels, ground truth and templates.
+
+    Parameters
+    ----------
+    seq : Sequence
+        Possibly with lazy (file-backed) arrays; those are read and their file closed.
+    """
+    from scenegen.sequence import GroundTruth
+
+    def ro(a: Any) -> NDArray[Any]:
+        arr = np.array(a, copy=True)
+        arr.setflags(write=False)
+        return arr
+
+    frames, labels = ro(seq.frames), ro(seq.labels)
+    for lazy in (seq.frames, seq.labels):
+        if hasattr(lazy, "close"):
+            lazy.close()
+    gt = GroundTruth(**{k: ro(v) for k, v in seq.gt.as_dict().items()})
+    return replace(
+        seq,
+        frames=frames,
+        labels=labels,
+        gt=gt,
+        templates={k: ro(v) for k, v in seq.templates.items()},
+    )
+
+
+def _fixtures_dir(config: pytest.Config) -> Path:
+    opt = config.getoption("--scenegen-fixtures")
+    if opt:
+        return Path(opt)
+    return Path(config.rootpath) / str(config.getini("scenegen_fixtures"))
+
+
+@pytest.fixture(scope="session")
+def scenegen_sequence(request: pytest.FixtureRequest) -> Callable[..., Any]:
+    """Factory: ``(preset name | SceneConfig | dict, seed=0, frames=None) -> Sequence``."""
+    from scenegen.errors import ConfigError, DataError
+    from scenegen.io import read, write
+    from scenegen.render.plan import _resolve, generate
+
+    # No disk cache when pytest runs without its cache plugin (-p no:cacheprovider).
+    cache = getattr(request.config, "cache", None)
+    folder = Path(cache.mkdir("scenegen")) if cache is not None else None
+    memo: dict[str, Any] = {}
+
+    def factory(source: Any, seed: int = 0, frames: int | None = None) -> Any:
+        if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+            raise ConfigError(f"seed must be a non-negative integer, got {seed!r}")
+        cfg, preset = _resolve(source)
+        if frames is not None:
+            if isinstance(frames, bool) or not isinstance(frames, (int, np.integer)):
+                raise ConfigError(f"frames must be an integer, got {frames!r}")
+            if frames < 1:
+                raise ConfigError(f"frames must be >= 1, got {frames}")
+            cfg = replace(cfg, n_frames=int(frames))
+        # The preset name is recorded in the sequence, so it is part of the key.
+        key = cache_key(cfg, int(seed)) + (f"-{preset}" if preset else "")
+        if key in memo:
+            return memo[key]
+        path = folder / f"{key}.h5" if folder is not None else None
+        seq = None
+        if path is not None and path.exists():
+            try:
+                seq = frozen(read(path))
+            except DataError:
+                seq = None  # a damaged cache entry is regenerated and rewritten
+        if seq is None:
+            seq = frozen(generate(source, seed=int(seed), frames=frames))
+            if path is not None:
+                write(path, seq, compression="lzf")
+        memo[key] = seq
+        return seq
+
+    return factory
+
+
+@pytest.fixture(scope="session")
+def scenegen_fixture(request: pytest.FixtureRequest) -> Callable[[str], Any]:
+    """Factory: ``(name) -> Sequence`` of the committed fixture ``<fixtures>/<name>.h5``."""
+    from scenegen.io import read
+
+    folder = _fixtures_dir(request.config)
+    memo: dict[str, Any] = {}
+
+    def factory(name: str) -> Any:
+        if name in memo:
+            return memo[name]
+        path = folder / f"{name}.h5"
+        if not path.exists():
+            known = sorted(p.stem for p in folder.glob("*.h5")) if folder.is_dir() else []
+            raise FileNotFoundError(
+                f"no scenegen fixture {name!r} in {folder}; known: {', '.join(known) or 'none'}"
+            )
+        seq = frozen(read(path))
+        registry = folder / "registry.json"
+        if registry.exists():
+            _check_digests(registry, name, seq)
+        memo[name] = seq
+        return seq
+
+    return factory
+
+
+def _check_digests(registry: Path, name: str, seq: Any) -> None:
+    from scenegen.testing.fixtures import digests
+
+    entry = json.loads(registry.read_text(encoding="utf-8")).get("fixtures", {}).get(name)
+    if entry is None:
+        return
+    stored, actual = entry.get("digests", {}), digests(seq)
+    bad = sorted(k for k in set(stored) | set(actual) if stored.get(k) != actual.get(k))
+    if bad:
+        raise AssertionError(
+            f"fixture {name!r}: {', '.join(bad)} differ from the digests in {registry}; "
+            "run `scenegen fixtures verify`"
+        )
+
+
+def _nan_mask(arr: NDArray[Any]) -> NDArray[np.bool_]:
+    if arr.dtype.kind in "fc":
+        return np.isnan(arr)
+    return np.zeros(arr.shape, dtype=bool)
+
+
+def assert_close_to_expected(
+    path: Path, actual: Any, *, atol: float = 0.0, rtol: float = 0.0, regen: bool = False
+) -> bool:
+    """Compare ``actual`` with the array stored at ``path`` (``.npy``).
+
+    Shapes must agree, NaN must match NaN, and every other element must satisfy
+    ``|actual - expected| <= atol + rtol * |expected|``. With ``regen`` the file is written
+    instead (atomically, and only if its contents change).
+
+    Returns
+    -------
+    bool
+        True if the file was written.
+
+    Raises
+    ------
+    AssertionError
+        Naming the file, how many elements differ, the largest difference, the first
+        differing element and the tolerances.
+    """
+    from scenegen.io import atomic_path
+
+    if atol < 0 or rtol < 0:
+        raise ValueError(f"tolerances must be >= 0, got atol={atol}, rtol={rtol}")
+    arr = np.asarray(actual)
+    if regen:
+        if path.exists():
+            old = np.load(path)
+            if old.dtype == arr.dtype and np.array_equal(
+                old, arr, equal_nan=arr.dtype.kind in "fc"
+            ):
+                return False
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with atomic_path(path) as tmp, open(tmp, "wb") as fh:
+            np.save(fh, arr)
+        return True
+    if not path.exists():
+        raise AssertionError(f"no stored expectation {path}; run pytest with --scenegen-regen")
+    expected = np.load(path)
+    if expected.shape != arr.shape:
+        raise AssertionError(f"{path}: shape {arr.shape}, expected {expected.shape}")
+    nan_a, nan_e = _nan_mask(arr), _nan_mask(expected)
+    if np.any(nan_a != nan_e):
+        idx = tuple(int(i) for i in np.argwhere(nan_a != nan_e)[0])
+        raise AssertionError(
+            f"{path}: NaN pattern differs first at {idx}: got {arr[idx]!r}, "
+            f"expected {expected[idx]!r}"
+        )
+    a = arr.astype(np.float64) if arr.dtype.kind in "biu" else arr
+    e = expected.astype(np.float64) if expected.dtype.kind in "biu" else expected
+    ok = np.isclose(a, e, atol=atol, rtol=rtol) | nan_a
+    if not ok.all():
+        idx = tuple(int(i) for i in np.argwhere(~ok)[0])
+        diff = np.abs(np.where(ok, 0, a - e))
+        raise AssertionError(
+            f"{path}: {int((~ok).sum())} of {ok.size} values differ beyond atol={atol}, "
+            f"rtol={rtol} (largest difference {float(diff.max()):.6g}); first at {idx}: "
+            f"got {arr[idx]!r}, expected {expected[idx]!r}"
+        )
+    return False
+
+
+def _check_key(key: Any) -> PurePosixPath:
+    if not isinstance(key, str) or not key:
+        raise ValueError(f"expectation key must be a non-empty string, got {key!r}")
+    p = PurePosixPath(key)
+    if p.is_absolute() or any(part in ("", ".", "..") for part in p.parts) or "\\" in key:
+        raise ValueError(f"expectation key {key!r} must be a relative path without '..'")
+    return p
+
+
+@pytest.fixture
+def scenegen_expect(request: pytest.FixtureRequest) -> Callable[..., None]:
+    """``scenegen_expect(key, array, atol=None, rtol=None)``: compare with (or, under
+    ``--scenegen-regen``, write) ``<fixtures>/expected/<key>.npy``."""
+    folder = _fixtures_dir(request.config) / "expected"
+    regen = bool(request.config.getoption("--scenegen-regen"))
+    marker = request.node.get_closest_marker("scenegen_tolerance")
+    default_atol = float(marker.kwargs.get("atol", 0.0)) if marker else 0.0
+    default_rtol = float(marker.kwargs.get("rtol", 0.0)) if marker else 0.0
+    written = request.config.stash[_written_key]
+
+    def check(key: str, actual: Any, atol: float | None = None, rtol: float | None = None) -> None:
+        rel = _check_key(key)
+        path = folder.joinpath(*rel.parent.parts) / f"{rel.name}.npy"
+        if assert_close_to_expected(
+            path,
+            actual,
+            atol=default_atol if atol is None else atol,
+            rtol=default_rtol if rtol is None else rtol,
+            regen=regen,
+        ):
+            written.append((str(path), "wrote"))
+
+    return check

@@ -1,0 +1,135 @@
+"""scenegen.evaluation.evaluate and the ``evaluate`` verb on a small generated sequence."""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+import numpy as np
+import pytest
+
+import scenegen
+from scenegen.cli import evaluate as cli_evaluate
+from scenegen.errors import DataError
+from scenegen.evaluation.evaluate import evaluate, format_table, to_json
+from scenegen.io import TrackerResult, write_result
+
+
+def _target(name, x, y, depth):
+    return {
+        "name": name,
+        "role": "target",
+        "position": [x, y],
+        "appearance": {"shape": "rect", "size": [12, 12]},
+        "motion": {
+            "x": {"sigma": 1, "boundary": "reflect"},
+            "y": {"sigma": 1, "boundary": "reflect"},
+        },
+        "depth": [[0, depth]],
+    }
+
+
+@pytest.fixture(scope="module")
+def seq():
+    cfg = {
+        "name": "two",
+        "width": 80,
+        "height": 60,
+        "n_frames": 12,
+        "entities": [_target("a", 30, 30, 0), _target("b", 36, 32, 1)],
+    }
+    return scenegen.generate(cfg, seed=3)
+
+
+def test_perfect_result_scores_perfectly(seq):
+    gt = np.asarray(seq.gt.box[:, seq.target_indices()], dtype=np.float64)
+    rep = evaluate(seq, gt, seq.target_ids(), tracker="oracle")
+    assert rep["n_frames"] == 12 and rep["tracker"] == "oracle"
+    for t in rep["targets"]:
+        assert t["tracked"] == 100.0 and t["success"] and t["recovered"]
+        assert t["precision"] == pytest.approx(100.0) and t["mean_centre_error"] == 0.0
+        assert t["failure_frame"] == -1
+    o = rep["overall"]
+    assert o["mota"] == 1.0 and o["idf1"] == 1.0 and o["auc"] == pytest.approx(20 / 21)
+    text = format_table(rep)
+    assert "oracle" in text and "MOTA 1.000" in text
+    assert json.loads(to_json(rep)) == rep
+
+
+def test_lost_target_is_reported(seq):
+    est = np.array(seq.gt.box[:, seq.target_indices()], dtype=np.float64)
+    est[4:, 1, :2] = [0.0, 0.0]  # target b jumps to the corner and stays there
+    est[4:, 1, 2:] = [5.0, 5.0]
+    rep = evaluate(seq, est, seq.target_ids(), persist=3)
+    b = rep["targets"][1]
+    assert b["success"] is False and b["recovered"] is False
+    assert b["tracked"] == pytest.approx(100 * 4 / 12)
+    assert b["failure_frame"] == 4
+    assert rep["overall"]["mota"] < 1.0
+
+
+def test_depth_order_accuracy_of_true_ordering(seq):
+    idx = seq.target_indices()
+    depth = np.asarray(seq.gt.depth)[:, idx]
+    orderings = np.array([[0, 1], [1, 0]])
+    truth = (depth[:, 0] > depth[:, 1]).astype(int)  # row 1 when b is nearer
+    prob = np.eye(2)[truth]
+    est = seq.gt.box[:, idx]
+    rep = evaluate(seq, est, seq.target_ids(), order_prob=prob, orderings=orderings)
+    assert rep["overall"]["depth_order_accuracy"] == 100.0
+    rep = evaluate(seq, est, seq.target_ids(), order_prob=prob[:, ::-1], orderings=orderings)
+    assert rep["overall"]["depth_order_accuracy"] == 0.0
+
+
+def test_mismatches_raise_data_error_naming_them(seq):
+    idx = seq.target_indices()
+    est = np.asarray(seq.gt.box[:, idx], dtype=np.float64)
+    with pytest.raises(DataError, match="11 frames but sequence 'two' has 12"):
+        evaluate(seq, est[:11], seq.target_ids())
+    with pytest.raises(DataError, match="tracks 1 targets but sequence 'two' has 2"):
+        evaluate(seq, est[:, :1], seq.target_ids()[:1])
+    with pytest.raises(DataError, match="target id 99"):
+        evaluate(seq, est, [seq.target_ids()[0], 99])
+
+
+def _cli(argv):
+    parser = argparse.ArgumentParser()
+    sub = parser.add_subparsers()
+    cli_evaluate.register(sub)
+    args = parser.parse_args(argv)
+    return args.func(args)
+
+
+def test_evaluate_verb_table_json_and_mismatch(seq, tmp_path, capsys):
+    idx = seq.target_indices()
+    data = tmp_path / "seq.h5"
+    scenegen.write(data, seq)
+    boxes = np.asarray(seq.gt.box[:, idx], dtype=np.float32)
+    good = tmp_path / "good.h5"
+    write_result(good, TrackerResult("kalman", {}, 0, seq.name, seq.target_ids(), boxes))
+    assert _cli(["evaluate", str(data), str(good)]) == 0
+    assert "kalman" in capsys.readouterr().out
+    assert _cli(["evaluate", str(data), str(good), "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["overall"]["mota"] == 1.0
+    bad = tmp_path / "bad.h5"
+    write_result(bad, TrackerResult("kalman", {}, 0, seq.name, seq.target_ids(), boxes[:5]))
+    with pytest.raises(DataError, match="5 frames but sequence 'two' has 12") as err:
+        _cli(["evaluate", str(data), str(bad)])
+    assert "bad.h5" in str(err.value)
+
+
+def test_cli_exit_codes(seq, tmp_path, capsys):
+    from scenegen.cli import main
+
+    data = tmp_path / "seq.h5"
+    scenegen.write(data, seq)
+    boxes = np.asarray(seq.gt.box[:, seq.target_indices()], dtype=np.float32)
+    res = tmp_path / "res.h5"
+    write_result(res, TrackerResult("kalman", {}, 0, seq.name, seq.target_ids()[:1], boxes[:, :1]))
+    assert main(["evaluate", str(data), str(res)]) == 1
+    err = capsys.readouterr().err
+    assert "tracks 1 targets but sequence 'two' has 2" in err and "Traceback" not in err
+    write_result(res, TrackerResult("kalman", {}, 0, seq.name, seq.target_ids(), boxes))
+    assert main(["evaluate", str(data), str(res), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["overall"]["idf1"] == 1.0

@@ -1,0 +1,105 @@
+"""HDF5 round trips, lazy reading and result files (CONTRACT layout)."""
+
+from __future__ import annotations
+
+import h5py
+import numpy as np
+import pytest
+
+import scenegen
+from scenegen.errors import DataError
+from scenegen.io import LazyArray, TrackerResult, read, read_result, write, write_result
+from scenegen.io.validate import check_file
+
+
+@pytest.fixture(scope="module")
+def seq():
+    return scenegen.generate("shm-crossing", seed=3, frames=12)
+
+
+@pytest.mark.parametrize("compression", ["gzip", "lzf", "none"])
+def test_round_trip(tmp_path, seq, compression):
+    path = tmp_path / "s.h5"
+    write(path, seq, compression=compression)
+    back = read(path)
+    assert isinstance(back.frames, LazyArray)
+    np.testing.assert_array_equal(np.asarray(back.frames), seq.frames)
+    np.testing.assert_array_equal(np.asarray(back.labels), seq.labels)
+    for key, arr in seq.gt.as_dict().items():
+        np.testing.assert_array_equal(getattr(back.gt, key), arr)
+    assert back.config == seq.config and back.seed == 3 and back.preset == "shm-crossing"
+    np.testing.assert_array_equal(back.entities.role, seq.entities.role)
+    for eid, tpl in seq.templates.items():
+        np.testing.assert_array_equal(back.templates[eid], tpl)
+    assert check_file(path) == []
+
+
+def test_layout_matches_contract(tmp_path, seq):
+    path = tmp_path / "s.h5"
+    write(path, seq)
+    with h5py.File(path) as f:
+        assert f.attrs["schema"] == "scenegen/1" and f.attrs["generator_version"]
+        g = f["sequences/shm-crossing"]
+        for attr in ("seed", "config", "preset", "n_frames", "height", "width"):
+            assert attr in g.attrs
+        t, h, w, k = 12, 288, 360, len(seq.entities)
+        expect = {
+            "frames": ((t, h, w, 3), np.uint8), "labels": ((t, h, w), np.uint16),
+            "entities/id": ((k,), np.int32), "gt/box": ((t, k, 4), np.float32),
+            "gt/visible_box": ((t, k, 4), np.float32), "gt/center": ((t, k, 2), np.float32),
+            "gt/visibility": ((t, k), np.float32), "gt/present": ((t, k), np.bool_),
+            "gt/depth": ((t, k), np.int16),
+        }  # fmt: skip
+        for key, (shape, dtype) in expect.items():
+            assert g[key].shape == shape and g[key].dtype == dtype, key
+        assert g["frames"].chunks == (1, h, w, 3) and g["labels"].chunks == (1, h, w)
+        assert g["entities/role"][0].decode() == "target"
+        assert g["templates/1"].dtype == np.uint8 and g["templates/1"].shape[2] == 4
+
+
+def test_lazy_read_of_a_range(tmp_path, seq):
+    path = tmp_path / "s.h5"
+    write(path, seq)
+    back = read(path)
+    np.testing.assert_array_equal(back.frames[4:7], seq.frames[4:7])
+    assert back.frames.shape == seq.frames.shape and len(back.frames) == 12
+
+
+def test_several_sequences_need_a_name(tmp_path, seq):
+    other = scenegen.generate("kams-a", seed=0, frames=3)
+    path = tmp_path / "two.h5"
+    write(path, seq, other)
+    with pytest.raises(DataError, match="holds 2 sequences; name one of"):
+        read(path)
+    assert read(path, "kams-a").n_frames == 3
+    with pytest.raises(DataError, match="no sequence 'zzz'"):
+        read(path, "zzz")
+
+
+def test_not_hdf5_and_other_schema(tmp_path):
+    junk = tmp_path / "junk.h5"
+    junk.write_bytes(b"hello")
+    with pytest.raises(DataError, match="not an HDF5 file"):
+        read(junk)
+    other = tmp_path / "other.h5"
+    with h5py.File(other, "w") as f:
+        f.attrs["schema"] = "somebody/2"
+    with pytest.raises(DataError, match="schema is 'somebody/2', expected 'scenegen/1'"):
+        read(other)
+
+
+def test_result_round_trip(tmp_path):
+    res = TrackerResult(
+        tracker="shm", params={"n": 3}, seed=7, sequence="x",
+        target_ids=np.array([1, 2], np.int32), boxes=np.ones((4, 2, 4), np.float32),
+        orderings=np.array([[0, 1], [1, 0]], np.int16), order_prob=np.full((4, 2), 0.5, np.float32),
+    )  # fmt: skip
+    path = tmp_path / "r.h5"
+    write_result(path, res)
+    back = read_result(path)
+    assert back.tracker == "shm" and back.params == {"n": 3} and back.seed == 7
+    np.testing.assert_array_equal(back.orderings, res.orderings)
+    with h5py.File(path) as f:
+        g = f["results/shm"]
+        assert g["boxes"].dtype == np.float32 and g["orderings"].dtype == np.int16
+        assert g["order_prob"].shape == (4, 2)

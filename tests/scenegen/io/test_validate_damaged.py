@@ -1,0 +1,411 @@
+"""``validate`` on deliberately damaged files: every kind of damage is named in one line.
+
+Each test copies a small valid file, damages it in one way (h5py edits, truncation, flipped
+bytes inside a chunk) and asserts the exact problem line. The CLI prints one line per
+problem and exits 1, never a traceback; a crash of the HDF5 library itself on corrupted
+metadata becomes a problem line too (``validate`` checks in a child process).
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import signal
+
+import h5py
+import numpy as np
+import pytest
+
+from scenegen.cli import main
+from scenegen.config import from_dict
+from scenegen.errors import DataError
+from scenegen.io import TrackerResult, read, validate, write_result, write_scenario
+from scenegen.io.validate import check_file
+from scenegen.render.plan import plan
+
+SCENE = {
+    "name": "small",
+    "width": 48,
+    "height": 40,
+    "n_frames": 8,
+    "background": {"kind": "noise"},
+    "entities": [
+        {"name": "a", "role": "target", "position": [10, 20], "depth": 1,
+         "appearance": {"shape": "ellipse", "size": [9, 9], "colors": [[255, 0, 0]]},
+         "motion": {"x": {"boundary": "reflect"}, "y": {"boundary": "reflect"},
+                    "velocity": [3, 0]}},
+        {"name": "b", "role": "distractor", "position": [38, 22], "depth": 2,
+         "appearance": {"shape": "rect", "size": [7, 11], "colors": [[0, 0, 255]]},
+         "motion": {"x": {"boundary": "reflect"}, "y": {"boundary": "reflect"},
+                    "velocity": [-3, 0]}},
+        {"name": "wall", "role": "occluder", "position": [24, 12], "depth": 0,
+         "appearance": {"size": [6, 14], "colors": [[90, 90, 90]]}},
+    ],
+}  # fmt: skip
+SEQ = "sequence 'small'"
+
+
+@pytest.fixture(scope="module")
+def originals(tmp_path_factory):
+    """One valid file per compression."""
+    d = tmp_path_factory.mktemp("valid")
+    scn = plan(from_dict(SCENE), 5)
+    out = {}
+    for comp in ("gzip", "lzf", "none"):
+        out[comp] = d / f"small-{comp}.h5"
+        write_scenario(out[comp], scn, compression=comp)
+    return out
+
+
+@pytest.fixture
+def copy(tmp_path, originals):
+    """``copy(comp="gzip") -> path`` of a fresh copy of the valid file."""
+
+    def make(comp: str = "gzip"):
+        path = tmp_path / f"damaged-{comp}.h5"
+        shutil.copy(originals[comp], path)
+        return path
+
+    return make
+
+
+def edit(path, fn):
+    with h5py.File(path, "r+") as f:
+        fn(f["sequences/small"], f)
+    return path
+
+
+def flip(path, dataset, index):
+    """XOR bytes in the middle of the stored chunk ``index`` of ``dataset``."""
+    with h5py.File(path, "r") as f:
+        info = f[f"sequences/small/{dataset}"].id.get_chunk_info_by_coord(index)
+    with open(path, "r+b") as fh:
+        mid = info.byte_offset + info.size // 2
+        fh.seek(mid)
+        data = fh.read(4)
+        fh.seek(mid)
+        fh.write(bytes(b ^ 0x5A for b in data))
+    return path
+
+
+def test_the_valid_files_are_valid(originals):
+    for path in originals.values():
+        assert check_file(path) == []
+        assert check_file(path, isolate=True) == []
+
+
+def test_missing_schema(copy):
+    p = copy()
+    with h5py.File(p, "r+") as f:
+        del f.attrs["schema"]
+    assert check_file(p) == [f"{p}: missing schema attribute (expected 'scenegen/1')"]
+
+
+def test_wrong_schema(copy):
+    p = copy()
+    with h5py.File(p, "r+") as f:
+        f.attrs["schema"] = "scenegen/0"
+    assert check_file(p) == [f"{p}: schema is 'scenegen/0', expected 'scenegen/1'"]
+
+
+@pytest.mark.parametrize(
+    "key", ["frames", "labels", "gt/box", "gt/present", "gt/depth", "entities/role"]
+)
+def test_missing_dataset(copy, key):
+    p = edit(copy(), lambda g, f: g.__delitem__(key))
+    assert check_file(p) == [f"{p}: {SEQ}: missing dataset {key}"]
+
+
+def test_missing_attribute_and_group(copy):
+    def damage(g, f):
+        del g.attrs["n_frames"]
+
+    p = edit(copy(), damage)
+    assert check_file(p) == [f"{p}: {SEQ}: missing attribute n_frames"]
+    p = edit(copy(), lambda g, f: g.__delitem__("templates"))
+    assert check_file(p) == [f"{p}: {SEQ}: missing group templates"]
+    p = edit(copy(), lambda g, f: g.__delitem__("templates/2"))
+    assert check_file(p) == [f"{p}: {SEQ}: templates missing for ids 2"]
+
+
+def replace(g, key, data, **kw):
+    del g[key]
+    g.create_dataset(key, data=data, **kw)
+
+
+def test_shape_mismatch(copy):
+    p = edit(copy(), lambda g, f: replace(g, "gt/box", g["gt/box"][:7]))
+    assert check_file(p) == [f"{p}: {SEQ}: gt/box has shape (7, 3, 4), expected (8, 3, 4)"]
+    p = edit(copy(), lambda g, f: replace(g, "labels", g["labels"][:, :, :47]))
+    assert check_file(p) == [f"{p}: {SEQ}: labels has shape (8, 40, 47), expected (8, 40, 48)"]
+
+
+def test_dtype_mismatch(copy):
+    p = edit(copy(), lambda g, f: replace(g, "labels", g["labels"][()].astype(np.uint8)))
+    assert check_file(p) == [f"{p}: {SEQ}: labels has dtype uint8, expected uint16"]
+    p = edit(copy(), lambda g, f: replace(g, "gt/present", g["gt/present"][()].astype(np.int8)))
+    assert check_file(p) == [f"{p}: {SEQ}: gt/present has dtype int8, expected bool"]
+    p = edit(copy(), lambda g, f: replace(g, "entities/role", np.array([1, 2, 3])))
+    assert check_file(p) == [f"{p}: {SEQ}: entities/role has dtype int64, expected string"]
+
+
+def test_config_attribute(copy):
+    def bad_json(g, f):
+        g.attrs["config"] = "{not json"
+
+    p = edit(copy(), bad_json)
+    (line,) = check_file(p)
+    assert line.startswith(f"{p}: {SEQ}: attribute config is not a valid config: ")
+
+    def other_width(g, f):
+        g.attrs["width"] = 50
+
+    p = edit(copy(), other_width)
+    problems = check_file(p)
+    assert f"{p}: {SEQ}: attribute width=50 disagrees with the config's 48" in problems
+    assert f"{p}: {SEQ}: frames has shape (8, 40, 48, 3), expected (8, 40, 50, 3)" in problems
+
+
+def test_labels_naming_unknown_ids(copy):
+    def damage(g, f):
+        g["labels"][3, 0, 0] = 99
+
+    p = edit(copy(), damage)
+    assert check_file(p) == [f"{p}: {SEQ}: labels name ids not in entities/id at frames 3"]
+
+
+def test_visible_box_disagrees_with_labels(copy):
+    def damage(g, f):
+        vb = g["gt/visible_box"][()]
+        assert np.isfinite(vb[2, 0]).all()
+        vb[2, 0, 0] += 1
+        g["gt/visible_box"][...] = vb
+
+    p = edit(copy(), damage)
+    assert check_file(p) == [f"{p}: {SEQ}: gt/visible_box disagrees with labels at frames 2"]
+
+
+def test_visibility_disagrees_with_labels(copy):
+    def damage(g, f):
+        vis = g["gt/visibility"][()]
+        assert vis[5, 0] > 0
+        vis[5, 0] = 0
+        g["gt/visibility"][...] = vis
+
+    p = edit(copy(), damage)
+    assert check_file(p) == [
+        f"{p}: {SEQ}: gt/visibility or gt/present disagree with labels at frames 5"
+    ]
+
+
+def test_nan_pattern_disagrees_with_present(copy):
+    def nan_where_present(g, f):
+        box = g["gt/box"][()]
+        assert g["gt/present"][4, 1]
+        box[4, 1] = np.nan
+        g["gt/box"][...] = box
+
+    p = edit(copy(), nan_where_present)
+    assert check_file(p) == [
+        f"{p}: {SEQ}: gt/box NaN pattern disagrees with gt/present at frames 4"
+    ]
+
+    def absent_but_finite(g, f):
+        present = g["gt/present"][()]
+        present[6, 0] = False
+        g["gt/present"][...] = present
+
+    p = edit(copy(), absent_but_finite)
+    problems = check_file(p)
+    for line in (
+        "gt/box NaN pattern disagrees with gt/present at frames 6",
+        "gt/center NaN pattern disagrees with gt/present at frames 6",
+        "gt/visible_box is set where gt/present is false at frames 6",
+        "gt/visibility is nonzero where absent at frames 6",
+    ):
+        assert f"{p}: {SEQ}: {line}" in problems
+
+
+def test_center_and_ranges(copy):
+    def damage(g, f):
+        center = g["gt/center"][()]
+        center[1, 0, 0] += 3
+        g["gt/center"][...] = center
+        vis = g["gt/visibility"][()]
+        vis[7, 2] = 1.5
+        g["gt/visibility"][...] = vis
+
+    p = edit(copy(), damage)
+    problems = check_file(p, check_pixels=False)
+    assert problems == [
+        f"{p}: {SEQ}: gt/visibility is outside [0, 1] at frames 7",
+        f"{p}: {SEQ}: gt/center is not the centre of gt/box at frames 1",
+    ]
+
+
+def test_ids_must_be_unique(copy):
+    p = edit(copy(), lambda g, f: replace(g, "entities/id", np.array([1, 1, 3], np.int32)))
+    assert check_file(p) == [f"{p}: {SEQ}: entities/id must be unique and >= 1, got [1, 1, 3]"]
+
+
+@pytest.mark.parametrize("cut", ["0", "8", "100", "half", "size-1"])
+def test_truncated(copy, cut):
+    p = copy()
+    size = p.stat().st_size
+    n = {"0": 0, "8": 8, "100": 100, "half": size // 2, "size-1": size - 1}[cut]
+    os.truncate(p, n)
+    (line,) = check_file(p)
+    if n == 0:
+        assert line == f"{p}: not an HDF5 file"
+    elif n == 8:
+        assert line.startswith(f"{p}: not a readable HDF5 file (truncated or corrupted: ")
+    else:
+        assert line == f"{p}: truncated HDF5 file ({n} of {size} bytes)"
+    with pytest.raises(DataError) as err:
+        read(p)
+    assert str(err.value) == line
+
+
+@pytest.mark.parametrize("comp", ["gzip", "lzf", "none"])
+@pytest.mark.parametrize(("dataset", "index"), [("frames", (3, 0, 0, 0)), ("labels", (5, 0, 0))])
+def test_flipped_bytes_in_a_chunk(copy, comp, dataset, index):
+    p = flip(copy(comp), dataset, index)
+    assert check_file(p) == [
+        f"{p}: {SEQ}: {dataset} is damaged at frames {index[0]} (checksum or decompression failed)"
+    ]
+    seq = read(p)
+    np.asarray(getattr(seq, dataset)[index[0] + 1])  # other frames still read
+    with pytest.raises(DataError, match=rf"{dataset}\[{index[0]}\] is unreadable"):
+        getattr(seq, dataset)[index[0]]
+
+
+def test_flipped_bytes_in_ground_truth(copy):
+    p = flip(copy("none"), "gt/box", (0, 0, 0))
+    assert check_file(p) == [f"{p}: {SEQ}: gt/box is unreadable (checksum or decompression failed)"]
+    with pytest.raises(DataError, match=r"sequence 'small' is damaged"):
+        read(p)
+
+
+def test_damage_without_checksums_is_still_caught(copy):
+    """Files written without Fletcher-32 (other tools): labels are checked pixel by pixel,
+    and zlib's own checksum catches changes to gzip-compressed frames."""
+
+    def strip(g, f):
+        replace(g, "labels", g["labels"][()], chunks=(1, 40, 48))
+        replace(g, "frames", g["frames"][()], chunks=(1, 40, 48, 3), compression="gzip")
+
+    p = edit(copy(), strip)
+    assert check_file(p) == []
+    with h5py.File(p) as f:
+        info = f["sequences/small/labels"].id.get_chunk_info_by_coord((3, 0, 0))
+    with open(p, "r+b") as fh:
+        fh.seek(info.byte_offset + 40)
+        fh.write(b"\xff\xff\xff\xff")
+    p = flip(p, "frames", (6, 0, 0, 0))
+    assert check_file(p) == [
+        f"{p}: {SEQ}: frames is damaged at frames 6 (checksum or decompression failed)",
+        f"{p}: {SEQ}: labels name ids not in entities/id at frames 3",
+    ]
+
+
+def test_not_hdf5_folder_and_temp_file(copy, tmp_path):
+    junk = tmp_path / "junk.h5"
+    junk.write_text("hello")
+    assert check_file(junk) == [f"{junk}: not an HDF5 file"]
+    assert check_file(tmp_path) == [f"{tmp_path}: is a folder, not a scenegen file"]
+    tmp = tmp_path / ".small.h5.tmp-4242@somehost-abc123"
+    shutil.copy(copy(), tmp)
+    assert check_file(tmp) == [
+        f"{tmp}: an unfinished temporary file of a write to 'small.h5' (process 4242 on somehost)"
+    ]
+
+
+def test_result_files(tmp_path):
+    res = TrackerResult(
+        tracker="kalman", params={}, seed=0, sequence="small",
+        target_ids=np.array([1], np.int32), boxes=np.zeros((8, 1, 4), np.float32),
+    )  # fmt: skip
+    p = tmp_path / "r.h5"
+    write_result(p, res)
+    assert check_file(p) == []
+    with h5py.File(p, "r+") as f:
+        del f["results/kalman/boxes"]
+        f["results/kalman/boxes"] = np.zeros((8, 2, 4), np.float64)
+    assert check_file(p) == [
+        f"{p}: result 'kalman': boxes has shape (8, 2, 4), expected (8, 1, 4)",
+        f"{p}: result 'kalman': boxes has dtype float64, expected float32",
+    ]
+    with h5py.File(p, "r+") as f:
+        del f["results/kalman/boxes"]
+    assert check_file(p) == [f"{p}: result 'kalman': missing dataset boxes"]
+
+
+def test_cli_prints_one_line_per_problem_and_exits_1(copy, capsys):
+    p = edit(copy(), lambda g, f: g["labels"].__setitem__((3, 0, 0), 99))
+    p = flip(p, "frames", (2, 0, 0, 0))
+    code = main(["validate", str(p)])
+    out, err = capsys.readouterr()
+    assert code == 1 and out == ""
+    assert err.splitlines() == [
+        f"{p}: {SEQ}: frames is damaged at frames 2 (checksum or decompression failed)",
+        f"{p}: {SEQ}: labels name ids not in entities/id at frames 3",
+    ]
+    size = p.stat().st_size
+    os.truncate(p, 1000)
+    code = main(["validate", str(p)])
+    out, err = capsys.readouterr()
+    assert code == 1 and err.splitlines() == [f"{p}: truncated HDF5 file (1000 of {size} bytes)"]
+
+
+def test_other_verbs_on_a_damaged_chunk_exit_1_with_one_line(copy, tmp_path, capsys):
+    p = flip(copy(), "frames", (4, 0, 0, 0))
+    code = main(["export", str(p), "--format", "mot", "-o", str(tmp_path / "mot")])
+    _, err = capsys.readouterr()
+    assert code == 1
+    assert err == (
+        f"scenegen: error: {p}: sequences/small/frames[4] is unreadable "
+        "(damaged file: checksum or decompression failed)\n"
+    )
+    assert not (tmp_path / "mot").exists()
+    assert not list(tmp_path.glob(".mot.*"))  # the temporary folder is removed
+
+
+def test_a_crash_of_the_hdf5_library_becomes_one_line(copy, monkeypatch):
+    """Some corrupted metadata crashes libhdf5 itself (segmentation fault); the isolated
+    check reports that instead of dying. Simulated: the forked child kills itself."""
+
+    def crash(*args, **kwargs):
+        os.kill(os.getpid(), signal.SIGSEGV)
+
+    monkeypatch.setattr(validate, "_check_open_file", crash)
+    p = copy()
+    assert check_file(p, isolate=True) == [
+        f"{p}: damaged HDF5 file: the HDF5 library crashed reading it (SIGSEGV)"
+    ]
+
+
+def test_an_unexpected_error_in_the_isolated_check_is_one_line(copy, monkeypatch, capfd):
+    def fail(*args, **kwargs):
+        raise MemoryError("simulated")
+
+    monkeypatch.setattr(validate, "_check_open_file", fail)
+    p = copy()
+    assert check_file(p, isolate=True) == [f"{p}: could not be checked (MemoryError: simulated)"]
+    assert "Traceback" not in capfd.readouterr().err
+
+
+def test_random_byte_damage_never_raises(copy):
+    """Seeded random flips anywhere in the file (metadata included): the isolated check
+    always returns problem lines (or none, for flips in unused bytes), never raises."""
+    p = copy()
+    clean = p.read_bytes()
+    rng = np.random.default_rng(8)
+    for trial in range(24):
+        data = bytearray(clean)
+        span = 4096 if trial % 2 else len(data)  # half of the trials hit the metadata
+        for pos in rng.integers(0, span, size=int(rng.integers(1, 12))):
+            data[pos] ^= int(rng.integers(1, 256))
+        p.write_bytes(bytes(data))
+        problems = check_file(p, isolate=True)
+        assert all(isinstance(line, str) and line.startswith(f"{p}: ") for line in problems)
+        assert all("\n" not in line for line in problems)

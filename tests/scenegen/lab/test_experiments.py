@@ -1,0 +1,236 @@
+"""Experiments: identical results whatever the executor, resumable runs, bad input."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shutil
+import signal
+import time
+
+import pytest
+
+from scenegen.cli import experiment as cli_experiment
+from scenegen.errors import ConfigError
+from scenegen.lab.experiments import derive_seed, get, names, run_experiment
+from scenegen.lab.experiments.runner import Task, execute, plan_tasks
+
+# A small stochastic sweep: two seeded runs of two particle filters (quick: fewer
+# particles, λ = 20 only).
+NAME = "dps-synthetic"
+METHODS = ["nonps", "dps"]
+KW = {"runs": 2, "quick": True, "methods": METHODS, "progress": False, "figures": False}
+N_TASKS = 4
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory):
+    out = tmp_path_factory.mktemp("ref")
+    run_experiment(NAME, out, jobs=1, **KW)
+    return out
+
+
+def test_seed_derivation_is_stable():
+    # A fixed value: a change of hashing would silently change every published result.
+    assert derive_seed(0, "dps-synthetic", "dps", "dps-synthetic", "lam=20", 3) == (
+        derive_seed(0, "dps-synthetic", "dps", "dps-synthetic", "lam=20", 3)
+    )
+    assert derive_seed("a") == 6023598183589259276
+    assert derive_seed(0, "x", 1) != derive_seed(0, "x", 2)
+    t = Task(NAME, "dps", "dps-synthetic", "lam", 20.0, 0, 0, True)
+    other_run = Task(NAME, "dps", "dps-synthetic", "lam", 20.0, 1, 0, True)
+    assert t.tracker_seed() != other_run.tracker_seed()
+
+
+def test_same_bytes_with_two_local_processes(reference, tmp_path):
+    run_experiment(NAME, tmp_path, jobs=2, **KW)
+    assert (tmp_path / "results.json").read_bytes() == (reference / "results.json").read_bytes()
+    assert (tmp_path / "table.md").read_bytes() == (reference / "table.md").read_bytes()
+
+
+def test_same_bytes_on_a_dask_cluster(reference, tmp_path):
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(
+        n_workers=2, processes=True, threads_per_worker=1, dashboard_address=None
+    ) as cluster:
+        run_experiment(NAME, tmp_path, scheduler=cluster.scheduler_address, **KW)
+    assert (tmp_path / "results.json").read_bytes() == (reference / "results.json").read_bytes()
+
+
+def test_lost_dask_worker_loses_no_results(reference, tmp_path):
+    distributed = pytest.importorskip("distributed")
+    tasks = plan_tasks(get(NAME), runs=2, seed=0, quick=True, methods=METHODS)
+    killed: list[int] = []
+    with distributed.LocalCluster(
+        n_workers=2, processes=True, threads_per_worker=1, dashboard_address=None
+    ) as cluster:
+        pids = [w.process.pid for w in cluster.workers.values()]
+
+        def kill_a_worker(task):
+            if not killed:  # SIGKILL one worker as soon as the first run is stored
+                os.kill(pids[0], signal.SIGKILL)
+                killed.append(pids[0])
+
+        execute(tasks, tmp_path / "runs", scheduler=cluster.scheduler_address,
+                progress=False, on_done=kill_a_worker)
+    assert killed
+    assert len(list((tmp_path / "runs").glob("*.json"))) == len(tasks)
+    run_experiment(NAME, tmp_path, jobs=1, **KW)
+    assert (tmp_path / "results.json").read_bytes() == (reference / "results.json").read_bytes()
+
+
+def test_resume_skips_stored_runs_and_gives_same_results(reference, tmp_path):
+    shutil.copytree(reference / "runs", tmp_path / "runs")
+    stored = sorted((tmp_path / "runs").glob("*.json"))
+    assert len(stored) == N_TASKS
+    # An interrupted sweep: half the runs are missing.
+    for p in stored[::2]:
+        p.unlink()
+    # Mark a surviving run: if it were recomputed, the marker would be gone.
+    kept = stored[1]
+    rec = json.loads(kept.read_text())
+    rec["marker"] = "stored before the interruption"
+    kept.write_text(json.dumps(rec))
+    run_experiment(NAME, tmp_path, jobs=1, **KW)
+    assert json.loads(kept.read_text())["marker"] == "stored before the interruption"
+    assert (tmp_path / "results.json").read_bytes() == (reference / "results.json").read_bytes()
+    assert len(list((tmp_path / "runs").glob("*.json"))) == N_TASKS
+    assert not list((tmp_path / "runs").glob(".*"))  # no temporary files left behind
+
+
+def test_stale_or_damaged_run_files_are_redone(reference, tmp_path):
+    shutil.copytree(reference / "runs", tmp_path / "runs")
+    stored = sorted((tmp_path / "runs").glob("*.json"))
+    stored[0].write_text("{not json")
+    rec = json.loads(stored[1].read_text())
+    rec["key"]["seed"] = 99  # a run of another base seed: not this sweep's
+    stored[1].write_text(json.dumps(rec))
+    rec = json.loads(stored[2].read_text())
+    rec["params"]["n_particles"] = 7  # stored by an older definition of the experiment
+    stored[2].write_text(json.dumps(rec))
+    run_experiment(NAME, tmp_path, jobs=1, **KW)
+    assert (tmp_path / "results.json").read_bytes() == (reference / "results.json").read_bytes()
+
+
+def test_results_json_is_deterministic_and_complete(reference):
+    doc = json.loads((reference / "results.json").read_text())
+    assert doc["experiment"] == NAME and doc["runs"] == 2 and doc["quick"] is True
+    assert {m["slug"] for m in doc["methods"]} == set(METHODS)
+    assert list(doc["summary"]["by_value"]) == ["20"]
+    assert "fidelity" in doc and "summary" in doc
+    text = (reference / "results.json").read_text()
+    assert "NaN" not in text and "Infinity" not in text
+
+
+def test_unknown_names_list_the_valid_ones(tmp_path):
+    with pytest.raises(ConfigError, match="valid experiments: dps-synthetic, dps-occlusion"):
+        run_experiment("nope", tmp_path)
+    with pytest.raises(ConfigError, match="valid methods: kalman, shm, shm-fast"):
+        run_experiment("shm-depth", tmp_path, methods=["dps"], runs=1)
+    with pytest.raises(ConfigError, match="runs must be >= 1"):
+        run_experiment(NAME, tmp_path, runs=0, quick=True)
+    assert names() == [
+        "dps-synthetic", "dps-occlusion", "kams-accuracy", "kams-robustness", "shm-depth"
+    ]
+
+
+def test_unreachable_scheduler_fails_within_10_s(tmp_path):
+    address = "tcp://127.0.0.1:9"
+    t0 = time.monotonic()
+    with pytest.raises(ConfigError, match="tcp://127.0.0.1:9"):
+        run_experiment(NAME, tmp_path, scheduler=address, **KW)
+    assert time.monotonic() - t0 < 10.0
+
+
+def _cli(argv):
+    parser = argparse.ArgumentParser()
+    sub = parser.add_subparsers()
+    cli_experiment.register(sub)
+    args = parser.parse_args(argv)
+    return args.func(args)
+
+
+def test_experiment_verb(reference, tmp_path, capsys):
+    shutil.copytree(reference / "runs", tmp_path / "runs")
+    assert _cli(["experiment", NAME, "--runs", "2", "--quick", "--jobs", "1", "--method",
+                 "nonps", "--method", "dps", "-o", str(tmp_path)]) == 0
+    assert capsys.readouterr().out.strip().endswith("results.json")
+    assert (tmp_path / "results.json").read_bytes() == (reference / "results.json").read_bytes()
+    for f in ("table.md", "success_recovery.png", "fig4_uniqueness_effective_dynamics.png"):
+        assert (tmp_path / f).stat().st_size > 0
+    with pytest.raises(ConfigError, match="valid experiments"):
+        _cli(["experiment", "bogus", "-o", str(tmp_path)])
+    with pytest.raises(ConfigError, match="valid methods"):
+        _cli(["experiment", NAME, "--method", "bogus", "-o", str(tmp_path)])
+
+
+def test_sweep_values_can_be_restricted(tmp_path):
+    tasks = plan_tasks(get("dps-synthetic"), runs=2, seed=0, quick=False, values=[30])
+    assert {t.value for t in tasks} == {30.0} and len(tasks) == 9 * 2
+    with pytest.raises(ConfigError, match="valid values: 20, 30, 40, 50"):
+        plan_tasks(get("dps-synthetic"), runs=2, seed=0, quick=False, values=[25])
+
+
+@pytest.mark.slow
+def test_dps_synthetic_fidelity(tmp_path):
+    """Issue 6 item 6: 50 runs at λ = 20 reproduce the DPS paper's orderings."""
+    res = run_experiment("dps-synthetic", tmp_path, runs=50, values=[20], progress=False)
+    row = res["summary"]["by_value"]["20"]
+    nonps, dps, ps = row["methods"]["nonps"], row["methods"]["dps"], row["ps_mean"]
+    assert dps["hard"]["recovery"] > ps["hard"]["recovery"] > nonps["hard"]["recovery"]
+    assert ps["others"]["precision"] > nonps["others"]["precision"]
+    assert dps["others"]["precision"] > nonps["others"]["precision"]
+
+
+def test_report_links_tables_figures_and_previews(reference, tmp_path):
+    from scenegen.lab.report import build_report, markdown_to_html
+
+    shutil.copytree(reference, tmp_path / "experiments" / NAME)
+    run_experiment(NAME, tmp_path / "experiments" / NAME, jobs=1, runs=2, quick=True,
+                   methods=METHODS, progress=False)
+    (tmp_path / "presets").mkdir()
+    for f in ("kams-a.png", "kams-a.gif", "kams-a.h5"):
+        (tmp_path / "presets" / f).write_bytes(b"x")
+    index = build_report(tmp_path)
+    page = index.read_text()
+    assert f"experiments/{NAME}/success_recovery.png" in page
+    assert f"experiments/{NAME}/table.md" in page
+    assert "presets/kams-a.gif" in page and "presets/kams-a.png" in page
+    assert "id='fidelity'" in page and "kams-accuracy" in page  # missing ones are listed
+    doc = json.loads((tmp_path / "results.json").read_text())
+    assert list(doc["experiments"]) == [NAME]
+    assert build_report(tmp_path).read_text() == page  # deterministic
+    assert markdown_to_html("| a | b |\n|---|---|\n| **1** | `x<y` |") == (
+        "<table>\n<tr><th>a</th><th>b</th></tr>\n"
+        "<tr><td><strong>1</strong></td><td><code>x&lt;y</code></td></tr>\n</table>"
+    )
+
+
+def test_cli_exit_codes_for_bad_input(tmp_path, capsys):
+    from scenegen.cli import main
+
+    assert main(["experiment", "nope", "-o", str(tmp_path)]) == 2
+    assert "valid experiments: dps-synthetic" in capsys.readouterr().err
+    assert main(["experiment", NAME, "--method", "x", "-o", str(tmp_path)]) == 2
+    assert "valid methods: nonps, ps-1234567" in capsys.readouterr().err
+    assert main(["experiment", NAME, "--jobs", "0", "-o", str(tmp_path)]) == 2
+
+
+@pytest.mark.parametrize(
+    ("name", "methods", "figures"),
+    [
+        ("dps-occlusion", ["dps"], ["success_recovery.png", "uniqueness.png"]),
+        ("kams-accuracy", ["sok"], ["centre_error.png"]),
+        ("kams-robustness", ["kams", "meanshift"], ["robustness_z.png"]),
+        ("shm-depth", ["kalman", "shm-fast"], ["ordering_probability.png"]),
+    ],
+)
+def test_every_experiment_end_to_end_in_quick_mode(tmp_path, name, methods, figures):
+    res = run_experiment(name, tmp_path, runs=1 if name != "kams-robustness" else 2,
+                         quick=True, methods=methods, jobs=1, progress=False)
+    assert res["experiment"] == name and res["summary"]
+    table = (tmp_path / "table.md").read_text()
+    assert table.startswith(f"# {name}:") and "## Fidelity" in table
+    for f in figures:
+        assert (tmp_path / f).stat().st_size > 1000, f

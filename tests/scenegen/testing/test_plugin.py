@@ -1,0 +1,239 @@
+"""The pytest plugin as a user meets it: test files run with ``pytester``."""
+
+import json
+
+import numpy as np
+import pytest
+
+from scenegen.io import write
+from scenegen.render.plan import generate
+from scenegen.testing.fixtures import digests
+from scenegen.testing.pytest_plugin import (
+    assert_close_to_expected,
+    cache_key,
+    generator_fingerprint,
+)
+
+pytest_plugins = ["pytester"]
+
+SMALL = {
+    "width": 40,
+    "height": 30,
+    "n_frames": 3,
+    "entities": [
+        {
+            "name": "t",
+            "role": "target",
+            "position": [20, 15],
+            "appearance": {"size": [6, 6]},
+            "motion": {"x": {"boundary": "reflect", "sigma": 1}, "y": {"boundary": "reflect"}},
+        }
+    ],
+}
+
+
+def test_sequence_factory_generates_caches_and_freezes(pytester):
+    pytester.makepyfile(
+        test_user=f"""
+        import numpy as np
+        import pytest
+
+        CONFIG = {SMALL!r}
+
+        def test_preset(scenegen_sequence):
+            seq = scenegen_sequence("kams-a", seed=3, frames=2)
+            assert seq.frames.shape == (2, 240, 320, 3) and seq.seed == 3
+            assert seq is scenegen_sequence("kams-a", seed=3, frames=2)
+            with pytest.raises(ValueError):
+                seq.frames[0, 0, 0, 0] = 1
+
+        def test_config(scenegen_sequence):
+            seq = scenegen_sequence(CONFIG, seed=1)
+            assert isinstance(seq.frames, np.ndarray) and seq.frames.shape == (3, 30, 40, 3)
+            assert seq.gt.box.shape == (3, 1, 4)
+            assert not seq.gt.box.flags.writeable
+
+        def test_preset_name_is_kept(scenegen_sequence):
+            from scenegen import presets
+            a = scenegen_sequence("kams-a", seed=3, frames=2)
+            b = scenegen_sequence(presets.get("kams-a"), seed=3, frames=2)
+            assert a.preset == "kams-a" and b.preset == ""
+            np.testing.assert_array_equal(a.frames, b.frames)
+
+        def test_bad_seed(scenegen_sequence):
+            from scenegen.errors import ConfigError
+            with pytest.raises(ConfigError, match="seed"):
+                scenegen_sequence(CONFIG, seed=-1)
+        """
+    )
+    pytester.runpytest("-q").assert_outcomes(passed=4)
+    cached = sorted((pytester.path / ".pytest_cache" / "d" / "scenegen").glob("*.h5"))
+    assert len(cached) == 3
+    # The second session reads the cache: same contents as a fresh generation.
+    pytester.runpytest("-q").assert_outcomes(passed=4)
+    from scenegen.io import read
+
+    by_seed = {read(p).seed: read(p) for p in cached if not p.stem.endswith("kams-a")}
+    # Without pytest's cache plugin the factory still works, from memory only.
+    pytester.runpytest("-q", "-p", "no:cacheprovider").assert_outcomes(passed=4)
+    np.testing.assert_array_equal(np.asarray(by_seed[1].frames), generate(SMALL, seed=1).frames)
+
+
+def test_sequence_factory_works_inside_given(pytester):
+    pytester.makepyfile(
+        test_given=f"""
+        from hypothesis import given, settings, strategies as st
+
+        @settings(max_examples=3, deadline=None)
+        @given(seed=st.integers(0, 2))
+        def test_any_seed(scenegen_sequence, seed):
+            assert scenegen_sequence({SMALL!r}, seed=seed).seed == seed
+        """
+    )
+    pytester.runpytest("-q").assert_outcomes(passed=1)
+
+
+def test_expect_regen_then_compare_then_detect_change(pytester):
+    pytester.makepyfile(
+        test_expect="""
+        import numpy as np
+        import pytest
+
+        VALUE = 1.0
+
+        def test_boxes(scenegen_expect):
+            boxes = np.array([[[1.0, 2.0, 3.0, 4.0]], [[np.nan, 2.0, 3.0, VALUE]]])
+            scenegen_expect("run/boxes", boxes, atol=0.01)
+
+        @pytest.mark.scenegen_tolerance(atol=0.5)
+        def test_marker_tolerance(scenegen_expect):
+            scenegen_expect("loose", np.array([10.0 + VALUE / 10]))
+        """
+    )
+    first = pytester.runpytest("-q")
+    first.assert_outcomes(failed=2)
+    first.stdout.fnmatch_lines(["*no stored expectation*--scenegen-regen*"])
+
+    regen = pytester.runpytest("-q", "--scenegen-regen")
+    regen.assert_outcomes(passed=2)
+    regen.stdout.fnmatch_lines(["*scenegen --scenegen-regen*", "wrote: *boxes.npy"])
+    stored = pytester.path / "fixtures" / "expected" / "run" / "boxes.npy"
+    assert stored.exists() and (pytester.path / "fixtures" / "expected" / "loose.npy").exists()
+
+    pytester.runpytest("-q").assert_outcomes(passed=2)
+    # Unchanged expectations are not rewritten.
+    mtime = stored.stat().st_mtime_ns
+    again = pytester.runpytest("-q", "--scenegen-regen")
+    assert stored.stat().st_mtime_ns == mtime
+    assert "wrote:" not in again.stdout.str()
+
+    # A change beyond atol fails, naming the file and the difference; within the marker's
+    # tolerance it passes.
+    pytester.makepyfile(test_expect=pytester.path.joinpath("test_expect.py").read_text()
+                        .replace("VALUE = 1.0", "VALUE = 1.5"))  # fmt: skip
+    changed = pytester.runpytest("-q")
+    changed.assert_outcomes(passed=1, failed=1)
+    changed.stdout.fnmatch_lines(["*boxes.npy: 1 of 8 values differ beyond atol=0.01*"])
+
+
+def test_fixture_reads_committed_files_and_checks_digests(pytester):
+    folder = pytester.path / "data"
+    folder.mkdir()
+    seq = generate(SMALL, seed=2)
+    write(folder / "small.h5", seq)
+    registry = {"fixtures": {"small": {"digests": digests(seq)}}}
+    (folder / "registry.json").write_text(json.dumps(registry))
+    pytester.makepyfile(
+        test_fixture="""
+        import pytest
+
+        def test_read(scenegen_fixture):
+            seq = scenegen_fixture("small")
+            assert seq.frames.shape == (3, 30, 40, 3) and seq.seed == 2
+
+        def test_unknown(scenegen_fixture):
+            with pytest.raises(FileNotFoundError, match="known: small"):
+                scenegen_fixture("missing")
+        """
+    )
+    pytester.runpytest("-q", "--scenegen-fixtures", str(folder)).assert_outcomes(passed=2)
+    # A fixture file that no longer matches its registered digests is refused.
+    write(folder / "small.h5", generate(SMALL, seed=3))
+    tampered = pytester.runpytest("-q", "--scenegen-fixtures", str(folder))
+    tampered.assert_outcomes(passed=1, failed=1)
+    tampered.stdout.fnmatch_lines(["*fixture 'small': *frames* differ from the digests*"])
+
+
+def test_ini_option_sets_the_fixtures_folder(pytester):
+    pytester.makeini("[pytest]\nscenegen_fixtures = golden\n")
+    pytester.makepyfile(
+        test_ini="""
+        import numpy as np
+
+        def test_it(scenegen_expect):
+            scenegen_expect("x", np.arange(3))
+        """
+    )
+    pytester.runpytest("-q", "--scenegen-regen").assert_outcomes(passed=1)
+    assert (pytester.path / "golden" / "expected" / "x.npy").exists()
+
+
+def test_markers_are_registered_and_applied(pytester):
+    pytester.makepyfile(
+        test_markers="""
+        import pytest
+
+        def test_uses_fixture(scenegen_expect):
+            pass
+
+        @pytest.mark.scenegen_tolerance(atol=1.0)
+        def test_plain():
+            pass
+        """
+    )
+    result = pytester.runpytest("-q", "--strict-markers", "-m", "scenegen")
+    result.assert_outcomes(passed=1, deselected=1)
+    listed = pytester.runpytest("--markers")
+    listed.stdout.fnmatch_lines(["@pytest.mark.scenegen:*", "@pytest.mark.scenegen_tolerance*"])
+
+
+def test_expectation_keys_must_stay_inside_the_folder(pytester):
+    pytester.makepyfile(
+        test_keys="""
+        import pytest
+
+        @pytest.mark.parametrize("key", ["../escape", "a/../../b", "/abs", "", "a\\\\b"])
+        def test_bad_key(scenegen_expect, key):
+            with pytest.raises(ValueError, match="key"):
+                scenegen_expect(key, [1.0])
+        """
+    )
+    pytester.runpytest("-q", "--scenegen-regen").assert_outcomes(passed=5)
+
+
+def test_compare_helper_semantics(tmp_path):
+    path = tmp_path / "e.npy"
+    expected = np.array([1.0, np.nan, 3.0])
+    assert assert_close_to_expected(path, expected, regen=True)
+    assert not assert_close_to_expected(path, expected, regen=True)
+    assert_close_to_expected(path, expected + [0.1, 0, 0.3], atol=0.1, rtol=0.1)
+    with pytest.raises(AssertionError, match="NaN pattern"):
+        assert_close_to_expected(path, [1.0, 2.0, 3.0], atol=10)
+    with pytest.raises(AssertionError, match="shape"):
+        assert_close_to_expected(path, [1.0, np.nan])
+    with pytest.raises(AssertionError, match=r"largest difference 0\.5"):
+        assert_close_to_expected(path, [1.5, np.nan, 3.0], atol=0.1)
+    with pytest.raises(ValueError, match="tolerances"):
+        assert_close_to_expected(path, expected, atol=-1)
+
+
+def test_cache_key_changes_with_every_input():
+    from scenegen.config import from_dict
+
+    cfg = from_dict(SMALL)
+    base = cache_key(cfg, 0)
+    assert base == cache_key(from_dict(SMALL), 0)
+    assert len({base, cache_key(cfg, 1), cache_key(cfg, 0, frames=2)}) == 3
+    other = from_dict({**SMALL, "width": 41})
+    assert cache_key(other, 0) != base
+    assert len(generator_fingerprint()) == 16

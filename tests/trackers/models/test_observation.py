@@ -1,0 +1,362 @@
+"""Histogram kernel and colour observation models against plain per-patch oracles."""
+
+import cv2
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from skimage.color import rgb2hsv
+
+from trackers.kernels.histogram import (
+    KERNEL_CONE,
+    KERNEL_EPANECHNIKOV,
+    KERNEL_UNIFORM,
+    bhattacharyya_distance,
+    hsv_n_bins,
+    prepare_references,
+    prepared_distances,
+    quantize_hsv,
+    quantize_rgb,
+    region_distances,
+    region_histograms,
+)
+from trackers.models.observation import ColourModel
+
+KERNELS = (KERNEL_UNIFORM, KERNEL_EPANECHNIKOV, KERNEL_CONE)
+
+
+def _reference_histogram(bin_img, box, n_bins, kernel, n_parts):
+    """One box's histogram the slow, obvious way: every pixel centre tested."""
+    rows, cols = bin_img.shape
+    x, y, w, h = box
+    rr, cc = np.mgrid[0:rows, 0:cols]
+    px, py = cc + 0.5, rr + 0.5
+    inside = (px >= x) & (px < x + w) & (py >= y) & (py < y + h)
+    r2 = ((px - (x + w / 2)) / (w / 2)) ** 2 + ((py - (y + h / 2)) / (h / 2)) ** 2
+    if kernel == KERNEL_UNIFORM:
+        weight = np.ones_like(r2)
+    elif kernel == KERNEL_EPANECHNIKOV:
+        weight = np.clip(1.0 - r2, 0.0, None)
+    else:
+        weight = np.clip(1.0 - np.sqrt(r2), 0.0, None)
+    weight = np.where(inside, weight, 0.0)
+    part = np.minimum(((py - y) / (h / n_parts)).astype(int), n_parts - 1)
+    out = []
+    for j in range(n_parts):
+        wj = np.where(part == j, weight, 0.0)
+        hist = np.bincount(bin_img.ravel(), weights=wj.ravel(), minlength=n_bins)
+        total = hist.sum()
+        out.append(hist / total if total > 0 else np.full(n_bins, 1.0 / n_bins))
+    return np.concatenate(out) / n_parts
+
+
+def _frame(seed, height, width):
+    """A noise frame with a few flat rectangles (flat regions and noise both matter)."""
+    rng = np.random.default_rng(seed)
+    frame = rng.integers(0, 256, (height, width, 3), dtype=np.uint8)
+    for _ in range(3):
+        x0, y0 = rng.integers(0, width), rng.integers(0, height)
+        frame[y0:y0 + rng.integers(1, 20), x0:x0 + rng.integers(1, 20)] = rng.integers(0, 256, 3)
+    return frame
+
+
+@settings(max_examples=40)
+@given(seed=st.integers(0, 2**32 - 1), n_bins=st.integers(2, 300),
+       n_hists=st.integers(1, 20), common_ref=st.booleans())
+def test_bhattacharyya_equals_opencv(seed, n_bins, n_hists, common_ref):
+    rng = np.random.default_rng(seed)
+    # Sparse histograms too: zero bins are where sqrt(p q) formulas usually slip.
+    p = rng.dirichlet(np.full(n_bins, 0.3), n_hists) * (rng.random((n_hists, n_bins)) > 0.3)
+    p[:, 0] += 1e-3
+    p /= p.sum(axis=1, keepdims=True)
+    q = rng.dirichlet(np.ones(n_bins), 1 if common_ref else n_hists)
+    ours = bhattacharyya_distance(p, q[0] if common_ref else q)
+    theirs = [cv2.compareHist(p[i].astype(np.float32), q[0 if common_ref else i]
+                              .astype(np.float32), cv2.HISTCMP_BHATTACHARYYA)
+              for i in range(n_hists)]
+    np.testing.assert_allclose(ours, theirs, atol=2e-6)
+
+
+@settings(max_examples=25)
+@given(seed=st.integers(0, 2**32 - 1), height=st.integers(5, 40), width=st.integers(5, 40),
+       model=st.sampled_from(["rgb", "hsv"]), bins=st.integers(1, 12),
+       kernel=st.sampled_from(KERNELS), n_parts=st.integers(1, 3))
+def test_region_histograms_equal_per_patch_numpy(seed, height, width, model, bins, kernel,
+                                                  n_parts):
+    rng = np.random.default_rng(seed)
+    frame = _frame(seed, height, width)
+    if model == "rgb":
+        bin_img, n_bins = quantize_rgb(frame, bins), bins ** 3
+    else:
+        bin_img, n_bins = quantize_hsv(frame, bins, bins, bins), hsv_n_bins(bins, bins, bins)
+    n = 12
+    # Boxes anywhere: inside, cut by every border, wholly outside, sub-pixel and huge.
+    boxes = np.column_stack([
+        rng.uniform(-0.5 * width, 1.2 * width, n), rng.uniform(-0.5 * height, 1.2 * height, n),
+        rng.uniform(0.3, 1.5 * width, n), rng.uniform(0.3, 1.5 * height, n)])
+    boxes[0] = [0.0, 0.0, width, height]
+    boxes[1] = [-3.0, -2.0, 8.0, 7.0]
+    boxes[2] = [width - 2.5, height - 3.5, 6.0, 7.0]
+    boxes[3] = [width + 1.0, 1.0, 5.0, 5.0]
+    hists = region_histograms(bin_img, boxes, n_bins, kernel, n_parts)
+    expected = np.stack([_reference_histogram(bin_img, b, n_bins, kernel, n_parts)
+                         for b in boxes])
+    # Weights are accumulated in 2**-32 fixed point: exact to ~1e-9 of a small total.
+    np.testing.assert_allclose(hists, expected, rtol=0, atol=1e-8)
+    np.testing.assert_allclose(hists.sum(axis=1), 1.0, atol=1e-12)
+    refs = rng.dirichlet(np.ones(n_bins * n_parts), 3)
+    index = rng.integers(0, 3, n)
+    dist = region_distances(bin_img, boxes, refs, index, kernel, n_parts)
+    np.testing.assert_allclose(dist, bhattacharyya_distance(expected, refs[index]),
+                               rtol=0, atol=1e-7)
+
+
+@settings(max_examples=30)
+@given(seed=st.integers(0, 2**32 - 1), height=st.integers(5, 60), width=st.integers(5, 60),
+       bins=st.integers(1, 6), n_parts=st.integers(1, 3), n_refs=st.integers(1, 3),
+       spread=st.floats(0.5, 30.0), sparsity=st.floats(0.0, 0.95))
+def test_distance_paths_agree_with_per_patch_numpy(seed, height, width, bins, n_parts, n_refs,
+                                                   spread, sparsity):
+    """The integral and direct paths of the uniform kernel, and "auto", give the oracle's
+    distances: clustered and scattered boxes, boxes cut by the border or wholly outside,
+    thinner than a band, and references that are zero on most bins."""
+    rng = np.random.default_rng(seed)
+    frame = _frame(seed, height, width)
+    bin_img, n_bins = quantize_rgb(frame, bins), bins ** 3
+    n = 40
+    centre = rng.uniform(0, [width, height])
+    size = rng.uniform(0.3, 0.8 * max(width, height), 2)
+    boxes = np.column_stack([centre + rng.normal(0.0, spread, (n, 2)) - size / 2,
+                             size * np.exp(rng.normal(0.0, 0.2, (n, 2)))])
+    boxes[0] = [-3.0, -2.0, 8.0, 7.0]
+    boxes[1] = [width + 1.0, 1.0, 5.0, 5.0]
+    boxes[2] = [1.2, 1.2, 4.0, 0.8]
+    refs = rng.dirichlet(np.ones(n_bins * n_parts), n_refs)
+    refs *= rng.random(refs.shape) >= sparsity
+    refs[:, 0] += 1e-3
+    refs /= refs.sum(axis=1, keepdims=True)
+    index = rng.integers(0, n_refs, n)
+    expected = bhattacharyya_distance(
+        np.stack([_reference_histogram(bin_img, b, n_bins, KERNEL_UNIFORM, n_parts)
+                  for b in boxes]), refs[index])
+    for method in ("direct", "integral", "auto"):
+        dist = region_distances(bin_img, boxes, refs, index, KERNEL_UNIFORM, n_parts,
+                                method=method)
+        np.testing.assert_allclose(dist, expected, rtol=0, atol=1e-7, err_msg=method)
+
+
+def test_integral_path_is_taken_for_particle_clouds_and_matches_direct():
+    """A tracker's cloud: 300 boxes around each of 3 objects on a noise frame."""
+    rng = np.random.default_rng(0)
+    frame = rng.integers(0, 256, (120, 160, 3), dtype=np.uint8)
+    bin_img = quantize_rgb(frame)
+    truth = np.array([[20.0, 20.0, 30.0, 30.0], [90.0, 30.0, 30.0, 30.0],
+                      [60.0, 80.0, 30.0, 30.0]])
+    refs = region_histograms(bin_img, truth, 1000, KERNEL_UNIFORM)
+    boxes = np.repeat(truth, 300, axis=0)
+    boxes[:, :2] += rng.normal(0.0, 4.0, (900, 2))
+    index = np.repeat(np.arange(3), 300)
+    direct = region_distances(bin_img, boxes, refs, index, KERNEL_UNIFORM, method="direct")
+    assert np.sum(direct < 1e-6) >= 3  # boxes on the references: d = 0 up to rounding
+    for method in ("integral", "auto"):
+        d = region_distances(bin_img, boxes, refs, index, KERNEL_UNIFORM, method=method)
+        # Compare 1 − ρ = d²: near d = 0 the square root turns a 1e-15 rounding of ρ
+        # into 3e-8 of d.
+        np.testing.assert_allclose(d**2, direct**2, rtol=0, atol=1e-13)
+
+
+def test_empty_region_is_uniform():
+    bins = np.zeros((10, 10), dtype=np.int32)
+    hist = region_histograms(bins, np.array([[20.0, 20.0, 5.0, 5.0], [3.2, 3.2, 0.2, 0.2]]),
+                             4, KERNEL_CONE, 2)
+    np.testing.assert_allclose(hist, 1.0 / 8)
+
+
+def test_quantize_rgb_formula():
+    rng = np.random.default_rng(3)
+    frame = rng.integers(0, 256, (7, 9, 3), dtype=np.uint8)
+    b = frame.astype(int) * 10 // 256
+    np.testing.assert_array_equal(quantize_rgb(frame), b[..., 0] * 100 + b[..., 1] * 10 + b[..., 2])
+
+
+def _reference_hsv(frame, hb, sb, vb, s_min, v_min):
+    f = frame.astype(np.int64)
+    r, g, b = f[..., 0], f[..., 1], f[..., 2]
+    mx, mn = f.max(-1), f.min(-1)
+    d = mx - mn
+    h6 = np.where(mx == r, np.where(g < b, g - b + 6 * d, g - b),
+                  np.where(mx == g, b - r + 2 * d, r - g + 4 * d))
+    hbin = np.minimum(h6 * hb // np.maximum(6 * d, 1), hb - 1)
+    sbin = np.minimum(d * sb // np.maximum(mx, 1), sb - 1)
+    vbin = np.minimum(mx * vb // 255, vb - 1)
+    coloured = (d > 0) & (d * 2**20 >= np.ceil(s_min * 2**20) * mx) & (mx >= v_min * 255 - 1e-9)
+    return np.where(coloured, hbin * sb + sbin, hb * sb + vbin)
+
+
+@settings(max_examples=20)
+@given(seed=st.integers(0, 2**32 - 1), hb=st.integers(1, 40), sb=st.integers(1, 40),
+       vb=st.integers(1, 40), s_min=st.floats(0.0, 1.0), v_min=st.floats(0.0, 1.0))
+def test_quantize_hsv_equals_integer_reference(seed, hb, sb, vb, s_min, v_min):
+    frame = _frame(seed, 30, 30)
+    out = quantize_hsv(frame, hb, sb, vb, s_min, v_min)
+    np.testing.assert_array_equal(out, _reference_hsv(frame, hb, sb, vb, s_min, v_min))
+    assert out.min() >= 0 and out.max() < hsv_n_bins(hb, sb, vb)
+
+
+_ALL_COLOURS = None
+
+
+def _all_colours():
+    """Every 8-bit RGB colour once, as a (4096, 4096, 3) frame."""
+    global _ALL_COLOURS
+    if _ALL_COLOURS is None:
+        c = np.arange(2**24, dtype=np.uint32)
+        _ALL_COLOURS = np.stack([c >> 16, (c >> 8) & 255, c & 255], axis=-1).astype(
+            np.uint8).reshape(4096, 4096, 3)
+    return _ALL_COLOURS
+
+
+@pytest.mark.parametrize("hb, sb, vb, s_min, v_min", [(10, 10, 10, 0.1, 0.2)])
+def test_quantize_hsv_exact_on_every_colour(hb, sb, vb, s_min, v_min):
+    """The float32 divisions of the kernel give the exact integer floors on all 2**24
+    colours (the default model; more bin counts in the slow suite)."""
+    frame = _all_colours()
+    for rows in range(0, 4096, 512):  # in slices: the int64 reference is memory-hungry
+        part = frame[rows:rows + 512]
+        np.testing.assert_array_equal(quantize_hsv(part, hb, sb, vb, s_min, v_min),
+                                      _reference_hsv(part, hb, sb, vb, s_min, v_min))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("hb, sb, vb, s_min, v_min", [
+    (1, 1, 1, 0.0, 0.0), (8, 8, 8, 0.3, 0.1), (37, 91, 5, 0.55, 0.9),
+    (256, 255, 256, 1.0, 1.0)])
+def test_quantize_hsv_exact_on_every_colour_slow(hb, sb, vb, s_min, v_min):
+    test_quantize_hsv_exact_on_every_colour(hb, sb, vb, s_min, v_min)
+
+
+def test_quantize_rgb_exact_on_every_colour():
+    frame = _all_colours()[::4]  # every colour's channels appear in a quarter of the rows
+    for bins in (10, 7, 256):
+        b = frame.astype(np.int64) * bins // 256
+        np.testing.assert_array_equal(quantize_rgb(frame, bins),
+                                      (b[..., 0] * bins + b[..., 1]) * bins + b[..., 2])
+
+
+def test_quantize_hsv_agrees_with_skimage():
+    frame = _frame(5, 64, 64)
+    hsv = rgb2hsv(frame)
+    h, s, v = hsv[..., 0], hsv[..., 1], hsv[..., 2]
+    coloured = (s >= 0.1) & (v >= 0.2)
+    ref = np.where(coloured, np.minimum((h * 10).astype(int), 9) * 10
+                   + np.minimum((s * 10).astype(int), 9), 100 + np.minimum((v * 10).astype(int), 9))
+    # skimage's floating-point rounding can put an exact bin edge on either side.
+    assert np.mean(quantize_hsv(frame) == ref) > 0.995
+
+
+@pytest.mark.parametrize("kind", ["hsv", "rgb"])
+def test_model_scores_template_at_zero_and_shifted_worse(kind):
+    frame = _frame(1, 60, 80)
+    frame[20:40, 30:50] = (200, 30, 30)
+    frame[30:40, 30:50] = (30, 30, 200)
+    model = ColourModel(kind, lam=20.0)
+    box = np.array([[30.0, 20.0, 20.0, 20.0]])
+    model.set_references(frame, box)
+    obs = model.observe(frame)
+    boxes = np.array([[30.0, 20.0, 20.0, 20.0], [36.0, 24.0, 20.0, 20.0], [0.0, 0.0, 20.0, 20.0]])
+    d = obs.distances(boxes, np.zeros(3, dtype=int))
+    assert d[0] == pytest.approx(0.0, abs=1e-7)
+    assert d[0] < d[1] < d[2]
+    np.testing.assert_allclose(obs.log_likelihoods(boxes, np.zeros(3, dtype=int)), -20.0 * d**2)
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"kind": "lab"}, "unknown observation model 'lab'; valid: hsv, rgb"),
+    ({"kernel": "gauss"}, "unknown kernel 'gauss'"),
+    ({"lam": 0.0}, "lam"),
+    ({"bins": 0}, "bins"),
+    ({"n_parts": 0}, "n_parts"),
+])
+def test_model_rejects_bad_parameters(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        ColourModel(**kwargs)
+
+
+def test_kernel_rejects_bad_input():
+    bins = np.zeros((10, 10), dtype=np.int32)
+    with pytest.raises(ValueError, match="positive width and height"):
+        region_histograms(bins, np.array([[1.0, 1.0, 0.0, 3.0]]), 4, KERNEL_UNIFORM)
+    with pytest.raises(ValueError, match="bin_img values"):
+        region_histograms(bins + 4, np.array([[1.0, 1.0, 2.0, 3.0]]), 4, KERNEL_UNIFORM)
+    with pytest.raises(ValueError, match="kernel"):
+        region_histograms(bins, np.array([[1.0, 1.0, 2.0, 3.0]]), 4, 7)
+    with pytest.raises(ValueError, match="ref_index"):
+        region_distances(bins, np.array([[1.0, 1.0, 2.0, 3.0]]), np.full((1, 4), 0.25),
+                         np.array([1]), KERNEL_UNIFORM)
+    with pytest.raises(ValueError, match="unknown method 'fast'; valid: auto, direct, integral"):
+        region_distances(bins, np.array([[1.0, 1.0, 2.0, 3.0]]), np.full((1, 4), 0.25),
+                         np.array([0]), KERNEL_UNIFORM, method="fast")
+    with pytest.raises(ValueError, match="observe"):
+        ColourModel("rgb").observe(np.zeros((4, 4, 3), dtype=np.uint8))
+
+
+_DETERMINISM_SCRIPT = """
+import hashlib, sys
+import numpy as np
+junk = [np.empty(int(n)) for n in sys.argv[1:]]  # a different heap in each process
+from trackers.kernels.histogram import (KERNEL_CONE, KERNEL_EPANECHNIKOV, KERNEL_UNIFORM,
+                                        quantize_rgb, region_distances, region_histograms)
+rng = np.random.default_rng(0)
+frame = rng.integers(0, 256, (120, 160, 3), dtype=np.uint8)
+bins = quantize_rgb(frame)
+truth = np.array([[20.0, 20.0, 30.0, 30.0], [90.0, 30.0, 30.0, 30.0]])
+boxes = np.repeat(truth, 200, axis=0)
+boxes[:, :2] += rng.normal(0.0, 4.0, (400, 2))
+index = np.repeat(np.arange(2), 200)
+h = hashlib.sha256()
+for kernel in (KERNEL_UNIFORM, KERNEL_EPANECHNIKOV, KERNEL_CONE):
+    refs = region_histograms(bins, truth, 1000, kernel)
+    h.update(refs.tobytes())
+    for method in ("direct", "integral"):
+        h.update(region_distances(bins, boxes, refs, index, kernel, method=method).tobytes())
+print(h.hexdigest())
+"""
+
+
+def test_distances_are_the_same_bytes_in_another_process():
+    """Same inputs, same bytes, whatever the heap (and so the arrays' alignment) is."""
+    import subprocess
+    import sys
+
+    digests = {subprocess.run([sys.executable, "-c", _DETERMINISM_SCRIPT, *sizes],
+                              capture_output=True, text=True, check=True).stdout
+               for sizes in ([], ["1", "3", "1001"], ["17", "4099", "5"])}
+    assert len(digests) == 1, digests
+
+
+def test_prepared_distances_equal_region_distances_and_check_their_input():
+    rng = np.random.default_rng(4)
+    frame = _frame(4, 40, 50)
+    bin_img = quantize_hsv(frame)
+    n_bins = hsv_n_bins()
+    refs = rng.dirichlet(np.ones(2 * n_bins), 3) * (rng.random((3, 2 * n_bins)) > 0.5)
+    refs /= refs.sum(axis=1, keepdims=True)
+    boxes = np.column_stack([rng.uniform(-5, 45, 30), rng.uniform(-5, 35, 30),
+                             rng.uniform(2, 20, 30), rng.uniform(2, 20, 30)])
+    index = rng.integers(0, 3, 30)
+    prepared = prepare_references(refs, 2)
+    for kernel in KERNELS:
+        np.testing.assert_array_equal(
+            prepared_distances(bin_img, boxes, prepared, index, kernel),
+            region_distances(bin_img, boxes, refs, index, kernel, 2))
+    bad = boxes.copy()
+    bad[3, 2] = np.nan
+    with pytest.raises(ValueError, match="finite with positive width"):
+        prepared_distances(bin_img, bad, prepared, index, KERNEL_UNIFORM)
+    with pytest.raises(ValueError, match=r"ref_index must lie in \[0, 3\)"):
+        prepared_distances(bin_img, boxes, prepared, index + 1, KERNEL_UNIFORM)
+    with pytest.raises(ValueError, match="n_parts must be a positive divisor"):
+        prepare_references(refs, 7)
+    model = ColourModel("hsv")
+    with pytest.raises(ValueError, match=r"references must have shape \(K, 220\)"):
+        model.references = refs[:, :100]
