@@ -1,6 +1,6 @@
 """Scenario planning and rendering: config + seed -> frames, labels and ground truth.
 
-Data flows one way (STYLE.md): :func:`plan` turns a config and a seed into a
+Data flows one way: :func:`plan` turns a config and a seed into a
 :class:`Scenario` (trajectories, depths, templates: everything but pixels), and
 :meth:`Scenario.render` draws any frame range of it in one compiled call. The static
 layer (background, clutter and entities that never move and lie behind all others) is
@@ -10,6 +10,10 @@ Randomness: each entity draws from its own stream, keyed by the scenario seed an
 entity's *name*, so adding, removing or reordering other entities never changes its
 trajectory or appearance. Per-frame sensor noise is keyed by the frame index, so rendering
 in chunks gives the same bytes as rendering at once.
+
+Position noise is added to the planned motion path per frame; the path itself (before the
+noise) is kept as :attr:`Scenario.path_x`, :attr:`Scenario.path_y` and recorded as
+``gt/path_center``.
 """
 
 from __future__ import annotations
