@@ -45,6 +45,7 @@ from numpy.typing import NDArray
 from trackers.base import Estimate, Tracker
 from trackers.filters.diagnostics import effective_dynamics, uniqueness
 from trackers.filters.resampling import RESAMPLERS, resample, weighted_resample_groups
+from trackers.filters.weights import log_sum_exp_groups, normalised_weights
 from trackers.kernels.histogram import KERNELS
 from trackers.models.dynamics import AR2, boxes_from_states, states_from_boxes
 from trackers.models.observation import (
@@ -74,19 +75,6 @@ ASSIGNMENTS: tuple[str, ...] = ("random", "interleaved")
 def circular_shift(n_objects: int, k: int) -> NDArray[np.int64]:
     """The k-th circular shift (k, k+1, …, M−1, 0, …, k−1) of the objects 0…M−1."""
     return (np.arange(n_objects) + k) % n_objects
-
-
-def _normalised_weights(logw: NDArray[np.float64]) -> NDArray[np.float64]:
-    """exp(logw) / Σ exp(logw), computed without overflow."""
-    w = np.exp(logw - logw.max())
-    return w / w.sum()
-
-
-def _group_log_sum_exp(x: NDArray[np.float64], starts: NDArray[np.int64],
-                       sizes: NDArray[np.int64]) -> NDArray[np.float64]:
-    """log Σ exp(x) over each contiguous group, shape (C,), without overflow."""
-    m = np.maximum.reduceat(x, starts)
-    return m + np.log(np.add.reduceat(np.exp(x - np.repeat(m, sizes)), starts))
 
 
 @dataclass(frozen=True)
@@ -296,7 +284,7 @@ class Condensation(_ParticleTracker):
         ll = ll.reshape(n, k)
         self._prev = x
         self.particles = new
-        self.weights = np.column_stack([_normalised_weights(ll[:, i]) for i in range(k)])
+        self.weights = np.column_stack([normalised_weights(ll[:, i]) for i in range(k)])
         return self._estimate(self.weights)
 
 
@@ -321,7 +309,7 @@ class JointPF(_ParticleTracker):
         ll = obs.log_likelihoods(self._boxes(new.reshape(-1, 3), objects), objects)
         self._prev = x
         self.particles = new
-        self.weights = _normalised_weights(ll.reshape(n, k).sum(axis=1))
+        self.weights = normalised_weights(ll.reshape(n, k).sum(axis=1))
         return self._estimate(np.repeat(self.weights[:, None], k, axis=1))
 
 
@@ -389,13 +377,13 @@ class _Partitioned(_ParticleTracker):
         plain normalisation. Returns the weights (N,) and the mixture weights (C,).
         """
         if sizes.size == 1:
-            return _normalised_weights(logw), np.ones(1)
+            return normalised_weights(logw), np.ones(1)
         starts = np.cumsum(sizes) - sizes
-        log_total = _group_log_sum_exp(logw, starts, sizes)
-        log_evidence = log_total - _group_log_sum_exp(logpi, starts, sizes)
-        mixture = _normalised_weights(np.log(sizes / sizes.sum()) + log_evidence)
+        log_total = log_sum_exp_groups(logw, starts, sizes)
+        log_evidence = log_total - log_sum_exp_groups(logpi, starts, sizes)
+        mixture = normalised_weights(np.log(sizes / sizes.sum()) + log_evidence)
         logw_final = logw + np.repeat(np.log(mixture) - log_total, sizes)
-        return _normalised_weights(logw_final), mixture
+        return normalised_weights(logw_final), mixture
 
 
 class PartitionedSampling(_Partitioned):

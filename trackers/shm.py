@@ -74,6 +74,7 @@ from numpy.typing import NDArray
 
 from trackers.base import Estimate, Tracker
 from trackers.filters.kalman import KalmanFilter
+from trackers.filters.weights import normalised_weights
 from trackers.kalman import KalmanParams, boxes_at, measurement_cov
 from trackers.models.layered import LayeredMatcher, orderings
 from trackers.params import check_choice, check_number
@@ -95,11 +96,6 @@ def transition_matrix(n_orderings: int, p_stay: float) -> NDArray[np.float64]:
     pi = np.full((n_orderings, n_orderings), (1.0 - p_stay) / (n_orderings - 1))
     np.fill_diagonal(pi, p_stay)
     return pi
-
-
-def _softmax(logw: NDArray[np.float64], axis: int = -1) -> NDArray[np.float64]:
-    w = np.exp(logw - np.max(logw, axis=axis, keepdims=True))
-    return w / np.sum(w, axis=axis, keepdims=True)
 
 
 EVIDENCES = ("union", "objects")
@@ -291,9 +287,9 @@ min_visible, support, blur
         logw = logw.reshape(n_order, n_order)  # [i, j]
         top = logw.max()
         log_pj = top + np.log(np.exp(logw - top).sum(axis=0))
-        self.order_prob = _softmax(log_pj)
+        self.order_prob = normalised_weights(log_pj)
         # Collapse (moment matching) over the previous ordering i, per ordering j.
-        w = _softmax(logw, axis=0)  # P(i | j)
+        w = normalised_weights(logw, axis=0)  # P(i | j)
         mu = pairs.x.reshape(n_order, n_order, -1)
         cov = pairs.P.reshape(n_order, n_order, *pairs.P.shape[1:])
         new_mu = np.einsum("ij,ijn->jn", w, mu)
@@ -353,7 +349,7 @@ min_visible, support, blur, p_stay, lam, mse_rate, mse_floor, evidence
         prior = self.order_prob @ self._evidence.pi
         log_ev = self._evidence.log_evidence(meas.mse, meas.counts)
         logp = np.log(np.maximum(prior, 1e-300)) + log_ev
-        self.order_prob = _softmax(logp)
+        self.order_prob = normalised_weights(logp)
         valid = np.isfinite(meas.mse)  # (L, M)
         q = self.order_prob[:, None] * valid
         mass = q.sum(axis=0)  # (M,)
