@@ -104,7 +104,7 @@ from numpy.typing import NDArray
 
 from trackers.params import TrackerParams
 
-__all__ = ["Estimate", "Tracker", "as_generator", "check_boxes", "check_frame"]
+__all__ = ["BaseTracker", "Estimate", "Tracker", "as_generator", "check_boxes", "check_frame"]
 
 RngLike = np.random.Generator | int | None
 
@@ -183,7 +183,7 @@ def check_boxes(boxes: Any, frame_shape: tuple[int, ...]) -> NDArray[np.float64]
     return arr.copy()
 
 
-class Tracker(ABC):
+class BaseTracker(ABC):
     """Base class of every tracker: ``init`` on the first frame, then ``step``.
 
     Subclasses set ``name`` and implement ``_init`` and ``_step``; this class validates
@@ -279,6 +279,11 @@ class Tracker(ABC):
 
     @abstractmethod
     def _step(self, frame: NDArray[np.uint8]) -> Estimate: ...
+
+
+#: The name the tracker modules subclass; ``trackers.Tracker`` is the protocol
+#: (``trackers.protocol``) that any tracker, subclass or not, satisfies.
+Tracker = BaseTracker
 
 
 def _signature(params: type[TrackerParams]) -> inspect.Signature:

@@ -1,4 +1,9 @@
-"""Running a tracker over a whole sequence."""
+"""Running a tracker over a whole sequence.
+
+Works with any object that follows the protocol (:class:`trackers.Tracker`): only
+``init(frame, boxes)`` and ``step(frame) -> estimate with .boxes`` are used; an
+estimate's ``extras`` (a dict of per-frame arrays) is collected when present.
+"""
 
 from __future__ import annotations
 
@@ -9,9 +14,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from trackers.base import Tracker
+from trackers.protocol import Tracker
 
-__all__ = ["TrackResult", "track"]
+__all__ = ["TrackResult", "estimate_boxes", "track"]
 
 
 @dataclass
@@ -25,10 +30,83 @@ class TrackResult:
     extras : dict of str to ndarray
         Per-frame diagnostics stacked over frames, shape (T, ...); frame 0 repeats frame 1's
         shape with NaN (floats) where the tracker reports nothing before its first step.
+        Empty for a tracker whose estimates have no ``extras``.
     """
 
     boxes: NDArray[np.float64]
     extras: dict[str, NDArray[Any]] = field(default_factory=dict)
+
+
+def _label(tracker: Any) -> str:
+    return type(tracker).__name__
+
+
+def estimate_boxes(tracker: Any, estimate: Any, n_targets: int, frame: int) -> NDArray[np.float64]:
+    """The ``boxes`` of what ``tracker.step`` returned, checked: float64 (K, 4).
+
+    Raises
+    ------
+    ValueError
+        Naming the tracker, the frame and what is wrong (no ``boxes``, wrong shape,
+        infinite values).
+    """
+    if not hasattr(estimate, "boxes"):
+        raise ValueError(
+            f"{_label(tracker)}.step() at frame {frame} returned {type(estimate).__name__}, "
+            "which has no .boxes (the protocol: step(frame) -> estimate with .boxes (K, 4))"
+        )
+    try:
+        boxes = np.asarray(estimate.boxes, dtype=np.float64)
+    except (TypeError, ValueError) as err:
+        raise ValueError(
+            f"{_label(tracker)}.step() at frame {frame}: .boxes is not numeric: {err}"
+        ) from None
+    if boxes.shape != (n_targets, 4):
+        raise ValueError(
+            f"{_label(tracker)}.step() at frame {frame}: .boxes has shape {boxes.shape}, "
+            f"expected ({n_targets}, 4) (one [x, y, w, h] row per initial box)"
+        )
+    if np.isinf(boxes).any():
+        raise ValueError(
+            f"{_label(tracker)}.step() at frame {frame}: .boxes holds inf "
+            "(the protocol: finite, or NaN for a lost target)"
+        )
+    return boxes
+
+
+def _init_boxes(boxes: Any) -> NDArray[np.float64]:
+    arr = np.asarray(boxes, dtype=np.float64)
+    if arr.ndim == 1 and arr.shape[0] == 4:
+        arr = arr[None, :]
+    if arr.ndim != 2 or arr.shape[1] != 4 or arr.shape[0] < 1:
+        raise ValueError(f"init_boxes must have shape (K, 4) with K >= 1, got {np.shape(boxes)}")
+    return arr
+
+
+def _stack_extras(tracker: Any, per_frame: list[dict[str, Any]], n: int) -> dict[str, Any]:
+    extras: dict[str, NDArray[Any]] = {}
+    if n < 2:
+        return extras
+    for key in per_frame[1]:
+        first = np.asarray(per_frame[1][key])
+        is_float = first.dtype.kind == "f"
+        stacked = np.empty((n, *first.shape), dtype=np.float64 if is_float else first.dtype)
+        stacked[0] = np.nan if is_float else 0
+        for t in range(1, n):
+            if key not in per_frame[t]:
+                raise ValueError(
+                    f"{_label(tracker)}.step() at frame {t}: extras lacks {key!r}, "
+                    "given at frame 1 (extras must have the same keys every frame)"
+                )
+            value = np.asarray(per_frame[t][key])
+            if value.shape != first.shape:
+                raise ValueError(
+                    f"{_label(tracker)}.step() at frame {t}: extras[{key!r}] has shape "
+                    f"{value.shape}, {first.shape} at frame 1"
+                )
+            stacked[t] = value
+        extras[key] = stacked
+    return extras
 
 
 def track(
@@ -40,35 +118,39 @@ def track(
 ) -> TrackResult:
     """Run ``tracker`` over ``frames`` (T, H, W, 3), initialised with ``init_boxes`` (K, 4).
 
-    ``frames`` may be a lazy array (anything indexable with a length); frames are read one
-    at a time. ``progress``, if given, is called with the number of frames done.
+    ``tracker`` is anything with ``init(frame, boxes)`` and ``step(frame)`` returning an
+    object with ``boxes`` (K, 4) (:class:`trackers.Tracker`). ``frames`` may be a lazy
+    array (anything indexable with a length); frames are read one at a time.
+    ``progress``, if given, is called with the number of frames done.
+
+    Raises
+    ------
+    ValueError
+        If ``frames`` is empty, ``init_boxes`` is not (K, 4), or an estimate breaks the
+        protocol (naming the frame).
+    TypeError
+        If ``tracker`` lacks ``init`` or ``step``.
     """
+    if not isinstance(tracker, Tracker):
+        missing = [m for m in ("init", "step") if not callable(getattr(tracker, m, None))]
+        raise TypeError(
+            f"{_label(tracker)} is not a tracker: it has no {' or '.join(missing)} method "
+            "(the protocol: init(frame, boxes), step(frame) -> estimate with .boxes)"
+        )
     n = len(frames)
     if n < 1:
         raise ValueError("frames is empty: need at least one frame")
-    tracker.init(frames[0], init_boxes)
-    k = tracker.n_targets
+    start = _init_boxes(init_boxes)
+    k = start.shape[0]
+    tracker.init(frames[0], start.copy())
     boxes = np.empty((n, k, 4), dtype=np.float64)
-    boxes[0] = np.asarray(init_boxes, dtype=np.float64).reshape(k, 4)
+    boxes[0] = start
     per_frame: list[dict[str, Any]] = [{}]
     for t in range(1, n):
         est = tracker.step(frames[t])
-        boxes[t] = est.boxes
-        per_frame.append(est.extras)
+        boxes[t] = estimate_boxes(tracker, est, k, t)
+        extras = getattr(est, "extras", None)
+        per_frame.append(dict(extras) if isinstance(extras, dict) else {})
         if progress is not None:
             progress(t)
-    extras: dict[str, NDArray[Any]] = {}
-    keys = per_frame[1].keys() if n > 1 else ()
-    for key in keys:
-        first = np.asarray(per_frame[1][key])
-        stacked = np.empty(
-            (n, *first.shape), dtype=first.dtype if first.dtype.kind != "f" else np.float64
-        )
-        if first.dtype.kind == "f":
-            stacked[0] = np.nan
-        else:
-            stacked[0] = 0
-        for t in range(1, n):
-            stacked[t] = np.asarray(per_frame[t][key])
-        extras[key] = stacked
-    return TrackResult(boxes=boxes, extras=extras)
+    return TrackResult(boxes=boxes, extras=_stack_extras(tracker, per_frame, n))

@@ -4,18 +4,37 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
+from pathlib import Path
 from typing import Any
 
 from scenegen.cli.progress import bar
 from scenegen.errors import ConfigError
 
-__all__ = ["parse_params", "register"]
+__all__ = ["check_writable", "parse_params", "register"]
+
+
+def _tracker_names() -> list[str]:
+    import trackers
+
+    return trackers.names()
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("track", help="run a tracker over a sequence, write a result file")
+    names = ", ".join(_tracker_names())
+    p = sub.add_parser(
+        "track",
+        help="run a tracker over a sequence, write a result file",
+        description="Run a tracker over a sequence (its targets present at frame 0, started "
+        "from their ground-truth boxes) and write a result file.",
+        epilog=f"trackers: {names}; or MODULE:FACTORY (or FILE.py:FACTORY), a callable "
+        "returning an object with init(frame, boxes) and step(frame) -> .boxes",
+    )
     p.add_argument("file", help="scenegen .h5 file")
-    p.add_argument("--tracker", required=True, help="tracker name (see trackers.names())")
+    p.add_argument(
+        "--tracker", required=True, metavar="NAME|MODULE:FACTORY",
+        help=f"one of: {names}; or a user's factory MODULE:FACTORY",
+    )  # fmt: skip
     p.add_argument("--seed", type=int, default=0, help="tracker random seed (default 0)")
     p.add_argument(
         "--param", action="append", default=[], metavar="KEY=VALUE",
@@ -40,18 +59,38 @@ def parse_params(items: list[str]) -> dict[str, Any]:
     return out
 
 
+def check_writable(path: str | Path) -> None:
+    """Raise ConfigError naming ``path`` if a file cannot be written there (missing or
+    unwritable folder, or a folder in the way)."""
+    target = Path(path)
+    folder = target.parent if str(target.parent) else Path(".")
+    if target.is_dir():
+        raise ConfigError(f"{target}: cannot write the output: it is a directory")
+    if not folder.is_dir():
+        raise ConfigError(f"{target}: cannot write the output: no folder {folder}")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise ConfigError(f"{target}: cannot write the output: folder {folder} is not writable")
+
+
 def cmd_track(args: argparse.Namespace) -> int:
     from scenegen.io import read, write_result
-    from scenegen.lab.run import run_tracker
+    from scenegen.lab.run import run_tracker, tracker_label
 
     if args.seed < 0:
         raise ConfigError(f"--seed must be >= 0, got {args.seed}")
     params = parse_params(args.param)
+    check_writable(args.output)
     seq = read(args.file, args.sequence)
-    with bar(seq.n_frames - 1, f"track {args.tracker}", unit="frame") as pb:
+    label = tracker_label(args.tracker)
+    with bar(seq.n_frames - 1, f"track {label}", unit="frame") as pb:
         res = run_tracker(seq, args.tracker, params, args.seed, progress=lambda n: pb.update(1))
     if hasattr(seq.frames, "close"):
         seq.frames.close()
-    write_result(args.output, res)
-    print(f"wrote {args.output} ({args.tracker}, {res.boxes.shape[1]} targets)")
+    try:
+        write_result(args.output, res)
+    except OSError as err:
+        raise ConfigError(
+            f"{args.output}: cannot write the output: {err.strerror or err}"
+        ) from None
+    print(f"wrote {args.output} ({label}, {res.boxes.shape[1]} targets)")
     return 0

@@ -3,6 +3,12 @@
 ``scenegen track``, the experiments and fixture regeneration all go through :func:`run`,
 so the tracked targets (those present at frame 0, :meth:`Sequence.initial_targets`), the
 initial boxes and the recorded result are decided here and nowhere else.
+
+The tracker is one of ours by name (``trackers.names()``), a ``"module:factory"`` or
+``"path/to/file.py:factory"`` string naming a user's factory, or the factory itself: any
+callable returning an object with ``init(frame, boxes)`` and ``step(frame) -> .boxes``
+(:class:`trackers.Tracker`). A factory gets ``rng=seed`` when it accepts ``rng`` (or
+``**kwargs``), and the parameters as keywords.
 """
 
 from __future__ import annotations
@@ -17,7 +23,9 @@ from numpy.typing import NDArray
 from scenegen.errors import ConfigError, DataError
 from scenegen.io import TrackerResult
 
-__all__ = ["Run", "run", "run_tracker"]
+__all__ = ["Run", "make_tracker", "resolve_factory", "run", "run_tracker", "tracker_label"]
+
+TrackerSpec = str | Callable[..., Any]
 
 
 @dataclass(frozen=True)
@@ -42,9 +50,124 @@ class Run:
     tracker: Any = None
 
 
+def resolve_factory(spec: str) -> Callable[..., Any]:
+    """The callable named by ``"module:attr"`` or ``"path/to/file.py:attr"``.
+
+    The current directory is searched first for ``module`` (as ``python -m`` does), so a
+    user's module next to their data is found.
+
+    Raises
+    ------
+    ConfigError
+        One line naming ``spec`` and what is wrong (no colon, module not importable,
+        attribute missing or not callable).
+    """
+    import importlib
+    import importlib.util
+    import sys
+    from pathlib import Path
+
+    module_name, sep, attr = spec.rpartition(":")
+    if not sep or not module_name or not attr:
+        raise ConfigError(f"tracker {spec!r}: expected a tracker name or MODULE:FACTORY")
+    try:
+        if module_name.endswith(".py"):
+            path = Path(module_name)
+            if not path.is_file():
+                raise ConfigError(f"tracker {spec!r}: no such file {module_name}")
+            name = f"scenegen_user_tracker_{path.stem}"
+            loader_spec = importlib.util.spec_from_file_location(name, path)
+            assert loader_spec is not None and loader_spec.loader is not None
+            module = importlib.util.module_from_spec(loader_spec)
+            sys.modules[name] = module
+            loader_spec.loader.exec_module(module)
+        else:
+            if "" not in sys.path and str(Path.cwd()) not in sys.path:
+                sys.path.insert(0, str(Path.cwd()))
+            module = importlib.import_module(module_name)
+    except ConfigError:
+        raise
+    except Exception as err:  # a user's module may raise anything on import
+        text = str(err).strip().splitlines()
+        raise ConfigError(
+            f"tracker {spec!r}: cannot import {module_name}: {type(err).__name__}: "
+            f"{text[0] if text else ''}"
+        ) from None
+    obj: Any = module
+    for part in attr.split("."):
+        if not hasattr(obj, part):
+            raise ConfigError(f"tracker {spec!r}: {module_name} has no attribute {attr!r}")
+        obj = getattr(obj, part)
+    if not callable(obj):
+        raise ConfigError(f"tracker {spec!r}: {attr} is not callable ({type(obj).__name__})")
+    return obj
+
+
+def tracker_label(tracker: TrackerSpec) -> str:
+    """The name a result records for ``tracker``: the name or ``module:factory`` string
+    (a file spec by its file name, since a result group's name holds no ``/``), else
+    ``module:qualname`` of a factory."""
+    if isinstance(tracker, str):
+        module, sep, attr = tracker.rpartition(":")
+        if sep and "/" in module:
+            return f"{module.rsplit('/', 1)[-1]}:{attr}"
+        return tracker
+    module = getattr(tracker, "__module__", None) or "?"
+    name = getattr(tracker, "__qualname__", None) or type(tracker).__name__
+    return f"{module}:{name}"
+
+
+def _accepts_rng(factory: Callable[..., Any]) -> bool:
+    import inspect
+
+    try:
+        sig = inspect.signature(factory)
+    except (TypeError, ValueError):
+        return False
+    return any(
+        p.name == "rng" or p.kind is inspect.Parameter.VAR_KEYWORD
+        for p in sig.parameters.values()
+    )
+
+
+def make_tracker(tracker: TrackerSpec, params: dict[str, Any], seed: int) -> Any:
+    """Build ``tracker`` (a name, a ``module:factory`` spec or a factory) with ``params``
+    and ``rng=seed`` (a factory gets ``rng`` only if it accepts it).
+
+    Raises
+    ------
+    ConfigError
+        For an unknown name or parameter, a factory that fails, or an object that is not
+        a tracker (naming what it lacks).
+    """
+    import trackers
+
+    if isinstance(tracker, str) and ":" not in tracker:
+        try:
+            return trackers.make(tracker, rng=seed, **params)
+        except (TypeError, ValueError) as err:
+            raise ConfigError(str(err)) from None
+    factory = resolve_factory(tracker) if isinstance(tracker, str) else tracker
+    label = tracker_label(tracker)
+    kwargs = dict(params)
+    if _accepts_rng(factory):
+        kwargs.setdefault("rng", seed)
+    try:
+        obj = factory(**kwargs)
+    except (TypeError, ValueError) as err:
+        raise ConfigError(f"tracker {label!r}: {err}") from None
+    if not isinstance(obj, trackers.Tracker):
+        missing = [m for m in ("init", "step") if not callable(getattr(obj, m, None))]
+        raise ConfigError(
+            f"tracker {label!r} returned a {type(obj).__name__}, which has no "
+            f"{' or '.join(missing)} method (a tracker needs init(frame, boxes) and step(frame))"
+        )
+    return obj
+
+
 def run(
     seq: Any,
-    name: str,
+    name: TrackerSpec,
     params: dict[str, Any] | None = None,
     seed: int = 0,
     *,
@@ -57,10 +180,10 @@ def run(
     ----------
     seq : Sequence
         The sequence (frames may be lazy).
-    name : str
-        A tracker name (``trackers.names()``).
+    name : str or callable
+        A tracker name (``trackers.names()``), a ``"module:factory"`` spec, or a factory.
     params : dict, optional
-        Tracker parameters (``trackers.make(name, **params)``).
+        Tracker parameters (``trackers.make(name, **params)``, or the factory's keywords).
     seed : int
         The tracker's ``rng``.
     progress : callable, optional
@@ -89,7 +212,7 @@ def run(
     if single_thread:
         numba.set_num_threads(1)
     try:
-        tracker = trackers.make(name, rng=seed, **params)
+        tracker = make_tracker(name, params, seed)
         out = trackers.track(tracker, seq.frames, init, progress=progress)
     except DataError:
         raise  # a damaged file (DataError is a ValueError): exit 1, not 2
@@ -104,7 +227,7 @@ def run(
         # Frame 0 is the initialisation: every ordering equally likely.
         order_prob[0] = 1.0 / order_prob.shape[1]
     result = TrackerResult(
-        tracker=name,
+        tracker=tracker_label(name),
         params=params,
         seed=seed,
         sequence=seq.name,
@@ -118,7 +241,7 @@ def run(
 
 def run_tracker(
     seq: Any,
-    name: str,
+    name: TrackerSpec,
     params: dict[str, Any] | None = None,
     seed: int = 0,
     progress: Callable[[int], None] | None = None,

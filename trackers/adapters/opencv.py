@@ -1,0 +1,208 @@
+"""OpenCV's single-object trackers behind the protocol, one cv2 tracker per target.
+
+>>> import trackers.adapters
+>>> tracker = trackers.adapters.opencv("MIL", rng=0)   # cv2.TrackerMIL
+>>> isinstance(tracker, trackers.Tracker)
+True
+
+``opencv(name)`` looks up ``cv2.Tracker<name>`` (then ``cv2.legacy.Tracker<name>``, in
+builds that have it). Keyword parameters set the fields of ``cv2.Tracker<name>_Params``
+(for MIL: ``samplerSearchWinSize``, ``featureSetNumFeatures``, ...). In
+opencv-python-headless 5.0 only MIL constructs without model files (DaSiamRPN, Nano and
+Vit need ONNX models, passed through their Params fields); KCF, CSRT and the others ship in
+opencv-contrib.
+
+OpenCV boxes are integers: an initial box is rounded outward to whole pixels and clipped
+to the frame, and grown about its centre to at least :data:`MIN_SIDE` pixels a side
+(``cv2.TrackerMIL`` never returns from ``update`` on a box under 5 px, measured with
+cv2 5.0); a grown box is reported with its initial size, centred where OpenCV puts it.
+When a cv2 tracker reports failure its target's box is NaN for that frame
+(``extras["ok"]`` says which succeeded); it keeps updating and may find the target again.
+OpenCV's trackers draw from OpenCV's global random state: ``rng`` (an int) is passed to
+``cv2.setRNGSeed`` at ``init``, but MIL is not reproducible across runs even so, hence
+``deterministic = False``.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from trackers.base import Estimate, check_boxes, check_frame
+
+__all__ = ["OpenCVTracker", "opencv", "opencv_names"]
+
+# Trackers that construct without model files in opencv-python-headless (checked in the
+# suite: tests/trackers/test_adapters.py).
+MIN_SIDE = 5
+_NO_MODEL_FILES = ("MIL", "KCF", "CSRT", "Boosting", "MedianFlow", "TLD", "MOSSE")
+
+
+def _lookup(name: str) -> tuple[Any, Any]:
+    """(tracker class, Params class or None) of ``cv2.Tracker<name>``."""
+    import cv2
+
+    for ns in (cv2, getattr(cv2, "legacy", None)):
+        if ns is None:
+            continue
+        cls = getattr(ns, f"Tracker{name}", None)
+        if cls is not None and hasattr(cls, "create"):
+            return cls, getattr(ns, f"Tracker{name}_Params", None)
+    raise ValueError(
+        f"unknown OpenCV tracker {name!r} in cv2 {cv2.__version__}; "
+        f"available without model files: {', '.join(opencv_names()) or 'none'}"
+    )
+
+
+def opencv_names() -> list[str]:
+    """OpenCV tracker names this cv2 build offers that need no model files."""
+    import cv2
+
+    out = []
+    for name in _NO_MODEL_FILES:
+        for ns in (cv2, getattr(cv2, "legacy", None)):
+            if ns is not None and hasattr(getattr(ns, f"Tracker{name}", None), "create"):
+                out.append(name)
+                break
+    return out
+
+
+class OpenCVTracker:
+    """``K`` OpenCV single-object trackers of one kind, one per target.
+
+    Parameters
+    ----------
+    name : str
+        ``cv2.Tracker<name>``, e.g. ``"MIL"``.
+    rng : int or None
+        Seed for ``cv2.setRNGSeed`` at ``init`` (OpenCV's global random state).
+    **params
+        Fields of ``cv2.Tracker<name>_Params``.
+
+    Raises
+    ------
+    ValueError
+        For an unknown tracker, an unknown parameter (naming the valid ones) or a value
+        OpenCV rejects.
+    """
+
+    deterministic = False
+    handles_occlusion = False
+
+    def __init__(self, name: str, *, rng: int | None = None, **params: Any) -> None:
+        if rng is not None and (isinstance(rng, bool) or not isinstance(rng, (int, np.integer))):
+            raise ValueError(f"rng of an OpenCV tracker must be an int seed or None, not {rng!r}")
+        self.name = name
+        self.rng = rng
+        self.params = dict(params)
+        self._cls, self._params_cls = _lookup(name)
+        self._make()  # fail at construction on bad parameters or missing model files
+        self._trackers: list[Any] = []
+        self._sizes: list[tuple[float, float] | None] = []
+        self._shape: tuple[int, ...] | None = None
+
+    def _make(self) -> Any:
+        import cv2
+
+        if not self.params:
+            try:
+                return self._cls.create()
+            except cv2.error as err:
+                raise ValueError(f"cv2.Tracker{self.name}: {_cv2_message(err)}") from None
+        if self._params_cls is None:
+            raise ValueError(f"cv2.Tracker{self.name} takes no parameters, got {self.params}")
+        p = self._params_cls()
+        valid = [a for a in dir(p) if not a.startswith("_")]
+        for key, value in self.params.items():
+            if key not in valid:
+                raise ValueError(
+                    f"unknown parameter {key!r} for cv2.Tracker{self.name}; valid: "
+                    f"{', '.join(valid)}"
+                )
+            try:
+                setattr(p, key, value)
+            except (TypeError, cv2.error) as err:
+                raise ValueError(
+                    f"cv2.Tracker{self.name} parameter {key}={value!r}: {err}"
+                ) from None
+        try:
+            return self._cls.create(p)
+        except cv2.error as err:
+            raise ValueError(f"cv2.Tracker{self.name}: {_cv2_message(err)}") from None
+
+    def init(self, frame: Any, boxes: Any) -> None:
+        """Start one cv2 tracker per box on ``frame`` (H, W, 3) RGB; ``boxes`` (K, 4)."""
+        import cv2
+
+        rgb = check_frame(frame)
+        boxes = check_boxes(boxes, rgb.shape)
+        if self.rng is not None:
+            cv2.setRNGSeed(int(self.rng))
+        bgr = np.ascontiguousarray(rgb[:, :, ::-1])
+        self._shape = rgb.shape
+        self._trackers, self._sizes = [], []
+        for box in boxes:
+            t = self._make()
+            px = _pixel_box(box, rgb.shape)
+            t.init(bgr, px)
+            self._trackers.append(t)
+            grown = px[2] > np.ceil(box[2]) or px[3] > np.ceil(box[3])
+            self._sizes.append((float(box[2]), float(box[3])) if grown else None)
+
+    def step(self, frame: Any) -> Estimate:
+        """Update every cv2 tracker on ``frame``; NaN boxes where one reports failure."""
+        if self._shape is None:
+            raise ValueError(f"cv2.Tracker{self.name}: call init() before step()")
+        rgb = check_frame(frame, self._shape)
+        bgr = np.ascontiguousarray(rgb[:, :, ::-1])
+        out = np.full((len(self._trackers), 4), np.nan)
+        ok = np.zeros(len(self._trackers), dtype=bool)
+        for k, t in enumerate(self._trackers):
+            found, box = t.update(bgr)
+            if found:
+                out[k] = box
+                ok[k] = True
+                size = self._sizes[k]
+                if size is not None:
+                    cx, cy = box[0] + box[2] / 2, box[1] + box[3] / 2
+                    out[k] = (cx - size[0] / 2, cy - size[1] / 2, size[0], size[1])
+        return Estimate(boxes=out, extras={"ok": ok})
+
+    def __repr__(self) -> str:
+        extra = "".join(f", {k}={v!r}" for k, v in self.params.items())
+        return f"opencv({self.name!r}, rng={self.rng!r}{extra})"
+
+
+def _cv2_message(err: Exception) -> str:
+    lines = [s.strip() for s in str(err).strip().splitlines() if s.strip()]
+    return lines[-1] if lines else type(err).__name__
+
+
+def _pixel_box(box: NDArray[np.float64], shape: tuple[int, ...]) -> tuple[int, int, int, int]:
+    """``box`` [x, y, w, h] rounded outward to whole pixels, clipped to the frame, at
+    least ``MIN_SIDE`` a side (where the frame allows)."""
+    x, bw = _span(box[0], box[2], shape[1])
+    y, bh = _span(box[1], box[3], shape[0])
+    return x, y, bw, bh
+
+
+def _span(start: float, size: float, limit: int) -> tuple[int, int]:
+    """(start, length) in whole pixels of [start, start + size) within [0, limit)."""
+    lo = int(np.clip(np.floor(start), 0, limit - 1))
+    hi = int(np.clip(np.ceil(start + size), lo + 1, limit))
+    side = min(MIN_SIDE, limit)
+    if hi - lo < side:
+        centre = (lo + hi) / 2
+        lo = int(np.clip(np.floor(centre - side / 2), 0, limit - side))
+        hi = lo + side
+    return lo, hi - lo
+
+
+def opencv(name: str, **kw: Any) -> OpenCVTracker:
+    """An OpenCV tracker behind the protocol: ``opencv("MIL", rng=0, **params)``.
+
+    See :class:`OpenCVTracker`.
+    """
+    return OpenCVTracker(name, **kw)

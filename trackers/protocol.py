@@ -1,0 +1,51 @@
+"""The tracker protocol: what any tracker must offer to be run, scored and checked.
+
+A tracker is any object with two methods::
+
+    tracker.init(frame, boxes)        # frame (H, W, 3) uint8 RGB, boxes (K, 4) [x, y, w, h]
+    estimate = tracker.step(frame)    # estimate.boxes: (K, 4), NaN rows where it has lost a target
+
+Nothing else is required; ``trackers.track``, ``scenegen track --tracker module:factory``
+and ``scenegen.testing.check_tracker`` discover the optional parts when present:
+
+``estimate.extras``
+    dict of per-frame diagnostics (arrays of a fixed shape), stacked over frames by
+    ``trackers.track``.
+``tracker.orderings``
+    (L, K) depth orderings, for trackers that report ``order_prob`` in ``extras``.
+``tracker.deterministic``
+    bool, default True: the same ``rng`` seed gives the same boxes.
+``tracker.handles_occlusion``
+    bool, default False: the tracker claims to recover a target after a short full
+    occlusion (the conformance suite checks it only then).
+
+Our own trackers subclass :class:`trackers.base.BaseTracker`, which also validates frames
+and boxes; a tracker does not have to.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Protocol, runtime_checkable
+
+__all__ = ["EstimateLike", "Tracker"]
+
+
+@runtime_checkable
+class EstimateLike(Protocol):
+    """What ``step`` returns: anything with ``boxes``, array-like of shape (K, 4)."""
+
+    boxes: Any
+
+
+@runtime_checkable
+class Tracker(Protocol):
+    """A tracker: ``init(frame, boxes)`` on the first frame, then ``step(frame)``.
+
+    ``isinstance(obj, trackers.Tracker)`` is True for any object with both methods.
+    """
+
+    def init(self, frame: Any, boxes: Any) -> None:
+        """Start on ``frame`` (H, W, 3) with one box per target, ``boxes`` (K, 4)."""
+
+    def step(self, frame: Any) -> EstimateLike:
+        """Advance one frame (H, W, 3); return an estimate whose ``boxes`` is (K, 4)."""
