@@ -241,6 +241,12 @@ def regen(
             "trackers": dict(sorted(runs.items())),
         }
     _write_registry(root, {n: entries[n] for n in defs if n in entries})
+    if root.resolve() == default_dir().resolve():
+        # The repository's fixtures are the built-in ones: ship their digests.
+        from scenegen.testing.builtin import write_digests
+
+        if write_digests({n: entries[n] for n in defs if n in entries}):
+            changes.append("scenegen/testing/builtin_digests.json: rewritten")
     return changes, errors
 
 

@@ -16,7 +16,11 @@ scenegen_fixture
     Session-scoped factory ``scenegen_fixture(name) -> Sequence`` reading the committed
     regression fixture ``<fixtures>/<name>.h5``. If the folder holds a ``registry.json``
     (as written by ``scenegen fixtures regen``), the arrays are checked against its
-    SHA-256 digests first.
+    SHA-256 digests first. A name not in the folder but built in (``one-pixel``,
+    ``single-frame``, ``enter-leave``, ``full-occlusion``, ``distractor-on-target`` and
+    ``<preset>-small``) is regenerated from its definition, checked against the digests
+    shipped with scenegen and cached (:mod:`scenegen.testing.builtin`), so it works in
+    any project.
 scenegen_expect
     ``scenegen_expect(key, array, atol=None, rtol=None)`` compares ``array`` with the
     stored expectation ``<fixtures>/expected/<key>.npy``: shapes must agree, NaN must
@@ -254,10 +258,14 @@ def scenegen_sequence(request: pytest.FixtureRequest) -> Callable[..., Any]:
 
 @pytest.fixture(scope="session")
 def scenegen_fixture(request: pytest.FixtureRequest) -> Callable[[str], Any]:
-    """Factory: ``(name) -> Sequence`` of the committed fixture ``<fixtures>/<name>.h5``."""
+    """Factory: ``(name) -> Sequence`` of the committed fixture ``<fixtures>/<name>.h5``,
+    else of the built-in fixture ``name`` (:mod:`scenegen.testing.builtin`)."""
     from scenegen.io import read
+    from scenegen.testing.builtin import builtin_fixture, builtin_names
 
     folder = _fixtures_dir(request.config)
+    cache = getattr(request.config, "cache", None)
+    builtin_cache = Path(cache.mkdir("scenegen")) / "fixtures" if cache is not None else None
     memo: dict[str, Any] = {}
 
     def factory(name: str) -> Any:
@@ -265,9 +273,13 @@ def scenegen_fixture(request: pytest.FixtureRequest) -> Callable[[str], Any]:
             return memo[name]
         path = folder / f"{name}.h5"
         if not path.exists():
+            if name in builtin_names():
+                memo[name] = frozen(builtin_fixture(name, cache=builtin_cache))
+                return memo[name]
             known = sorted(p.stem for p in folder.glob("*.h5")) if folder.is_dir() else []
+            known += [n for n in builtin_names() if n not in known]
             raise FileNotFoundError(
-                f"no scenegen fixture {name!r} in {folder}; known: {', '.join(known) or 'none'}"
+                f"no scenegen fixture {name!r} in {folder} nor built in; known: {', '.join(known)}"
             )
         seq = frozen(read(path))
         registry = folder / "registry.json"
