@@ -1,6 +1,23 @@
-"""Test tooling for tracker authors: hypothesis strategies, the pytest plugin, fixtures.
+"""Test tooling for tracker authors: the conformance suite, hypothesis strategies, the
+pytest plugin, built-in fixtures.
 
 Nothing here imports :mod:`trackers`: the tooling works for any tracker.
 """
 
-__all__: list[str] = []
+from scenegen.testing.conformance import (
+    CHECKS,
+    CheckResult,
+    ConformanceReport,
+    check_tracker,
+    checks_table,
+    parametrize_with_checks,
+)
+
+__all__ = [
+    "CHECKS",
+    "CheckResult",
+    "ConformanceReport",
+    "check_tracker",
+    "checks_table",
+    "parametrize_with_checks",
+]

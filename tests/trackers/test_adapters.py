@@ -35,8 +35,9 @@ def test_small_boxes_are_grown_for_opencv_and_reported_at_their_size():
     # cv2.TrackerMIL never returns on boxes under 5 px; the adapter grows them.
     out = trackers.track(opencv("MIL", rng=0), _scene(3), [[0, 0, 1, 1], [63.5, 47.5, 0.5, 0.5]])
     found = out.extras["ok"][1:]
-    np.testing.assert_array_equal(out.boxes[1:][found][:, 2:], np.array([[1, 1], [0.5, 0.5]])[
-        np.nonzero(found)[1]])
+    np.testing.assert_array_equal(
+        out.boxes[1:][found][:, 2:], np.array([[1, 1], [0.5, 0.5]])[np.nonzero(found)[1]]
+    )
 
 
 def test_failure_is_nan():

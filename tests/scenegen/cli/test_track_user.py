@@ -53,14 +53,18 @@ def user_dir(tmp_path_factory):
 
 def test_track_runs_a_users_factory(user_dir, monkeypatch, capsys):
     monkeypatch.chdir(user_dir)
-    assert main(["track", "seq.h5", "--tracker", "usertrk:make", "--param", "offset=2",
-                 "-o", "r.h5"]) == 0, capsys.readouterr().err
+    assert (
+        main(["track", "seq.h5", "--tracker", "usertrk:make", "--param", "offset=2", "-o", "r.h5"])
+        == 0
+    ), capsys.readouterr().err
     res = read_result(user_dir / "r.h5")
     assert res.tracker == "usertrk:make" and res.params == {"offset": 2}
     np.testing.assert_allclose(res.boxes[1:] - res.boxes[0], 2)
     # rng=seed reaches a factory that takes rng; a file path works too
-    assert main(["track", "seq.h5", "--tracker", "./usertrk.py:seeded", "--seed", "3",
-                 "-o", "s.h5"]) == 0, capsys.readouterr().err
+    assert (
+        main(["track", "seq.h5", "--tracker", "./usertrk.py:seeded", "--seed", "3", "-o", "s.h5"])
+        == 0
+    ), capsys.readouterr().err
     res = read_result(user_dir / "s.h5")
     assert res.tracker == "usertrk.py:seeded"
     np.testing.assert_allclose(res.boxes[1:] - res.boxes[0], 3)

@@ -1,0 +1,198 @@
+"""check_tracker on hand-made trackers: each check fails for the reason it names."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from scenegen.testing import CHECKS, check_tracker, checks_table, parametrize_with_checks
+
+
+class Still:
+    """Only init and step: never moves its boxes."""
+
+    def init(self, frame, boxes):
+        self.boxes = np.asarray(boxes, dtype=float)
+
+    def step(self, frame):
+        return SimpleNamespace(boxes=self.boxes.copy())
+
+
+class Follower(Still):
+    """Follows the centroid of the saturated pixels (the suite's targets are saturated
+    discs on grey backgrounds): a good tracker of one unoccluded target."""
+
+    def step(self, frame):
+        f = frame.astype(int)
+        rows, cols = np.nonzero(f.max(axis=-1) - f.min(axis=-1) > 100)
+        if rows.size:
+            w, h = self.boxes[0, 2:]
+            self.boxes[0, :2] = cols.mean() + 0.5 - w / 2, rows.mean() + 0.5 - h / 2
+        return SimpleNamespace(boxes=self.boxes.copy())
+
+
+def _status(report):
+    return {r.name: r.status for r in report.results}
+
+
+def test_a_still_tracker_passes_the_protocol_checks_and_fails_to_keep_a_moving_target():
+    report = check_tracker(Still, report=True)
+    assert _status(report) == {
+        "protocol": "passed",
+        "edge_fixtures": "passed",
+        "boxes": "passed",
+        "deterministic": "passed",
+        "translation_equivariance": "passed",
+        "keeps_lone_target": "failed",
+        "recovers_after_occlusion": "skipped",
+    }
+    assert report.failed == ["keeps_lone_target"]
+    msg = dict((r.name, r.message) for r in report.results)["keeps_lone_target"]
+    assert "IoU fell to" in msg and "below 0.5 at frame" in msg
+    with pytest.raises(AssertionError, match="Still failed 1 conformance check.*keeps_lone_target"):
+        check_tracker(Still)
+    assert "| Still | pass | pass | pass | pass | pass | FAIL | – |" in checks_table([report])
+
+
+def test_not_a_tracker_fails_protocol_and_skips_the_rest():
+    report = check_tracker(lambda: SimpleNamespace(init=lambda f, b: None), report=True)
+    assert report.results[0].status == "failed" and "no step method" in report.results[0].message
+    assert {r.status for r in report.results[1:]} == {"skipped"}
+
+
+def test_exceptions_name_the_fixture_and_frame():
+    class Fragile(Still):
+        def init(self, frame, boxes):
+            super().init(frame, boxes)
+            self.t = 0
+            if frame.shape[0] == 48 and len(boxes) == 1 and boxes[0][2] < 2:
+                self.tiny = True
+
+        def step(self, frame):
+            self.t += 1
+            if getattr(self, "tiny", False) and self.t == 3:
+                raise ZeroDivisionError("box too small")
+            return super().step(frame)
+
+    report = check_tracker(Fragile, report=True, checks=["edge_fixtures"])
+    assert report.results[0].message == (
+        "raised on 1 of 5 edge fixtures: one-pixel: step at frame 3 raised "
+        "ZeroDivisionError: box too small"
+    )
+
+
+def test_writing_into_the_frames_fails():
+    class Scribbler(Still):
+        def step(self, frame):
+            frame[0, 0] = 0
+            return super().step(frame)
+
+    report = check_tracker(Scribbler, report=True, checks="edge_fixtures")
+    assert "read-only" in report.results[0].message
+
+
+@pytest.mark.parametrize(
+    ("boxes", "needle"),
+    [
+        (lambda b: np.zeros((len(b), 5)), "has shape (1, 5), expected (1, 4)"),
+        (lambda b: np.where(np.arange(4) == 0, np.nan, b), "(a row must be finite, or all NaN)"),
+        (lambda b: [["a"] * 4] * len(b), ".boxes is not numeric"),
+    ],
+)
+def test_malformed_boxes_are_named(boxes, needle):
+    class Malformed(Still):
+        def step(self, frame):
+            return SimpleNamespace(boxes=boxes(self.boxes))
+
+    report = check_tracker(Malformed, report=True, checks=["boxes"])
+    assert report.results[0].status == "failed" and needle in report.results[0].message
+
+
+def test_determinism_only_where_claimed():
+    class Noisy(Still):
+        def __init__(self, rng=None):
+            self.rng = np.random.default_rng()  # ignores the seed on purpose
+
+        def step(self, frame):
+            return SimpleNamespace(boxes=self.boxes + self.rng.normal(0, 1, self.boxes.shape))
+
+    report = check_tracker(Noisy, report=True, checks=["deterministic"])
+    assert "two runs with seed 0 differ from frame 1" in report.results[0].message
+    skipped = check_tracker(Noisy, report=True, checks=["deterministic"], deterministic=False)
+    assert skipped.results[0].status == "skipped"
+
+    class Honest(Noisy):
+        deterministic = False
+
+    assert check_tracker(Honest, report=True, checks=["deterministic"]).results[0].status == (
+        "skipped"
+    )
+
+
+def test_a_rate_over_repeats_judges_a_stochastic_tracker():
+    class OddSeedsDrift(Follower):
+        def __init__(self, rng=0):
+            self.drift = rng % 2
+
+        def step(self, frame):
+            est = super().step(frame)
+            est.boxes[:, 0] += 20 * self.drift
+            return est
+
+    opts = {"checks": ["keeps_lone_target"], "repeats": 4}
+    half = check_tracker(OddSeedsDrift, report=True, min_pass_rate=0.5, **opts)
+    assert half.passed and half.results[0].message.endswith("in 2 of 4 runs")
+    strict = check_tracker(OddSeedsDrift, report=True, min_pass_rate=0.75, **opts)
+    assert strict.results[0].message.startswith(
+        "passed 2 of 4 runs, below the required rate 0.75: seed 1: IoU fell to"
+    )
+
+
+def test_equivariance_failure_names_the_shift():
+    class Anchored(Still):
+        def step(self, frame):  # drifts towards the frame's top-left corner: not equivariant
+            self.boxes[:, :2] *= 0.9
+            return super().step(frame)
+
+    report = check_tracker(Anchored, report=True, checks=["translation_equivariance"])
+    assert "shifting the scene by (7, 5) px moved the estimated centre by" in (
+        report.results[0].message
+    )
+
+
+def test_occlusion_check_runs_where_claimed():
+    opts = {"report": True, "checks": ["recovers_after_occlusion"], "handles_occlusion": True}
+    assert check_tracker(Follower, **opts).passed
+    lost = check_tracker(Still, **opts).results[0]
+    assert lost.status == "failed" and "first below 0.5 at frame 16 of 20" in lost.message
+    assert (
+        check_tracker(Still, report=True, checks=["recovers_after_occlusion"]).results[0].status
+        == "skipped"
+    )
+
+
+@pytest.mark.parametrize(
+    ("kw", "needle"),
+    [
+        ({"repeat": 2}, "unknown option 'repeat'; valid: seed, deterministic"),
+        ({"repeats": 0}, "repeats must be an integer >= 1"),
+        ({"min_pass_rate": 0}, "min_pass_rate must be in (0, 1]"),
+        ({"checks": ["nope"]}, "unknown check 'nope'; valid: protocol"),
+    ],
+)
+def test_bad_options_are_named(kw, needle):
+    with pytest.raises(ValueError) as info:
+        check_tracker(Still, **kw)
+    assert needle in str(info.value)
+
+
+@parametrize_with_checks([Still, (Follower, {"handles_occlusion": False})])
+def test_parametrize_with_checks_makes_one_test_per_check(factory, check, request):
+    assert request.node.callspec.id.split("-", 1)[1] in CHECKS
+    if factory is Still and check.name == "keeps_lone_target":
+        with pytest.raises(AssertionError, match="Still: keeps_lone_target: IoU fell"):
+            check(factory)
+    else:
+        check(factory)
