@@ -386,6 +386,23 @@ class SceneConfig:
         _check_magnitudes(self, "")
         self._check_depth_ties()
 
+    def __repr__(self) -> str:
+        # Short: failing hypothesis examples print it (the whole config is in to_dict).
+        roles: dict[str, int] = {}
+        for e in self.entities:
+            roles[e.role] = roles.get(e.role, 0) + 1
+        ents = ", ".join(f"{n} {r}" for r, n in roles.items()) or "none"
+        clutter = sum(c.count for c in self.clutter)
+        return (
+            f"SceneConfig(name={self.name!r}, {self.width}x{self.height}, "
+            f"{self.n_frames} frames, entities: {ents}, clutter: {clutter}, "
+            f"background: {self.background.kind})"
+        )
+
+    def _repr_pretty_(self, p: Any, cycle: bool) -> None:
+        # Hypothesis (and IPython) pretty-print dataclasses field by field otherwise.
+        p.text(repr(self))
+
     def _check_depth_ties(self) -> None:
         keyframes = sorted({f for e in self.entities for f, _ in e.depth if f < self.n_frames})
         for t in keyframes:

@@ -161,3 +161,7 @@ class Sequence:
             f"Sequence(name={self.name!r}, seed={self.seed}, preset={self.preset!r}, "
             f"frames={t}x{h}x{w}, entities={len(self.entities)})"
         )
+
+    def _repr_pretty_(self, p: Any, cycle: bool) -> None:
+        # Hypothesis (and IPython) pretty-print dataclasses field by field otherwise.
+        p.text(repr(self))

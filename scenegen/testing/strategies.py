@@ -22,6 +22,14 @@ Argument names are shared: ``width``/``height`` (canvas, pixels), ``min_size``/`
 ``max_speed`` (initial speed per coordinate, pixels per frame), ``margin`` (pixels kept
 between an entity and the border), ``boundaries`` (AR2 boundary rules).
 
+A failing example is readable: configs and sequences print one line, and each drawn
+config is attached with ``note()`` as YAML, with the command that regenerates the scene::
+
+    scene config (YAML, saved as /tmp/scenegen-examples/scene-1a2b3c4d5e6f.yaml):
+    width: 40 ...
+    regenerate: scenegen generate --config /tmp/scenegen-examples/scene-1a2b3c4d5e6f.yaml
+    --seed 7 -o scene.h5
+
 Example
 -------
 >>> import scenegen
@@ -37,9 +45,11 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence as SequenceABC
 from dataclasses import replace
+from pathlib import Path
 from typing import Any, cast
 
 import numpy as np
+from hypothesis import note
 from hypothesis import strategies as st
 from hypothesis.errors import InvalidArgument
 from hypothesis.strategies import SearchStrategy
@@ -56,7 +66,7 @@ from scenegen.config import (
 )
 from scenegen.sequence import Sequence
 
-__all__ = ["ar2_params", "boxes", "entity_specs", "scene_configs", "sequences"]
+__all__ = ["ar2_params", "boxes", "entity_specs", "example_file", "scene_configs", "sequences"]
 
 BOUNDARIES = ("reflect", "clamp", "free")
 ROLES = ("target", "distractor", "occluder")
@@ -619,7 +629,7 @@ def _scene_configs(
     if switches["clutter"] and draw(st.booleans()):
         clutter = (_draw_clutter(draw, width, height, sizes[0], margin),)
     sensor_noise = _hundredths(draw, 0, _MAX_SENSOR_NOISE) if noise else 0.0
-    return SceneConfig(
+    config = SceneConfig(
         width=width,
         height=height,
         n_frames=n_frames,
@@ -628,6 +638,54 @@ def _scene_configs(
         clutter=clutter,
         sensor_noise=sensor_noise,
     )
+    _note_config(config, None)
+    return config
+
+
+# --------------------------------------------------------------------------------------
+# notes on failing examples
+
+
+def example_file(config: SceneConfig) -> tuple[str, Path]:
+    """``config`` as YAML and the file it is saved in (``<tmp>/scenegen-examples/``, named
+    by the SHA-256 of the text, written once)."""
+    import hashlib
+    import tempfile
+
+    import yaml
+
+    from scenegen.config import to_dict
+    from scenegen.io.atomic import write_text
+
+    text = yaml.safe_dump(to_dict(config), sort_keys=False)
+    digest = hashlib.sha256(text.encode()).hexdigest()[:12]
+    path = Path(tempfile.gettempdir()) / "scenegen-examples" / f"scene-{digest}.yaml"
+    if not path.exists():
+        write_text(path, text, parents=True)
+    return text, path
+
+
+def _is_final() -> bool:
+    # Notes are printed only for the final (shrunk) failing example: only then is the
+    # YAML file worth writing.
+    from hypothesis.control import current_build_context
+
+    try:
+        return bool(current_build_context().is_final)
+    except InvalidArgument:
+        return False
+
+
+def _note_config(config: SceneConfig, seed: int | None) -> None:
+    """On the final example: the YAML (a drawn config, ``seed`` None) or the command that
+    regenerates the scene (a drawn sequence; its config's YAML is in the file)."""
+    if not _is_final():
+        return
+    text, path = example_file(config)
+    if seed is None:
+        note(f"scene config (YAML, saved as {path}):\n{text}")
+    else:
+        note(f"regenerate: scenegen generate --config {path} --seed {seed} -o scene.h5")
 
 
 # --------------------------------------------------------------------------------------
@@ -672,6 +730,7 @@ def _sequences(
     seed = draw(seeds)
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise InvalidArgument(f"seeds drew {seed!r}; seeds must be non-negative integers")
+    _note_config(config, int(seed))
     return generate(config, seed=int(seed))
 
 
