@@ -29,6 +29,13 @@ scenegen_expect
     ``scenegen_tolerance`` marker, else 0 — exact). With ``--scenegen-regen`` it writes
     the expectation instead (only if it changed) and the run ends with a list of what
     was written.
+scenegen_expect_distribution
+    ``scenegen_expect_distribution(key, samples, z=4.0, atol=0.0)`` for stochastic
+    outputs: ``samples`` (R, ...) holds one summary per run (R >= 2); the stored runs and
+    the new ones must have means within ``z`` standard errors (plus ``atol``) element by
+    element, so a tracker that is not reproducible run to run can be pinned without
+    flaky failures (:mod:`scenegen.testing.distribution`). ``--scenegen-regen`` stores
+    the runs.
 
 Every sequence the fixtures return holds in-memory, read-only numpy arrays (they are
 shared between tests).
@@ -76,7 +83,12 @@ __all__ = [
     "generator_fingerprint",
 ]
 
-FIXTURE_NAMES = ("scenegen_sequence", "scenegen_fixture", "scenegen_expect")
+FIXTURE_NAMES = (
+    "scenegen_sequence",
+    "scenegen_fixture",
+    "scenegen_expect",
+    "scenegen_expect_distribution",
+)
 # Modules whose source decides the pixels and ground truth of a generated sequence.
 _GENERATOR_MODULES = (
     "config.py",
@@ -379,6 +391,27 @@ def scenegen_expect(request: pytest.FixtureRequest) -> Callable[..., None]:
             rtol=default_rtol if rtol is None else rtol,
             regen=regen,
         ):
+            written.append((str(path), "wrote"))
+
+    return check
+
+
+@pytest.fixture
+def scenegen_expect_distribution(request: pytest.FixtureRequest) -> Callable[..., None]:
+    """``scenegen_expect_distribution(key, samples, z=4.0, atol=0.0)``: compare the runs
+    ``samples`` (R, ...) of a stochastic output with (or, under ``--scenegen-regen``, store
+    them as) ``<fixtures>/expected/<key>.npy``
+    (:func:`scenegen.testing.distribution.distribution_difference`)."""
+    from scenegen.testing.distribution import DEFAULT_Z, assert_distribution_matches
+
+    folder = _fixtures_dir(request.config) / "expected"
+    regen = bool(request.config.getoption("--scenegen-regen"))
+    written = request.config.stash[_written_key]
+
+    def check(key: str, samples: Any, z: float = DEFAULT_Z, atol: float = 0.0) -> None:
+        rel = _check_key(key)
+        path = folder.joinpath(*rel.parent.parts) / f"{rel.name}.npy"
+        if assert_distribution_matches(path, samples, z=z, atol=atol, regen=regen):
             written.append((str(path), "wrote"))
 
     return check
