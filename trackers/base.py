@@ -1,4 +1,4 @@
-"""The tracker protocol shared by every tracker, the particle-set convention, input validation.
+"""Our trackers' base class (the protocol itself: trackers.protocol), particle sets, validation.
 
 A tracker is constructed with keyword parameters (``trackers.make(name, **params)``),
 initialised on the first frame with one box per target, then stepped frame by frame::

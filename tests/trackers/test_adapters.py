@@ -72,3 +72,12 @@ def test_params_reach_opencv():
     assert repr(t) == "opencv('MIL', rng=None, samplerSearchWinSize=30.0)"
     out = trackers.track(t, _scene(3), [[10, 15, 12, 12]])
     assert out.boxes.shape == (3, 1, 4)
+
+
+def test_docstring_example_runs():
+    import doctest
+
+    from trackers.adapters import opencv as module
+
+    result = doctest.testmod(module)
+    assert result.attempted > 0 and result.failed == 0

@@ -196,3 +196,12 @@ def test_parametrize_with_checks_makes_one_test_per_check(factory, check, reques
             check(factory)
     else:
         check(factory)
+
+
+def test_docstring_example_runs():
+    import doctest
+
+    from scenegen.testing import conformance
+
+    result = doctest.testmod(conformance)
+    assert result.attempted > 0 and result.failed == 0

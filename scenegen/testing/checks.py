@@ -1,0 +1,469 @@
+"""The conformance checks: small generated scenes, a protocol-only runner, one function
+per check (``CHECKS``), and their :class:`Options`.
+
+Each check takes ``(factory, options)`` and returns a message (passed), raises
+``AssertionError`` (failed, saying why) or :class:`NotApplicable` (skipped: the tracker
+does not claim the property). :func:`scenegen.testing.check_tracker` runs them; the
+module docstring of :mod:`scenegen.testing.conformance` lists what each one checks.
+The runner uses only ``init`` and ``step`` (the library never imports ``trackers``).
+"""
+
+from __future__ import annotations
+
+import inspect
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from functools import cache
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = [
+    "CHECKS",
+    "EDGE_FIXTURES",
+    "SHIFT",
+    "NotApplicable",
+    "Options",
+    "first_line",
+    "label",
+]
+
+EDGE_FIXTURES = (
+    "single-frame",
+    "one-pixel",
+    "enter-leave",
+    "full-occlusion",
+    "distractor-on-target",
+)
+SHIFT = (7, 5)  # camera shift (dx, dy) of the equivariance check, pixels
+
+
+@dataclass(frozen=True)
+class Options:
+    """What :func:`check_tracker` accepts (keyword options), with their defaults.
+
+    Attributes
+    ----------
+    seed : int
+        First seed given to the factory (``rng=seed``) when it accepts ``rng``.
+    deterministic, handles_occlusion : bool or None
+        The tracker's claims; None: read the tracker's attribute of that name (defaults
+        True and False).
+    repeats : int
+        Runs of each behavioural check (seeds ``seed .. seed + repeats - 1``).
+    min_pass_rate : float
+        Fraction of those runs that must pass, in (0, 1].
+    iou_threshold : float
+        IoU a kept target must reach.
+    equivariance_tol : float
+        Pixels the shifted centres may differ by.
+    checks : tuple of str or None
+        Run only these checks (default: all of :data:`CHECKS`).
+    """
+
+    seed: int = 0
+    deterministic: bool | None = None
+    handles_occlusion: bool | None = None
+    repeats: int = 1
+    min_pass_rate: float = 1.0
+    iou_threshold: float = 0.5
+    equivariance_tol: float = 1.0
+    checks: tuple[str, ...] | None = None
+
+    def __post_init__(self) -> None:
+        if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)):
+            raise ValueError(f"seed must be an integer, got {self.seed!r}")
+        if isinstance(self.repeats, bool) or not isinstance(self.repeats, int) or self.repeats < 1:
+            raise ValueError(f"repeats must be an integer >= 1, got {self.repeats!r}")
+        if not 0 < self.min_pass_rate <= 1:
+            raise ValueError(f"min_pass_rate must be in (0, 1], got {self.min_pass_rate!r}")
+        if not 0 < self.iou_threshold <= 1:
+            raise ValueError(f"iou_threshold must be in (0, 1], got {self.iou_threshold!r}")
+        if not self.equivariance_tol >= 0:
+            raise ValueError(f"equivariance_tol must be >= 0, got {self.equivariance_tol!r}")
+        if self.checks is not None:
+            for name in self.checks:
+                if name not in CHECKS:
+                    raise ValueError(f"unknown check {name!r}; valid: {', '.join(CHECKS)}")
+
+
+class NotApplicable(Exception):
+    """A check that does not apply (the message says why)."""
+
+
+# --------------------------------------------------------------------------------------
+# Building and running trackers
+
+
+def label(factory: Any) -> str:
+    return (
+        getattr(factory, "__qualname__", None)
+        or getattr(factory, "__name__", None)
+        or repr(factory)
+    )
+
+
+def _accepts_rng(factory: Callable[..., Any]) -> bool:
+    try:
+        params = inspect.signature(factory).parameters.values()
+    except (TypeError, ValueError):
+        return False
+    return any(p.name == "rng" or p.kind is p.VAR_KEYWORD for p in params)
+
+
+def _build(factory: Callable[..., Any], seed: int) -> Any:
+    return factory(rng=seed) if _accepts_rng(factory) else factory()
+
+
+@dataclass
+class _Run:
+    boxes: NDArray[np.float64] | None = None  # (T, K, 4); None if it raised
+    error: str | None = None
+    problems: list[str] = field(default_factory=list)  # protocol breaches of the estimates
+
+
+def _readonly(frames: Any) -> NDArray[np.uint8]:
+    arr = np.array(frames, dtype=np.uint8, copy=True)
+    arr.setflags(write=False)
+    return arr
+
+
+def _run(tracker: Any, frames: NDArray[np.uint8], init: NDArray[np.float64]) -> _Run:
+    """Run ``tracker`` over ``frames`` (T, H, W, 3) from ``init`` (K, 4), recording the
+    first exception (with its frame) and every malformed estimate."""
+    k = init.shape[0]
+    out = np.full((len(frames), k, 4), np.nan)
+    out[0] = init
+    run = _Run()
+    try:
+        tracker.init(frames[0], init.copy())
+    except Exception as err:
+        run.error = f"init raised {type(err).__name__}: {first_line(err)}"
+        return run
+    for t in range(1, len(frames)):
+        try:
+            est = tracker.step(frames[t])
+        except Exception as err:
+            run.error = f"step at frame {t} raised {type(err).__name__}: {first_line(err)}"
+            return run
+        boxes = getattr(est, "boxes", None)
+        if boxes is None:
+            run.problems.append(f"frame {t}: the estimate ({type(est).__name__}) has no .boxes")
+            continue
+        try:
+            arr = np.asarray(boxes, dtype=np.float64)
+        except (TypeError, ValueError):
+            run.problems.append(f"frame {t}: .boxes is not numeric")
+            continue
+        if arr.shape != (k, 4):
+            run.problems.append(f"frame {t}: .boxes has shape {arr.shape}, expected ({k}, 4)")
+            continue
+        finite = np.isfinite(arr)
+        mixed = ~(finite.all(axis=1) | np.isnan(arr).all(axis=1))
+        if mixed.any():
+            j = int(np.flatnonzero(mixed)[0])
+            run.problems.append(
+                f"frame {t}: box {j} is {arr[j].tolist()} (a row must be finite, or all NaN)"
+            )
+        out[t] = arr
+    run.boxes = out
+    return run
+
+
+def first_line(err: BaseException) -> str:
+    text = str(err).strip().splitlines()
+    return text[0] if text else ""
+
+
+def _iou(a: NDArray[np.float64], b: NDArray[np.float64]) -> NDArray[np.float64]:
+    """IoU of boxes (..., 4) [x, y, w, h]; 0 where either is NaN."""
+    x0 = np.maximum(a[..., 0], b[..., 0])
+    y0 = np.maximum(a[..., 1], b[..., 1])
+    x1 = np.minimum(a[..., 0] + a[..., 2], b[..., 0] + b[..., 2])
+    y1 = np.minimum(a[..., 1] + a[..., 3], b[..., 1] + b[..., 3])
+    inter = np.clip(x1 - x0, 0, None) * np.clip(y1 - y0, 0, None)
+    union = a[..., 2] * a[..., 3] + b[..., 2] * b[..., 3] - inter
+    with np.errstate(invalid="ignore", divide="ignore"):
+        iou = inter / union
+    return np.nan_to_num(iou, nan=0.0)
+
+
+def _centres(boxes: NDArray[np.float64]) -> NDArray[np.float64]:
+    return boxes[..., :2] + boxes[..., 2:] / 2
+
+
+# --------------------------------------------------------------------------------------
+# Scenes (small, generated once per process)
+
+
+def _disc() -> Any:
+    from scenegen.config import Appearance
+
+    return Appearance(
+        shape="ellipse",
+        size=(14, 14),
+        pattern="sectors",
+        colors=((230, 30, 30), (30, 170, 30), (30, 60, 230), (240, 210, 0)),
+    )
+
+
+def _lone_config(width: int, height: int, background: Any) -> Any:
+    from scenegen.config import AR2, EntitySpec, Motion, SceneConfig
+
+    still = AR2(boundary="free", sigma=0.0)
+    return SceneConfig(
+        name="conformance-lone-target",
+        width=width,
+        height=height,
+        n_frames=16,
+        background=background,
+        entities=(
+            EntitySpec(
+                name="target",
+                role="target",
+                appearance=_disc(),
+                position=(width / 2 - 10.0, height / 2 - 4.0),
+                motion=Motion(x=still, y=still, velocity=(1.25, 0.5)),
+            ),
+        ),
+    )
+
+
+@cache
+def _scene(name: str) -> tuple[NDArray[np.uint8], NDArray[np.float64], NDArray[np.float64]]:
+    """(frames (T, H, W, 3) read-only, init boxes (K, 4), ground-truth boxes (T, K, 4))."""
+    from scenegen.config import AR2, Appearance, Background, EntitySpec, Motion, SceneConfig
+    from scenegen.render.plan import generate
+
+    if name in EDGE_FIXTURES:
+        from scenegen.testing.builtin import builtin_fixture
+
+        seq = builtin_fixture(name)
+    elif name == "lone":
+        bg = Background(kind="texture", color=(200, 200, 180), low=90, high=170, scale=4)
+        seq = generate(_lone_config(96, 72, bg), seed=3)
+    elif name == "shifted":
+        # A uniform background: the scene seen by two cameras SHIFT pixels apart.
+        bg = Background(kind="uniform", color=(235, 235, 235))
+        seq = generate(_lone_config(96 + SHIFT[0], 72 + SHIFT[1], bg), seed=3)
+    elif name == "occlusion":
+        still = AR2(boundary="free", sigma=0.0)
+        cfg = SceneConfig(
+            name="conformance-occlusion",
+            width=120,
+            height=64,
+            n_frames=20,
+            background=Background(kind="uniform", color=(235, 235, 235)),
+            entities=(
+                EntitySpec(
+                    name="walker",
+                    role="target",
+                    appearance=_disc(),
+                    position=(16.0, 32.0),
+                    motion=Motion(x=still, y=still, velocity=(4.0, 0.0)),
+                    depth=((0, 1),),
+                ),
+                EntitySpec(
+                    name="wall",
+                    role="occluder",
+                    appearance=Appearance(shape="rect", size=(24, 32), colors=((90, 90, 90),)),
+                    position=(48.0, 32.0),
+                    depth=((0, 0),),
+                ),
+            ),
+        )
+        seq = generate(cfg, seed=3)
+    else:
+        raise KeyError(name)
+    targets = seq.initial_targets(0)
+    return (
+        _readonly(seq.frames),
+        seq.init_boxes(0),
+        np.asarray(seq.gt.box[:, targets], dtype=np.float64),
+    )
+
+
+# --------------------------------------------------------------------------------------
+# The checks: each takes (factory, options) and returns a message, raises AssertionError
+# (failed) or NotApplicable (not applicable).
+
+
+def _claim(factory: Callable[..., Any], opts: Options, name: str, default: bool) -> bool:
+    given = getattr(opts, name)
+    if given is not None:
+        return bool(given)
+    return bool(getattr(_build(factory, opts.seed), name, default))
+
+
+def check_protocol(factory: Callable[..., Any], opts: Options) -> str:
+    """The object has callable ``init`` and ``step``."""
+    try:
+        tracker = _build(factory, opts.seed)
+    except Exception as err:
+        raise AssertionError(
+            f"the factory raised {type(err).__name__}: {first_line(err)}"
+        ) from None
+    missing = [m for m in ("init", "step") if not callable(getattr(tracker, m, None))]
+    if missing:
+        raise AssertionError(
+            f"{type(tracker).__name__} has no {' or '.join(missing)} method "
+            "(a tracker needs init(frame, boxes) and step(frame) -> estimate with .boxes)"
+        )
+    return f"{type(tracker).__name__} has init and step"
+
+
+def _edge_runs(factory: Callable[..., Any], opts: Options) -> dict[str, _Run]:
+    runs = {}
+    for name in EDGE_FIXTURES:
+        frames, init, _ = _scene(name)
+        runs[name] = _run(_build(factory, opts.seed), frames, init)
+    return runs
+
+
+def check_edge_fixtures(factory: Callable[..., Any], opts: Options) -> str:
+    """Runs without exception on every edge-case fixture."""
+    bad = [f"{n}: {r.error}" for n, r in _edge_runs(factory, opts).items() if r.error]
+    if bad:
+        raise AssertionError(
+            f"raised on {len(bad)} of {len(EDGE_FIXTURES)} edge fixtures: " + "; ".join(bad)
+        )
+    return f"ran on {', '.join(EDGE_FIXTURES)}"
+
+
+def check_boxes(factory: Callable[..., Any], opts: Options) -> str:
+    """Estimates have ``boxes`` (K, 4), each row finite or all NaN."""
+    runs = _edge_runs(factory, opts)
+    bad = [
+        f"{n}: {r.problems[0]}"
+        + (f" (and {len(r.problems) - 1} more)" if len(r.problems) > 1 else "")
+        for n, r in runs.items()
+        if r.problems
+    ]
+    if bad:
+        raise AssertionError("malformed estimates: " + "; ".join(bad))
+    ran = [n for n, r in runs.items() if r.boxes is not None]
+    if not ran:
+        raise NotApplicable("no edge fixture ran (see edge_fixtures)")
+    lost = sum(int(np.isnan(r.boxes[1:, :, 0]).sum()) for r in runs.values() if r.boxes is not None)
+    return f"(K, 4), finite or NaN on {len(ran)} fixtures ({lost} NaN boxes)"
+
+
+def check_deterministic(factory: Callable[..., Any], opts: Options) -> str:
+    """Two trackers with the same seed give identical boxes."""
+    if not _claim(factory, opts, "deterministic", True):
+        raise NotApplicable("the tracker does not claim to be deterministic")
+    frames, init, _ = _scene("lone")
+    a, b = (_run(_build(factory, opts.seed), frames, init) for _ in range(2))
+    if a.error or b.error:
+        raise AssertionError(f"the run raised: {a.error or b.error}")
+    if not np.array_equal(a.boxes, b.boxes, equal_nan=True):
+        diff = np.abs(np.nan_to_num(a.boxes - b.boxes, nan=np.inf))
+        t = int(np.argwhere(diff > 0)[0][0])
+        raise AssertionError(
+            f"two runs with seed {opts.seed} differ from frame {t} (largest difference "
+            f"{float(diff.max()):.3g} px); pass deterministic=False if the tracker is "
+            "stochastic (then judge it with repeats and min_pass_rate)"
+        )
+    return f"same boxes twice with seed {opts.seed}"
+
+
+def _judge(opts: Options, name: str, one: Callable[[int], str | None]) -> str:
+    """Run ``one(seed)`` (None: passed, else why not) ``opts.repeats`` times."""
+    seeds = [opts.seed + i for i in range(opts.repeats)]
+    failures = [(s, why) for s in seeds if (why := one(s)) is not None]
+    rate = 1 - len(failures) / len(seeds)
+    if rate + 1e-12 < opts.min_pass_rate:
+        if len(seeds) == 1:
+            raise AssertionError(failures[0][1])
+        detail = "; ".join(f"seed {s}: {why}" for s, why in failures[:3])
+        raise AssertionError(
+            f"passed {len(seeds) - len(failures)} of {len(seeds)} runs, "
+            f"below the required rate {opts.min_pass_rate:g}: {detail}"
+        )
+    if len(seeds) == 1:
+        return name
+    return f"{name} in {len(seeds) - len(failures)} of {len(seeds)} runs"
+
+
+def check_translation_equivariance(factory: Callable[..., Any], opts: Options) -> str:
+    """Centres on a shifted scene are the centres shifted, within ``equivariance_tol``."""
+    full, _, gt = _scene("shifted")
+    dx, dy = SHIFT
+    h, w = full.shape[1] - dy, full.shape[2] - dx
+    a_frames, b_frames = full[:, :h, :w], full[:, dy:, dx:]
+    init = gt[0]
+    shift = np.array([dx, dy, 0.0, 0.0])
+
+    def one(seed: int) -> str | None:
+        a = _run(_build(factory, seed), a_frames, init)
+        b = _run(_build(factory, seed), b_frames, init - shift)
+        if a.error or b.error:
+            return f"the run raised: {a.error or b.error}"
+        err = np.abs(_centres(b.boxes) + shift[:2] - _centres(a.boxes))
+        worst = np.nan_to_num(err, nan=0.0).max(axis=-1)  # (T, K)
+        nan_differs = np.isnan(a.boxes[..., 0]) != np.isnan(b.boxes[..., 0])
+        if nan_differs.any():
+            t = int(np.argwhere(nan_differs)[0][0])
+            return f"the target is lost (NaN) in only one of the two views from frame {t}"
+        if worst.max() > opts.equivariance_tol:
+            t = int(np.argwhere(worst > opts.equivariance_tol)[0][0])
+            return (
+                f"shifting the scene by ({dx}, {dy}) px moved the estimated centre by "
+                f"{float(worst[t].max()):.2f} px more at frame {t} (tolerance "
+                f"{opts.equivariance_tol:g} px)"
+            )
+        return None
+
+    return _judge(opts, f"equivariant within {opts.equivariance_tol:g} px", one)
+
+
+def _iou_check(
+    factory: Callable[..., Any], opts: Options, scene: str, frames_from: int, what: str
+) -> str:
+    frames, init, gt = _scene(scene)
+
+    def one(seed: int) -> str | None:
+        run = _run(_build(factory, seed), frames, init)
+        if run.error:
+            return f"the run raised: {run.error}"
+        iou = _iou(run.boxes, gt)[frames_from:].min(axis=-1)
+        if iou.min() < opts.iou_threshold:
+            t = frames_from + int(np.argmax(iou < opts.iou_threshold))
+            return (
+                f"IoU fell to {float(iou.min()):.2f} (first below {opts.iou_threshold:g} "
+                f"at frame {t} of {len(frames)})"
+            )
+        return None
+
+    return _judge(opts, what, one)
+
+
+def check_keeps_lone_target(factory: Callable[..., Any], opts: Options) -> str:
+    """A lone, slow, unoccluded target: IoU >= ``iou_threshold`` every frame."""
+    return _iou_check(factory, opts, "lone", 1, f"IoU >= {opts.iou_threshold:g} in all 16 frames")
+
+
+def check_recovers_after_occlusion(factory: Callable[..., Any], opts: Options) -> str:
+    """After 3 frames fully hidden: IoU >= ``iou_threshold`` in the last 4 of 20 frames."""
+    if not _claim(factory, opts, "handles_occlusion", False):
+        raise NotApplicable("the tracker does not claim to handle occlusion")
+    return _iou_check(
+        factory,
+        opts,
+        "occlusion",
+        16,
+        f"IoU >= {opts.iou_threshold:g} in frames 16-19 after the occlusion",
+    )
+
+
+#: The checks, by name, in the order they run.
+CHECKS: dict[str, Callable[[Callable[..., Any], Options], str]] = {
+    "protocol": check_protocol,
+    "edge_fixtures": check_edge_fixtures,
+    "boxes": check_boxes,
+    "deterministic": check_deterministic,
+    "translation_equivariance": check_translation_equivariance,
+    "keeps_lone_target": check_keeps_lone_target,
+    "recovers_after_occlusion": check_recovers_after_occlusion,
+}
