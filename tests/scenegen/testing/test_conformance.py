@@ -99,11 +99,14 @@ def test_writing_into_the_frames_fails():
         (lambda b: np.zeros((len(b), 5)), "has shape (1, 5), expected (1, 4)"),
         (lambda b: np.where(np.arange(4) == 0, np.nan, b), "(a row must be finite, or all NaN)"),
         (lambda b: [["a"] * 4] * len(b), ".boxes is not numeric"),
+        (None, "the estimate (ndarray) has no .boxes"),
     ],
 )
 def test_malformed_boxes_are_named(boxes, needle):
     class Malformed(Still):
         def step(self, frame):
+            if boxes is None:  # the boxes themselves, not an estimate holding them
+                return self.boxes.copy()
             return SimpleNamespace(boxes=boxes(self.boxes))
 
     report = check_tracker(Malformed, report=True, checks=["boxes"])
