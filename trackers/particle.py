@@ -46,7 +46,7 @@ from trackers.base import Estimate, Tracker
 from trackers.filters.diagnostics import effective_dynamics, uniqueness
 from trackers.filters.resampling import RESAMPLERS, resample, weighted_resample_groups
 from trackers.filters.weights import log_sum_exp_groups, normalised_weights
-from trackers.kernels.histogram import KERNELS
+from trackers.kernels.histogram import DEFAULT_BOX_LEVELS, KERNELS
 from trackers.models.dynamics import AR2, boxes_from_states, states_from_boxes
 from trackers.models.observation import (
     MODELS,
@@ -93,8 +93,10 @@ class ParticleParams(TrackerParams):
         Histogram bins per colour channel, in [1, 256].
     n_parts : int or None, optional
         Spatial components (horizontal bands) of a region; None: the model's default.
-    kernel : {"uniform", "epanechnikov", "cone"} or None, optional
+    kernel : {"uniform", "epanechnikov", "cone", "box"} or None, optional
         Kernel weighting the pixels of a region; None: the model's default.
+    box_levels : int, optional
+        Levels of the "box" kernel (nested rectangles), in [1, 16].
     sigma : tuple of 3 floats, optional
         (σ_u, σ_v, σ_a) of the AR2 tracking dynamics (DPS: 2, 2, 0.001).
     a1, a2 : float, optional
@@ -114,6 +116,7 @@ class ParticleParams(TrackerParams):
     bins: int = 10
     n_parts: int | None = None
     kernel: str | None = None
+    box_levels: int = DEFAULT_BOX_LEVELS
     sigma: tuple[float, float, float] = (2.0, 2.0, 0.001)
     a1: float = 2.0
     a2: float = -1.0
@@ -128,6 +131,7 @@ class ParticleParams(TrackerParams):
         check_integer(self, "n_parts", low=1, optional=True)
         if self.kernel is not None:
             check_choice(self, "kernel", KERNELS)
+        check_integer(self, "box_levels", low=1, high=16)
         check_sigma3(self, "sigma")
         check_number(self, "a1")
         check_number(self, "a2")
@@ -223,7 +227,8 @@ class _ParticleTracker(Tracker):
             self.model = params.observation
         else:
             self.model = ColourModel(params.model, bins=params.bins, n_parts=params.n_parts,
-                                     kernel=params.kernel, lam=params.lam)
+                                     kernel=params.kernel, lam=params.lam,
+                                     box_levels=params.box_levels)
         self.dynamics = AR2(sigma=params.sigma, a1=params.a1, a2=params.a2)
         self.particles = np.empty((0, 0, 3))
         self.weights = np.empty(0)

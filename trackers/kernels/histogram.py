@@ -46,8 +46,8 @@ from __future__ import annotations
 
 from typing import NamedTuple
 
-import numpy as np
 import numba
+import numpy as np
 from numba import njit, prange
 from numpy.typing import NDArray
 
