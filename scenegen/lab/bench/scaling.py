@@ -138,7 +138,8 @@ def write_figure(rows: list[BenchRow], path: str | Path) -> Path:
         ax.set_xlabel(titles[axis])
         ax.set_ylabel("ms per step")
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=8)
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(fontsize=8)
     fig.suptitle("dps step cost (1 thread)")
     fig.tight_layout()
     path = Path(path)
