@@ -3,16 +3,21 @@
 All four share the observation model (``trackers.models.observation``: colour histograms, one
 compiled call per sampling stage for every particle of every object), the AR2 dynamics of
 (u, v, a) (``trackers.models.dynamics``) and the resamplers (``trackers.filters.resampling``); they
-differ only in how they sample the joint state (ALGORITHMS.md §3):
+differ only in how they sample the joint state (docs/algorithms.md §2):
 
 - ``Condensation`` ("condensation"): one independent single-object filter per target
-  (Isard & Blake 1998); the M = 1 case of §3.1, run side by side.
+  (Isard & Blake 1998); the one-object joint filter, run side by side.
 - ``JointPF`` ("joint-pf", the paper's "Non-PS"): one filter over the joint state;
   resample, propagate every object, weight by the joint likelihood Π_i p(Z | X_i).
-- ``PartitionedSampling`` ("ps", §3.3): objects one at a time in an ``ordering``;
+- ``PartitionedSampling`` ("ps", DPS §3): objects one at a time in an ``ordering``;
   weighted resampling by each object's likelihood before the next object moves.
-- ``DistributedPartitionedSampling`` ("dps", §3.4): the set split into ``n_groups``
+- ``DistributedPartitionedSampling`` ("dps", DPS §4): the set split into ``n_groups``
   mixture components, each running PS with its own circular-shift ordering.
+
+The observation model is swappable: the keyword ``observation`` takes any
+``trackers.models.observation.ObservationModel`` (e.g. ``PositionModel``, a Gaussian
+likelihood of the box centre around measured positions) in place of the colour model.
+Parameters are the fields of ``ParticleParams`` (``PSParams``, ``DPSParams``).
 
 Every step starts by resampling the set by the previous step's weights, so after a step
 ``self.particles`` (N, K, 3) and ``self.weights`` are the weighted set that represents
@@ -289,7 +294,7 @@ class Condensation(_ParticleTracker):
 
 
 class JointPF(_ParticleTracker):
-    """Joint particle filter over all targets ("Non-PS", ALGORITHMS.md §3.1).
+    """Joint particle filter over all targets ("Non-PS", docs/algorithms.md §2.3).
 
     Resample the joint set, propagate every object, weight by Π_i p(Z | X_i). The
     likelihoods of all N × K candidate boxes come from one kernel call.
@@ -342,7 +347,7 @@ class _Partitioned(_ParticleTracker):
             stage = obs.log_likelihoods(self._boxes(new, obj), obj)
             ll[rows, obj] = stage
             if j < m - 1:
-                # §3.3 weighted resampling inside each group with the weighting function
+                # Weighted resampling (DPS §3) inside each group with the weighting function
                 # g_j = Π_{i<=j} p(Z | X_{o_i}) of the objects placed so far. The carried
                 # weights are π ∝ 1 / g_{j-1}, so ancestors are drawn ∝ p(Z | X_{o_j}) and
                 # the particles stay concentrated where every placed object is likely;
@@ -367,7 +372,7 @@ class _Partitioned(_ParticleTracker):
     @staticmethod
     def _reassemble(logw: NDArray[np.float64], logpi: NDArray[np.float64],
                     sizes: NDArray[np.int64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Mixture reassembly (§3.4, after Vermaak, Doucet & Pérez 2003).
+        """Mixture reassembly (DPS §4, after Vermaak, Doucet & Pérez 2003).
 
         π_c,t ∝ π_c,t−1 Σ_{n∈c} w̃_n, and particle n of group c gets π_c,t w̃_n / Σ_c w̃,
         with w̃_n = π'_n Π_i p(Z | X_i) (log ``logw``) and π' the group's proposal weights
@@ -387,7 +392,7 @@ class _Partitioned(_ParticleTracker):
 
 
 class PartitionedSampling(_Partitioned):
-    """Partitioned sampling (MacCormick & Blake 2000; ALGORITHMS.md §3.3).
+    """Partitioned sampling (MacCormick & Blake 2000; docs/algorithms.md §2.5).
 
     Parameters: ``PSParams`` (``ordering`` and the ``ParticleParams``) as keywords, and
     ``rng``.
@@ -420,7 +425,7 @@ class PartitionedSampling(_Partitioned):
 
 
 class DistributedPartitionedSampling(_Partitioned):
-    """Distributed partitioned sampling (Smith & Gatica-Perez 2004; ALGORITHMS.md §3.4).
+    """Distributed partitioned sampling (Smith & Gatica-Perez 2004; docs/algorithms.md §2.6).
 
     Each step the resampled set is divided into ``n_groups`` mixture components of
     N / C particles (the remainder spread over the first groups); component c runs PS

@@ -1,7 +1,7 @@
 """Switching hypothesized measurements (SHM) trackers: positions and depth order.
 
 Wang, Tan & Loe, "Switching hypothesized measurements: a dynamic model with applications
-to occlusion adaptive joint tracking" (IJCAI 2007); ALGORITHMS.md §5.
+to occlusion adaptive joint tracking" (IJCAI 2007); docs/algorithms.md §4.
 
 Model (§2.2). ``M`` objects, ``L = M!`` depth orderings ``s_t`` (``self.orderings``, each
 row nearest first). ``s_t`` is a first-order Markov chain (eq. 1) that stays with
