@@ -161,7 +161,8 @@ class KalmanTracker(Tracker):
         self._origin = boxes[:, :2] + boxes[:, 2:] / 2
         k = boxes.shape[0]
         m = self.model
-        # The state is the displacement from the first centre (the AR2 mean, docs/algorithms.md §1.1).
+        # The state is the displacement from the first centre (the AR2 mean,
+        # docs/algorithms.md §1.1).
         self.kf = KalmanFilter(
             np.zeros((k, m.dim)), m.P0, m.F, m.Q, m.H, np.eye(2) * self.r_floor
         )
