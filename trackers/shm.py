@@ -171,6 +171,8 @@ class ShmParams(FastShmParams):
 
     def __post_init__(self) -> None:
         super().__post_init__()
+        if self.use_mse not in (True, False):  # bool, numpy bool, 0 or 1
+            raise ValueError(f"use_mse must be True or False, got {self.use_mse!r}")
         self._set("use_mse", bool(self.use_mse))
 
 
