@@ -237,7 +237,7 @@ class _ParticleTracker(Tracker):
         self.model.set_references(frame, boxes)
         states, self._sizes = states_from_boxes(boxes)
         self._mean = states
-        n = self.n_particles
+        n = self.params.n_particles
         self.particles = np.repeat(states[None], n, axis=0)
         self._prev = self.particles.copy()
         self.weights = np.full(n, 1.0 / n)
@@ -273,12 +273,13 @@ class Condensation(_ParticleTracker):
 
     def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
         super()._init(frame, boxes)
-        self.weights = np.full((self.n_particles, self.n_targets), 1.0 / self.n_particles)
+        n = self.params.n_particles
+        self.weights = np.full((n, self.n_targets), 1.0 / n)
 
     def _step(self, frame: NDArray[np.uint8]) -> Estimate:
         obs = self.model.observe(frame)
-        n, k = self.n_particles, self.n_targets
-        idx = np.column_stack([resample(self.weights[:, i], method=self.resampler,
+        n, k = self.params.n_particles, self.n_targets
+        idx = np.column_stack([resample(self.weights[:, i], method=self.params.resampler,
                                         rng=self.rng) for i in range(k)])
         cols = np.arange(k)
         x = self.particles[idx, cols]
@@ -305,8 +306,8 @@ class JointPF(_ParticleTracker):
 
     def _step(self, frame: NDArray[np.uint8]) -> Estimate:
         obs = self.model.observe(frame)
-        n, k = self.n_particles, self.n_targets
-        idx = resample(self.weights, method=self.resampler, rng=self.rng)
+        n, k = self.params.n_particles, self.n_targets
+        idx = resample(self.weights, method=self.params.resampler, rng=self.rng)
         x = self.particles[idx]
         prev = self._prev[idx]
         new = self.dynamics.propagate(x, prev, self._mean, rng=self.rng)
@@ -330,8 +331,8 @@ class _Partitioned(_ParticleTracker):
 
     def _partitioned_step(self, frame: NDArray[np.uint8]) -> tuple[Estimate, NDArray]:
         obs: FrameLikelihood = self.model.observe(frame)
-        n, m = self.n_particles, self.n_targets
-        idx = resample(self.weights, method=self.resampler, rng=self.rng)
+        n, m = self.params.n_particles, self.n_targets
+        idx = resample(self.weights, method=self.params.resampler, rng=self.rng)
         x, prev, sizes, orderings = self._groups(self.particles[idx], self._prev[idx])
         group = np.repeat(np.arange(sizes.size), sizes)
         rows = np.arange(n)
@@ -356,7 +357,7 @@ class _Partitioned(_ParticleTracker):
                 log_g += stage
                 k, w = weighted_resample_groups(
                     np.exp(logpi - logpi.max()), np.exp(log_g - log_g.max()), sizes,
-                    method=self.resampler, rng=self.rng)
+                    method=self.params.resampler, rng=self.rng)
                 x, prev, ll, log_g = x[k], prev[k], ll[k], log_g[k]
                 logpi = np.log(w)
         # The set {x, π'} still represents the predicted joint state (weighted resampling
@@ -403,21 +404,21 @@ class PartitionedSampling(_Partitioned):
 
     def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
         k = boxes.shape[0]
-        if isinstance(self.ordering, tuple):
-            order = np.asarray(self.ordering, dtype=np.int64)
+        if isinstance(self.params.ordering, tuple):
+            order = np.asarray(self.params.ordering, dtype=np.int64)
             if sorted(order.tolist()) != list(range(k)):
-                raise ValueError(f"ordering {list(self.ordering)} is not a permutation of the "
-                                 f"{k} targets 0..{k - 1}")
+                raise ValueError(f"ordering {list(self.params.ordering)} is not a permutation "
+                                 f"of the {k} targets 0..{k - 1}")
         else:
-            if self.ordering >= k:
+            if self.params.ordering >= k:
                 raise ValueError(f"ordering (circular shift) must lie in [0, {k}) for {k} "
-                                 f"targets, got {self.ordering}")
-            order = circular_shift(k, int(self.ordering))
+                                 f"targets, got {self.params.ordering}")
+            order = circular_shift(k, int(self.params.ordering))
         self._order = order[None, :]
         super()._init(frame, boxes)
 
     def _groups(self, x, prev):
-        return x, prev, np.array([self.n_particles]), self._order
+        return x, prev, np.array([self.params.n_particles]), self._order
 
     def _step(self, frame: NDArray[np.uint8]) -> Estimate:
         est, _ = self._partitioned_step(frame)
@@ -447,21 +448,21 @@ class DistributedPartitionedSampling(_Partitioned):
 
     def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
         k = boxes.shape[0]
-        c = k if self.n_groups is None else self.n_groups
-        if c > self.n_particles:
+        c = k if self.params.n_groups is None else self.params.n_groups
+        if c > self.params.n_particles:
             raise ValueError(f"n_groups = {c} (one per target) exceeds n_particles = "
-                             f"{self.n_particles}")
-        n = self.n_particles
+                             f"{self.params.n_particles}")
+        n = self.params.n_particles
         self._sizes_c = np.array([n // c + (i < n % c) for i in range(c)], dtype=np.int64)
         self._orders = np.stack([circular_shift(k, i % k) for i in range(c)])
-        if self.assignment == "interleaved":
+        if self.params.assignment == "interleaved":
             self._interleave = np.concatenate([np.arange(i, n, c) for i in range(c)])
         super()._init(frame, boxes)
 
     def _groups(self, x, prev):
         if self._sizes_c.size > 1:
-            if self.assignment == "random":
-                order = self.rng.permutation(self.n_particles)
+            if self.params.assignment == "random":
+                order = self.rng.permutation(self.params.n_particles)
             else:
                 order = self._interleave
             x, prev = x[order], prev[order]
