@@ -41,7 +41,7 @@ Colour-histogram models (``ColourModel``)
 A ``ColourModel`` turns a frame into a bin-index image once (``ColourModel.observe``),
 then scores any number of candidate boxes of any of the tracked objects in one compiled
 call (``FrameObservation.distances`` / ``log_likelihoods``; the likelihood is exp(−λ d²),
-ALGORITHMS.md §2)::
+docs/algorithms.md §2.2)::
 
     model = ColourModel("hsv", lam=20.0)
     model.set_references(frame0, boxes0)            # (K, 4): one template per object
@@ -142,7 +142,7 @@ class ColourModel:
     box_levels : int, optional
         Levels L of the "box" kernel, in [1, 16] (ignored by the other kernels).
     lam : float, optional
-        λ of the likelihood p(Z | X) ∝ exp(−λ d²) (ALGORITHMS.md §2.1), > 0.
+        λ of the likelihood p(Z | X) ∝ exp(−λ d²) (docs/algorithms.md §2.2), > 0.
     s_min, v_min : float, optional
         Saturation and value thresholds of the "hsv" model (fractions of the range).
 
