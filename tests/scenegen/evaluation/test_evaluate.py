@@ -44,16 +44,22 @@ def seq():
 def test_perfect_result_scores_perfectly(seq):
     gt = np.asarray(seq.gt.box[:, seq.target_indices()], dtype=np.float64)
     rep = evaluate(seq, gt, seq.target_ids(), tracker="oracle")
-    assert rep["n_frames"] == 12 and rep["tracker"] == "oracle"
-    for t in rep["targets"]:
-        assert t["tracked"] == 100.0 and t["success"] and t["recovered"]
-        assert t["precision"] == pytest.approx(100.0) and t["mean_centre_error"] == 0.0
-        assert t["failure_frame"] == -1
-    o = rep["overall"]
-    assert o["mota"] == 1.0 and o["idf1"] == 1.0 and o["auc"] == pytest.approx(20 / 21)
+    assert rep.n_frames == 12 and rep.tracker == "oracle"
+    for t in rep.targets:
+        assert t.tracked == 100.0 and t.success and t.recovered
+        assert t.precision == pytest.approx(100.0) and t.mean_centre_error == 0.0
+        assert t.failure_frame == -1
+        assert t.mot.mota == 1.0 and t.mot.hota == pytest.approx(1.0) and t.track_id == t.id
+    o = rep.overall
+    assert o.mot.mota == 1.0 and o.mot.idf1 == 1.0 and o.auc == pytest.approx(20 / 21)
+    assert (o.mot.fp, o.mot.fn, o.mot.idsw, o.mot.mt, o.mot.ml) == (0, 0, 0, 2, 0)
     text = format_table(rep)
-    assert "oracle" in text and "MOTA 1.000" in text
-    assert json.loads(to_json(rep)) == rep
+    assert "oracle" in text and "MOTA 1.000" in text and "HOTA 1.000" in text
+    doc = json.loads(to_json(rep))
+    assert doc == rep.to_dict()
+    keys = {"mota", "motp", "idf1", "idp", "idr", "fp", "fn", "idsw", "hota", "deta", "assa",
+            "auc", "precision_20"}  # fmt: skip
+    assert keys <= set(doc["overall"]) and all(keys <= set(t) for t in doc["targets"])
 
 
 def test_lost_target_is_reported(seq):
@@ -61,11 +67,12 @@ def test_lost_target_is_reported(seq):
     est[4:, 1, :2] = [0.0, 0.0]  # target b jumps to the corner and stays there
     est[4:, 1, 2:] = [5.0, 5.0]
     rep = evaluate(seq, est, seq.target_ids(), persist=3)
-    b = rep["targets"][1]
-    assert b["success"] is False and b["recovered"] is False
-    assert b["tracked"] == pytest.approx(100 * 4 / 12)
-    assert b["failure_frame"] == 4
-    assert rep["overall"]["mota"] < 1.0
+    b = rep.targets[1]
+    assert b.success is False and b.recovered is False
+    assert b.tracked == pytest.approx(100 * 4 / 12)
+    assert b.failure_frame == 4
+    assert rep.overall.mot.mota < 1.0
+    assert (b.mot.fp, b.mot.fn) == (8, 8) and rep.overall.mot.fn == 8
 
 
 def test_depth_order_accuracy_of_true_ordering(seq):
@@ -76,9 +83,10 @@ def test_depth_order_accuracy_of_true_ordering(seq):
     prob = np.eye(2)[truth]
     est = seq.gt.box[:, idx]
     rep = evaluate(seq, est, seq.target_ids(), order_prob=prob, orderings=orderings)
-    assert rep["overall"]["depth_order_accuracy"] == 100.0
+    assert rep.overall.depth_order_accuracy == 100.0
+    assert "depth_order_accuracy" in rep.to_dict()["overall"]
     rep = evaluate(seq, est, seq.target_ids(), order_prob=prob[:, ::-1], orderings=orderings)
-    assert rep["overall"]["depth_order_accuracy"] == 0.0
+    assert rep.overall.depth_order_accuracy == 0.0
 
 
 def test_mismatches_raise_data_error_naming_them(seq):
