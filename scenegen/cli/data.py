@@ -48,7 +48,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
     p = sub.add_parser(
         "export",
-        help="export a sequence (MOT, OTB, GOT-10k, VOT layouts) or a result (MOT tracker file)",
+        help="export a sequence (mot, otb, got10k, vot) or a result (mot tracker file)",
     )
     p.add_argument("file", type=Path, help="scenegen .h5 file, or a result .h5 file")
     p.add_argument(

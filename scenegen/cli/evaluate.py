@@ -62,10 +62,16 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
         target count or ids), naming the mismatch and the files.
     """
     from scenegen.errors import DataError
-    from scenegen.evaluation.evaluate import evaluate, evaluate_tracks, format_table
+    from scenegen.evaluation.evaluate import (
+        check_options,
+        evaluate,
+        evaluate_tracks,
+        format_table,
+    )
     from scenegen.io import read, read_result
     from scenegen.io.mot import read_mot_tracker
 
+    check_options(args.gt_mode, args.visibility_threshold, args.otb_average)
     seq = read(args.file, args.sequence)
     options = {
         "gt_mode": args.gt_mode,

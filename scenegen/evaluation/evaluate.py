@@ -52,6 +52,7 @@ __all__ = [
     "DEFAULT_RECOVER_FRAMES",
     "GT_MODES",
     "OTB_AVERAGES",
+    "check_options",
     "SequenceReport",
     "TargetScores",
     "evaluate",
@@ -136,7 +137,8 @@ def _finite(x: float) -> float | None:
     return float(x) if np.isfinite(x) else None
 
 
-def _check_options(gt_mode: str, visibility_threshold: float, otb_average: str) -> None:
+def check_options(gt_mode: str, visibility_threshold: float, otb_average: str) -> None:
+    """Raise ConfigError naming an unknown ``gt_mode`` / ``otb_average`` or a bad threshold."""
     if gt_mode not in GT_MODES:
         raise ConfigError(f"gt_mode must be one of {', '.join(GT_MODES)}; got {gt_mode!r}")
     if not 0.0 <= visibility_threshold < 1.0:
@@ -208,7 +210,7 @@ def evaluate(
     ConfigError
         If an option is out of range.
     """
-    _check_options(gt_mode, visibility_threshold, otb_average)
+    check_options(gt_mode, visibility_threshold, otb_average)
     est = np.asarray(boxes, dtype=np.float64)
     ids = np.asarray(target_ids).astype(np.int64).reshape(-1)
     name = str(getattr(sequence, "name", ""))
@@ -326,7 +328,7 @@ def evaluate_tracks(
     DataError
         If the frame count differs from the sequence's.
     """
-    _check_options(gt_mode, visibility_threshold, otb_average)
+    check_options(gt_mode, visibility_threshold, otb_average)
     est = np.asarray(boxes, dtype=np.float64)
     ids = np.asarray(track_ids).astype(np.int64).reshape(-1)
     name = str(getattr(sequence, "name", ""))

@@ -26,7 +26,6 @@ Ground-truth modes (``gt_mode``) say which ground-truth boxes count:
 
 from __future__ import annotations
 
-import errno
 import math
 from pathlib import Path
 
@@ -210,10 +209,11 @@ def read_mot_tracker(
 
 
 class writable:
-    """Context manager: turn a permission or read-only error into one ConfigError line.
+    """Context manager: turn an operating-system error while writing into one ConfigError.
 
     ``with writable(target): ...`` reports ``TARGET: cannot write: REASON`` (exit 2 in the
-    CLI) instead of an internal error naming a temporary file.
+    CLI: the user must pick another output) instead of an internal error naming a
+    temporary file beside the target.
     """
 
     def __init__(self, target: str | Path) -> None:
@@ -223,9 +223,6 @@ class writable:
         return None
 
     def __exit__(self, kind: type | None, err: BaseException | None, tb: object) -> bool:
-        if isinstance(err, (PermissionError, IsADirectoryError)) or (
-            isinstance(err, OSError) and err.errno == errno.EROFS
-        ):
-            assert isinstance(err, OSError)
+        if isinstance(err, OSError) and err.errno is not None:
             raise ConfigError(f"{self.target}: cannot write: {err.strerror or err}") from None
         return False

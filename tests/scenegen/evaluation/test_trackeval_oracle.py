@@ -94,5 +94,5 @@ def test_result_and_its_tracker_file_score_the_same(name):
         b = rep_b.overall
         for attr in ("mota", "motp", "idf1", "hota", "deta", "assa", "fp", "fn", "idsw"):
             assert getattr(a.mot, attr) == pytest.approx(getattr(b.mot, attr), abs=TOL)
-        if len(rep_a.targets) == len(rep_b.targets):  # else the file's rows include targets nobody tracked
+        if len(rep_a.targets) == len(rep_b.targets):  # else rows include untracked targets
             assert a.auc == pytest.approx(b.auc, abs=TOL)
