@@ -69,7 +69,3 @@ def main(argv: Sequence[str] | None = None) -> int:
             file=sys.stderr,
         )
         return 1
-
-
-def entry() -> None:  # pragma: no cover - console script wrapper
-    sys.exit(main())

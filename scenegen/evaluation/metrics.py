@@ -1,8 +1,8 @@
 """Tracking metrics: the DPS measures, OTB curves, KAMS failure frames, McNemar, CLEAR MOT, IDF1.
 
 Everything here is pure numpy (CLEAR MOT and IDF1 use the TrackEval-exact matchings of
-:mod:`scenegen.evaluation.mot`) and works on boxes ``[x, y, w, h]`` in pixels (0-based:
-the top-left pixel covers [0, 1) × [0, 1)). A box with any NaN coordinate means "no box": an absent
+:mod:`scenegen.evaluation.mot`) and works on boxes ``[x, y, w, h]`` in pixels
+(docs/format.md, "Conventions"). A box with any NaN coordinate means "no box": an absent
 ground-truth entity or a missing estimate.
 
 Frame conventions
@@ -384,7 +384,7 @@ def otb_curves(
 
 
 def failure_frame(error: ArrayLike, threshold: float, *, persist: int = 10) -> int:
-    """Frame at which a run fails (KAMS §3.1, ALGORITHMS §4.6), or -1 if it never does.
+    """Frame at which a run fails (KAMS §3.1, docs/algorithms.md §5), or -1 if it never does.
 
     (open) A run "fails when the error stays above a threshold". Here it fails at the first
     frame t that starts ``persist`` consecutive frames whose error is above ``threshold``
