@@ -141,3 +141,25 @@ def test_cli_exit_codes(seq, tmp_path, capsys):
     write_result(res, TrackerResult("kalman", {}, 0, seq.name, seq.target_ids(), boxes))
     assert main(["evaluate", str(data), str(res), "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["overall"]["idf1"] == 1.0
+
+
+def test_tracks_with_foreign_ids_pair_by_identity_and_otb_average(seq):
+    from scenegen.evaluation import evaluate_tracks
+
+    gt = np.asarray(seq.gt.box[:, seq.target_indices()], dtype=np.float64)
+    est = gt[:, ::-1].copy()  # column 0 follows target b, column 1 target a
+    est[6:, 0] = np.nan  # track 70 (on b) stops half way
+    rep = evaluate_tracks(seq, est, [70, 80], tracker="other")
+    assert [(t.id, t.track_id) for t in rep.targets] == [(1, 80), (2, 70)]
+    assert rep.targets[0].mot.mota == 1.0 and rep.targets[1].mot.fn == 6
+    assert rep.targets[1].auc == pytest.approx(0.5 * 20 / 21)
+    assert rep.overall.auc == pytest.approx(np.mean([t.auc for t in rep.targets]))
+    pooled = evaluate_tracks(seq, est, [70, 80], otb_average="frames").overall
+    from scenegen.evaluation.metrics import otb_curves
+
+    assert pooled.otb_average == "frames"
+    assert pooled.auc == otb_curves(est[:, ::-1], gt).auc
+    with pytest.raises(scenegen.errors.ConfigError, match="otb_average"):
+        evaluate_tracks(seq, est, [70, 80], otb_average="mean")
+    with pytest.raises(DataError, match="tracks span 5 frames"):
+        evaluate_tracks(seq, est[:5], [70, 80])
