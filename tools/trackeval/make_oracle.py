@@ -6,7 +6,7 @@ and ``np.int``), so it runs in a side environment, not in the project's::
     python3 -m venv /tmp/trackeval-venv
     /tmp/trackeval-venv/bin/pip install 'numpy<1.24' scipy
     /tmp/trackeval-venv/bin/pip install /path/to/a/checkout/of/TrackEval
-    /tmp/trackeval-venv/bin/python tools/trackeval/make_oracle.py [TRACKEVAL_COMMIT]
+    /tmp/trackeval-venv/bin/python tools/trackeval/make_oracle.py [--commit SHA] [--out oracle.json]
 
 The inputs are made by ``tools/trackeval/make_inputs.py`` (scenegen's own exports of the
 fixtures). Every tracker is scored on every sequence under both ground-truth modes with
@@ -19,6 +19,7 @@ This script does not import scenegen.
 
 from __future__ import annotations
 
+import argparse
 import json
 import subprocess
 import sys
@@ -103,8 +104,6 @@ def score(mode: str, trackers: list[str], seqs: list[str]) -> dict:
 
 
 def _trackeval_commit() -> str:
-    if len(sys.argv) > 1:  # the commit of the checkout installed, when pip copied it
-        return sys.argv[1]
     path = Path(trackeval.__file__).resolve().parents[1]
     try:
         return subprocess.run(
@@ -118,10 +117,14 @@ def _trackeval_commit() -> str:
 
 
 def main() -> None:
+    parser = argparse.ArgumentParser(description="Score the committed MOT files with TrackEval.")
+    parser.add_argument("--commit", help="TrackEval commit installed (when pip copied it)")
+    parser.add_argument("--out", type=Path, default=DATA / "oracle.json", help="output file")
+    args = parser.parse_args()
     trackers = sorted(p.name for p in (DATA / "trackers").iterdir() if p.is_dir())
     oracle: dict = {
         "tool": "TrackEval",
-        "trackeval": _trackeval_commit(),
+        "trackeval": args.commit or _trackeval_commit(),
         "numpy": np.__version__,
         "python": sys.version.split()[0],
         "modes": {},
@@ -129,8 +132,8 @@ def main() -> None:
     for mode in ("amodal", "visible"):
         seqs = sorted(p.name for p in (DATA / "gt" / mode).iterdir() if p.is_dir())
         oracle["modes"][mode] = score(mode, trackers, seqs)
-    (DATA / "oracle.json").write_text(json.dumps(oracle, indent=1, sort_keys=True) + "\n")
-    print(f"wrote {DATA / 'oracle.json'}")
+    args.out.write_text(json.dumps(oracle, indent=1, sort_keys=True) + "\n")
+    print(f"wrote {args.out}")
 
 
 if __name__ == "__main__":

@@ -96,3 +96,19 @@ def test_result_and_its_tracker_file_score_the_same(name):
             assert getattr(a.mot, attr) == pytest.approx(getattr(b.mot, attr), abs=TOL)
         if len(rep_a.targets) == len(rep_b.targets):  # else rows include untracked targets
             assert a.auc == pytest.approx(b.auc, abs=TOL)
+
+
+@pytest.mark.slow
+def test_oracle_reproduces_with_trackeval(tmp_path):
+    """Rerun TrackEval on the committed files (needs its side environment: set
+    TRACKEVAL_PYTHON to a Python with trackeval and numpy < 1.24)."""
+    import os
+    import subprocess
+
+    python = os.environ.get("TRACKEVAL_PYTHON")
+    if not python:
+        pytest.skip("TRACKEVAL_PYTHON is not set (TrackEval's side environment)")
+    out = tmp_path / "oracle.json"
+    script = ROOT / "tools" / "trackeval" / "make_oracle.py"
+    subprocess.run([python, str(script), "--out", str(out)], check=True, capture_output=True)
+    assert json.loads(out.read_text())["modes"] == ORACLE["modes"]
