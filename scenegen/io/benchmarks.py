@@ -10,8 +10,9 @@ OTB (Wu et al. 2015, the MATLAB toolkit)
     ``img/0001.jpg …`` and ``groundtruth_rect.txt``. Pixel coordinates are 1-based
     (MATLAB): ``x + 1, y + 1, w, h``. OTB has no absence label: a frame where the target
     is out of the scene is written ``0,0,0,0``, which the toolkit's
-    ``calcSeqErrRobust`` skips (it ignores annotations with a value <= 0). Occluded
-    frames keep their amodal box, as OTB annotates occluded targets.
+    ``calcSeqErrRobust`` treats as unlabelled (any value <= 0: overlap and centre error
+    -1, still counted in the frame total). Occluded frames keep their amodal box, as OTB
+    annotates occluded targets.
 GOT-10k (Huang et al. 2019, the ``got10k`` Python toolkit)
     ``00000001.jpg …``, ``groundtruth.txt`` (0-based pixels, the toolkit reads them as
     they are), ``absence.label`` (1 where the target is out of the scene, box
