@@ -17,9 +17,11 @@ GOT-10k (Huang et al. 2019, the ``got10k`` Python toolkit)
     ``00000001.jpg …``, ``groundtruth.txt`` (0-based pixels, the toolkit reads them as
     they are), ``absence.label`` (1 where the target is out of the scene, box
     ``0,0,0,0``), ``cover.label`` (visible ratio in GOT-10k's levels 0–8: 0 fully
-    occluded or absent, 1 (0, 15 %), 2 [15, 30 %), … 7 [90, 100 %), 8 fully visible) and
+    occluded or absent, 1 (0, 15 %), 2 [15, 30 %), … 7 [90, 100 %), 8 fully visible),
+    ``cut_by_image.label`` (1 where the amodal box reaches past the image border) and
     ``meta_info.ini``. The toolkit scores only frames with cover > 0, so fully occluded
-    and absent frames do not count there.
+    and absent frames do not count there. It opens ``ROOT/<subset>/list.txt``: export
+    into ``ROOT/val`` for ``got10k.datasets.GOT10k(ROOT, subset="val")``.
 VOT (Kristan et al., the ``vot`` toolkit; short-term rectangle format)
     ``color/00000001.jpg …``, ``groundtruth.txt`` (0-based pixels, as the Python toolkit
     reads regions), absent frames ``nan,nan,nan,nan`` (VOT long-term's "target not
@@ -93,6 +95,12 @@ def _annotations(kind: str, seq: Sequence, k: int, fps: int, ext: str) -> dict[s
         files["cover.label"] = "".join(
             f"{cover_level(float(v), bool(p))}\n" for v, p in zip(vis, present, strict=True)
         )
+        right, bottom = box[:, 0] + box[:, 2], box[:, 1] + box[:, 3]
+        with np.errstate(invalid="ignore"):
+            cut = present & (
+                (box[:, 0] < 0) | (box[:, 1] < 0) | (right > seq.width) | (bottom > seq.height)
+            )
+        files["cut_by_image.label"] = "".join(f"{int(c)}\n" for c in cut)
         files["meta_info.ini"] = (
             "[METAINFO]\n"
             f"object_class: {seq.entities.name[k]}\n"

@@ -116,6 +116,8 @@ def test_benchmark_layouts(tmp_path, capsys):
     got = tmp_path / "got10k" / names[1]
     absence = (got / "absence.label").read_text().split()
     assert absence == [str(int(not p)) for p in seq.gt.present[:, seq.target_indices()[1]]]
+    cut = (got / "cut_by_image.label").read_text().split()
+    assert len(cut) == seq.n_frames and set(cut) <= {"0", "1"}
     assert "sequence" in {p.name for p in (tmp_path / "vot" / names[1]).iterdir()}
     code, _, _ = run(capsys, "export", src, "--format", "otb", "-o", tmp_path / "o2",
                      "--image-format", "png")  # fmt: skip
