@@ -86,6 +86,10 @@ def test_gt_export_modes(tmp_path, capsys):
             assert 8 in rows[:, 7]
             hidden = (rows[:, 7] == 1) & (rows[:, 8] == 0)
             assert hidden.any() and set(rows[hidden, 6]) == {0}
+    out = tmp_path / "jpg"
+    assert run(capsys, "export", src, "--format", "mot", "-o", out, "--image-format", "jpg")[0] == 0
+    assert "imExt=.jpg" in (out / "seqinfo.ini").read_text()
+    assert len(list((out / "img1").glob("*.jpg"))) == seq.n_frames
 
 
 def test_benchmark_layouts(tmp_path, capsys):
