@@ -3,16 +3,21 @@
 All four share the observation model (``trackers.models.observation``: colour histograms, one
 compiled call per sampling stage for every particle of every object), the AR2 dynamics of
 (u, v, a) (``trackers.models.dynamics``) and the resamplers (``trackers.filters.resampling``); they
-differ only in how they sample the joint state (ALGORITHMS.md §3):
+differ only in how they sample the joint state (docs/algorithms.md §2):
 
 - ``Condensation`` ("condensation"): one independent single-object filter per target
-  (Isard & Blake 1998); the M = 1 case of §3.1, run side by side.
+  (Isard & Blake 1998); the one-object joint filter, run side by side.
 - ``JointPF`` ("joint-pf", the paper's "Non-PS"): one filter over the joint state;
   resample, propagate every object, weight by the joint likelihood Π_i p(Z | X_i).
-- ``PartitionedSampling`` ("ps", §3.3): objects one at a time in an ``ordering``;
+- ``PartitionedSampling`` ("ps", DPS §3): objects one at a time in an ``ordering``;
   weighted resampling by each object's likelihood before the next object moves.
-- ``DistributedPartitionedSampling`` ("dps", §3.4): the set split into ``n_groups``
+- ``DistributedPartitionedSampling`` ("dps", DPS §4): the set split into ``n_groups``
   mixture components, each running PS with its own circular-shift ordering.
+
+The observation model is swappable: the keyword ``observation`` takes any
+``trackers.models.observation.ObservationModel`` (e.g. ``PositionModel``, a Gaussian
+likelihood of the box centre around measured positions) in place of the colour model.
+Parameters are the fields of ``ParticleParams`` (``PSParams``, ``DPSParams``).
 
 Every step starts by resampling the set by the previous step's weights, so after a step
 ``self.particles`` (N, K, 3) and ``self.weights`` are the weighted set that represents
@@ -46,7 +51,7 @@ from trackers.base import Estimate, Tracker
 from trackers.filters.diagnostics import effective_dynamics, uniqueness
 from trackers.filters.resampling import RESAMPLERS, resample, weighted_resample_groups
 from trackers.filters.weights import log_sum_exp_groups, normalised_weights
-from trackers.kernels.histogram import KERNELS
+from trackers.kernels.histogram import DEFAULT_BOX_LEVELS, KERNELS
 from trackers.models.dynamics import AR2, boxes_from_states, states_from_boxes
 from trackers.models.observation import (
     MODELS,
@@ -93,8 +98,10 @@ class ParticleParams(TrackerParams):
         Histogram bins per colour channel, in [1, 256].
     n_parts : int or None, optional
         Spatial components (horizontal bands) of a region; None: the model's default.
-    kernel : {"uniform", "epanechnikov", "cone"} or None, optional
+    kernel : {"uniform", "epanechnikov", "cone", "box"} or None, optional
         Kernel weighting the pixels of a region; None: the model's default.
+    box_levels : int, optional
+        Levels of the "box" kernel (nested rectangles), in [1, 16].
     sigma : tuple of 3 floats, optional
         (σ_u, σ_v, σ_a) of the AR2 tracking dynamics (DPS: 2, 2, 0.001).
     a1, a2 : float, optional
@@ -114,6 +121,7 @@ class ParticleParams(TrackerParams):
     bins: int = 10
     n_parts: int | None = None
     kernel: str | None = None
+    box_levels: int = DEFAULT_BOX_LEVELS
     sigma: tuple[float, float, float] = (2.0, 2.0, 0.001)
     a1: float = 2.0
     a2: float = -1.0
@@ -128,6 +136,7 @@ class ParticleParams(TrackerParams):
         check_integer(self, "n_parts", low=1, optional=True)
         if self.kernel is not None:
             check_choice(self, "kernel", KERNELS)
+        check_integer(self, "box_levels", low=1, high=16)
         check_sigma3(self, "sigma")
         check_number(self, "a1")
         check_number(self, "a2")
@@ -223,7 +232,8 @@ class _ParticleTracker(Tracker):
             self.model = params.observation
         else:
             self.model = ColourModel(params.model, bins=params.bins, n_parts=params.n_parts,
-                                     kernel=params.kernel, lam=params.lam)
+                                     kernel=params.kernel, lam=params.lam,
+                                     box_levels=params.box_levels)
         self.dynamics = AR2(sigma=params.sigma, a1=params.a1, a2=params.a2)
         self.particles = np.empty((0, 0, 3))
         self.weights = np.empty(0)
@@ -232,7 +242,7 @@ class _ParticleTracker(Tracker):
         self.model.set_references(frame, boxes)
         states, self._sizes = states_from_boxes(boxes)
         self._mean = states
-        n = self.n_particles
+        n = self.params.n_particles
         self.particles = np.repeat(states[None], n, axis=0)
         self._prev = self.particles.copy()
         self.weights = np.full(n, 1.0 / n)
@@ -268,12 +278,13 @@ class Condensation(_ParticleTracker):
 
     def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
         super()._init(frame, boxes)
-        self.weights = np.full((self.n_particles, self.n_targets), 1.0 / self.n_particles)
+        n = self.params.n_particles
+        self.weights = np.full((n, self.n_targets), 1.0 / n)
 
     def _step(self, frame: NDArray[np.uint8]) -> Estimate:
         obs = self.model.observe(frame)
-        n, k = self.n_particles, self.n_targets
-        idx = np.column_stack([resample(self.weights[:, i], method=self.resampler,
+        n, k = self.params.n_particles, self.n_targets
+        idx = np.column_stack([resample(self.weights[:, i], method=self.params.resampler,
                                         rng=self.rng) for i in range(k)])
         cols = np.arange(k)
         x = self.particles[idx, cols]
@@ -289,7 +300,7 @@ class Condensation(_ParticleTracker):
 
 
 class JointPF(_ParticleTracker):
-    """Joint particle filter over all targets ("Non-PS", ALGORITHMS.md §3.1).
+    """Joint particle filter over all targets ("Non-PS", docs/algorithms.md §2.3).
 
     Resample the joint set, propagate every object, weight by Π_i p(Z | X_i). The
     likelihoods of all N × K candidate boxes come from one kernel call.
@@ -300,8 +311,8 @@ class JointPF(_ParticleTracker):
 
     def _step(self, frame: NDArray[np.uint8]) -> Estimate:
         obs = self.model.observe(frame)
-        n, k = self.n_particles, self.n_targets
-        idx = resample(self.weights, method=self.resampler, rng=self.rng)
+        n, k = self.params.n_particles, self.n_targets
+        idx = resample(self.weights, method=self.params.resampler, rng=self.rng)
         x = self.particles[idx]
         prev = self._prev[idx]
         new = self.dynamics.propagate(x, prev, self._mean, rng=self.rng)
@@ -325,8 +336,8 @@ class _Partitioned(_ParticleTracker):
 
     def _partitioned_step(self, frame: NDArray[np.uint8]) -> tuple[Estimate, NDArray]:
         obs: FrameLikelihood = self.model.observe(frame)
-        n, m = self.n_particles, self.n_targets
-        idx = resample(self.weights, method=self.resampler, rng=self.rng)
+        n, m = self.params.n_particles, self.n_targets
+        idx = resample(self.weights, method=self.params.resampler, rng=self.rng)
         x, prev, sizes, orderings = self._groups(self.particles[idx], self._prev[idx])
         group = np.repeat(np.arange(sizes.size), sizes)
         rows = np.arange(n)
@@ -342,7 +353,7 @@ class _Partitioned(_ParticleTracker):
             stage = obs.log_likelihoods(self._boxes(new, obj), obj)
             ll[rows, obj] = stage
             if j < m - 1:
-                # §3.3 weighted resampling inside each group with the weighting function
+                # Weighted resampling (DPS §3) inside each group with the weighting function
                 # g_j = Π_{i<=j} p(Z | X_{o_i}) of the objects placed so far. The carried
                 # weights are π ∝ 1 / g_{j-1}, so ancestors are drawn ∝ p(Z | X_{o_j}) and
                 # the particles stay concentrated where every placed object is likely;
@@ -351,7 +362,7 @@ class _Partitioned(_ParticleTracker):
                 log_g += stage
                 k, w = weighted_resample_groups(
                     np.exp(logpi - logpi.max()), np.exp(log_g - log_g.max()), sizes,
-                    method=self.resampler, rng=self.rng)
+                    method=self.params.resampler, rng=self.rng)
                 x, prev, ll, log_g = x[k], prev[k], ll[k], log_g[k]
                 logpi = np.log(w)
         # The set {x, π'} still represents the predicted joint state (weighted resampling
@@ -367,7 +378,7 @@ class _Partitioned(_ParticleTracker):
     @staticmethod
     def _reassemble(logw: NDArray[np.float64], logpi: NDArray[np.float64],
                     sizes: NDArray[np.int64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Mixture reassembly (§3.4, after Vermaak, Doucet & Pérez 2003).
+        """Mixture reassembly (DPS §4, after Vermaak, Doucet & Pérez 2003).
 
         π_c,t ∝ π_c,t−1 Σ_{n∈c} w̃_n, and particle n of group c gets π_c,t w̃_n / Σ_c w̃,
         with w̃_n = π'_n Π_i p(Z | X_i) (log ``logw``) and π' the group's proposal weights
@@ -387,7 +398,7 @@ class _Partitioned(_ParticleTracker):
 
 
 class PartitionedSampling(_Partitioned):
-    """Partitioned sampling (MacCormick & Blake 2000; ALGORITHMS.md §3.3).
+    """Partitioned sampling (MacCormick & Blake 2000; docs/algorithms.md §2.5).
 
     Parameters: ``PSParams`` (``ordering`` and the ``ParticleParams``) as keywords, and
     ``rng``.
@@ -398,21 +409,21 @@ class PartitionedSampling(_Partitioned):
 
     def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
         k = boxes.shape[0]
-        if isinstance(self.ordering, tuple):
-            order = np.asarray(self.ordering, dtype=np.int64)
+        if isinstance(self.params.ordering, tuple):
+            order = np.asarray(self.params.ordering, dtype=np.int64)
             if sorted(order.tolist()) != list(range(k)):
-                raise ValueError(f"ordering {list(self.ordering)} is not a permutation of the "
-                                 f"{k} targets 0..{k - 1}")
+                raise ValueError(f"ordering {list(self.params.ordering)} is not a permutation "
+                                 f"of the {k} targets 0..{k - 1}")
         else:
-            if self.ordering >= k:
+            if self.params.ordering >= k:
                 raise ValueError(f"ordering (circular shift) must lie in [0, {k}) for {k} "
-                                 f"targets, got {self.ordering}")
-            order = circular_shift(k, int(self.ordering))
+                                 f"targets, got {self.params.ordering}")
+            order = circular_shift(k, int(self.params.ordering))
         self._order = order[None, :]
         super()._init(frame, boxes)
 
     def _groups(self, x, prev):
-        return x, prev, np.array([self.n_particles]), self._order
+        return x, prev, np.array([self.params.n_particles]), self._order
 
     def _step(self, frame: NDArray[np.uint8]) -> Estimate:
         est, _ = self._partitioned_step(frame)
@@ -420,7 +431,7 @@ class PartitionedSampling(_Partitioned):
 
 
 class DistributedPartitionedSampling(_Partitioned):
-    """Distributed partitioned sampling (Smith & Gatica-Perez 2004; ALGORITHMS.md §3.4).
+    """Distributed partitioned sampling (Smith & Gatica-Perez 2004; docs/algorithms.md §2.6).
 
     Each step the resampled set is divided into ``n_groups`` mixture components of
     N / C particles (the remainder spread over the first groups); component c runs PS
@@ -442,21 +453,21 @@ class DistributedPartitionedSampling(_Partitioned):
 
     def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
         k = boxes.shape[0]
-        c = k if self.n_groups is None else self.n_groups
-        if c > self.n_particles:
+        c = k if self.params.n_groups is None else self.params.n_groups
+        if c > self.params.n_particles:
             raise ValueError(f"n_groups = {c} (one per target) exceeds n_particles = "
-                             f"{self.n_particles}")
-        n = self.n_particles
+                             f"{self.params.n_particles}")
+        n = self.params.n_particles
         self._sizes_c = np.array([n // c + (i < n % c) for i in range(c)], dtype=np.int64)
         self._orders = np.stack([circular_shift(k, i % k) for i in range(c)])
-        if self.assignment == "interleaved":
+        if self.params.assignment == "interleaved":
             self._interleave = np.concatenate([np.arange(i, n, c) for i in range(c)])
         super()._init(frame, boxes)
 
     def _groups(self, x, prev):
         if self._sizes_c.size > 1:
-            if self.assignment == "random":
-                order = self.rng.permutation(self.n_particles)
+            if self.params.assignment == "random":
+                order = self.rng.permutation(self.params.n_particles)
             else:
                 order = self._interleave
             x, prev = x[order], prev[order]

@@ -1,7 +1,7 @@
 """Switching hypothesized measurements (SHM) trackers: positions and depth order.
 
 Wang, Tan & Loe, "Switching hypothesized measurements: a dynamic model with applications
-to occlusion adaptive joint tracking" (IJCAI 2007); ALGORITHMS.md §5.
+to occlusion adaptive joint tracking" (IJCAI 2007); docs/algorithms.md §4.
 
 Model (§2.2). ``M`` objects, ``L = M!`` depth orderings ``s_t`` (``self.orderings``, each
 row nearest first). ``s_t`` is a first-order Markov chain (eq. 1) that stays with
@@ -171,6 +171,8 @@ class ShmParams(FastShmParams):
 
     def __post_init__(self) -> None:
         super().__post_init__()
+        if self.use_mse not in (True, False):  # bool, numpy bool, 0 or 1
+            raise ValueError(f"use_mse must be True or False, got {self.use_mse!r}")
         self._set("use_mse", bool(self.use_mse))
 
 
@@ -190,8 +192,9 @@ class _SHMBase(Tracker):
         self._origin = boxes[:, :2] + boxes[:, 2:] / 2
         n_order = self.orderings.shape[0]
         self.order_prob = np.full(n_order, 1.0 / n_order)
+        p = self.params
         self._evidence = _OrderingEvidence(
-            n_order, self.p_stay, self.lam, self.mse_rate, self.mse_floor, self.evidence
+            n_order, p.p_stay, p.lam, p.mse_rate, p.mse_floor, p.evidence
         )
         self._log_u = -np.log(float(frame.shape[0] * frame.shape[1]))
 
@@ -253,7 +256,7 @@ min_visible, support, blur
         # One Gaussian per ordering; the state is the displacement from the first centres.
         self.kf = KalmanFilter(
             np.zeros((n_order, self.joint.dim)), self.joint.P0, self.joint.F, self.joint.Q,
-            self.joint.H, np.eye(2 * n_obj) * self.r_floor,
+            self.joint.H, np.eye(2 * n_obj) * self.params.r_floor,
         )
         ii, jj = np.divmod(np.arange(n_order * n_order), n_order)
         self._ii, self._jj = ii, jj
@@ -266,7 +269,7 @@ min_visible, support, blur
         mean = self.order_prob @ kf.x
         meas = self.matcher.measure(frame, self._origin + mean[self._pos], self._rows)
         z = meas.centres - self._origin[None]
-        r = measurement_cov(meas.mse, self.r_gain, self.r_floor)
+        r = measurement_cov(meas.mse, self.params.r_gain, self.params.r_floor)
         ii, jj = self._ii, self._jj
         # Prediction i updated with measurement j, for every pair (i, j).
         pairs = KalmanFilter(kf.x[ii], kf.P[ii], kf.F, kf.Q, kf.H, kf.R[ii])
@@ -282,7 +285,7 @@ min_visible, support, blur
             + np.log(np.maximum(self.order_prob, 1e-300))[ii]
             + loglik
         )
-        if self.use_mse:
+        if self.params.use_mse:
             logw = logw + self._evidence.log_evidence(meas.mse, meas.counts)[jj]
         logw = logw.reshape(n_order, n_order)  # [i, j]
         top = logw.max()
@@ -338,7 +341,7 @@ min_visible, support, blur, p_stay, lam, mse_rate, mse_floor, evidence
         self._init_common(frame, boxes)
         m = self.model
         self.kf = KalmanFilter(
-            np.zeros((boxes.shape[0], m.dim)), m.P0, m.F, m.Q, m.H, np.eye(2) * self.r_floor
+            np.zeros((boxes.shape[0], m.dim)), m.P0, m.F, m.Q, m.H, np.eye(2) * self.params.r_floor
         )
 
     def _step(self, frame: NDArray[np.uint8]) -> Estimate:
@@ -356,7 +359,7 @@ min_visible, support, blur, p_stay, lam, mse_rate, mse_floor, evidence
         seen = mass >= 0.5
         q = q / np.where(mass > 0, mass, 1.0)
         y = np.nan_to_num(meas.centres - self._origin[None])  # (L, M, 2)
-        r = measurement_cov(meas.mse, self.r_gain, self.r_floor)  # (L, M, 2, 2)
+        r = measurement_cov(meas.mse, self.params.r_gain, self.params.r_floor)  # (L, M, 2, 2)
         # Moment-matched mixture of the hypothesized measurements, per object.
         y_hat = np.einsum("lm,lmc->mc", q, y)
         dev = y - y_hat[None]

@@ -93,6 +93,7 @@ FIXTURE_NAMES = (
 _GENERATOR_MODULES = (
     "config.py",
     "io/hdf5.py",
+    "io/schema.py",
     "presets.py",
     "render/compose.py",
     "render/draw.py",

@@ -41,7 +41,7 @@ Colour-histogram models (``ColourModel``)
 A ``ColourModel`` turns a frame into a bin-index image once (``ColourModel.observe``),
 then scores any number of candidate boxes of any of the tracked objects in one compiled
 call (``FrameObservation.distances`` / ``log_likelihoods``; the likelihood is exp(−λ d²),
-ALGORITHMS.md §2)::
+docs/algorithms.md §2.2)::
 
     model = ColourModel("hsv", lam=20.0)
     model.set_references(frame0, boxes0)            # (K, 4): one template per object
@@ -70,8 +70,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from trackers.kernels.histogram import (
+    DEFAULT_BOX_LEVELS,
     KERNELS,
     PreparedReferences,
+    box_kernel_levels,
     hsv_n_bins,
     prepare_references,
     prepared_distances,
@@ -132,11 +134,15 @@ class ColourModel:
     n_parts : int or None, optional
         Horizontal bands per region (spatial components); None takes the model's default
         (2 for "hsv", 1 for "rgb").
-    kernel : {"uniform", "epanechnikov", "cone"} or None, optional
+    kernel : {"uniform", "epanechnikov", "cone", "box"} or None, optional
         Kernel profile weighting the pixels of a region; None takes the model's default
-        ("epanechnikov" for "hsv", "cone" for "rgb").
+        ("epanechnikov" for "hsv", "cone" for "rgb"). "box" is the nested-rectangle step
+        approximation of the Epanechnikov profile, which an integral histogram computes
+        exactly in O(levels × bins) per box (``trackers.kernels.histogram``).
+    box_levels : int, optional
+        Levels L of the "box" kernel, in [1, 16] (ignored by the other kernels).
     lam : float, optional
-        λ of the likelihood p(Z | X) ∝ exp(−λ d²) (ALGORITHMS.md §2.1), > 0.
+        λ of the likelihood p(Z | X) ∝ exp(−λ d²) (docs/algorithms.md §2.2), > 0.
     s_min, v_min : float, optional
         Saturation and value thresholds of the "hsv" model (fractions of the range).
 
@@ -169,6 +175,7 @@ class ColourModel:
         lam: float = 20.0,
         s_min: float = 0.1,
         v_min: float = 0.2,
+        box_levels: int = DEFAULT_BOX_LEVELS,
     ) -> None:
         if kind not in MODELS:
             raise ValueError(f"unknown observation model {kind!r}; valid: {', '.join(MODELS)}")
@@ -189,7 +196,9 @@ class ColourModel:
         self.kind = kind
         self.bins = int(bins)
         self.n_parts = int(n_parts)
+        box_kernel_levels(box_levels)  # validates
         self.kernel = kernel
+        self.box_levels = int(box_levels)
         self.lam = float(lam)
         self.s_min = float(s_min)
         self.v_min = float(v_min)
@@ -208,7 +217,8 @@ class ColourModel:
                    ) -> NDArray[np.float64]:
         """Histograms (P, dim) of ``boxes`` (P, 4) in ``frame`` (H, W, 3)."""
         return region_histograms(self.quantize(frame), boxes, self.n_bins,
-                                 KERNELS[self.kernel], self.n_parts)
+                                 KERNELS[self.kernel], self.n_parts,
+                                 box_levels=self.box_levels)
 
     @property
     def references(self) -> NDArray[np.float64] | None:
@@ -273,7 +283,7 @@ class FrameObservation:
         m = self.model
         # The bin image is the model's own quantisation of the frame: in range.
         return prepared_distances(self.bin_img, boxes, m._prepared, objects,
-                                  KERNELS[m.kernel])
+                                  KERNELS[m.kernel], box_levels=m.box_levels)
 
     def log_likelihoods(self, boxes: NDArray[np.floating], objects: NDArray[np.integer]
                         ) -> NDArray[np.float64]:
