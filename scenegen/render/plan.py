@@ -251,7 +251,7 @@ class Scenario:
         safe = np.maximum(tidx, 0)
         x0 = np.floor(self.cx[start:stop] - tw[safe] / 2 + 0.5).astype(np.int64)
         y0 = np.floor(self.cy[start:stop] - th[safe] / 2 + 0.5).astype(np.int64)
-        moving = self.moving_camera
+        moving = self.config.camera is not None
         if moving:
             x0 -= self.cam_x[start:stop, None]
             y0 -= self.cam_y[start:stop, None]
