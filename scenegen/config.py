@@ -384,7 +384,8 @@ class Background:
     size ``scale`` pixels in ``[low, high]``, tinted by ``color``) or ``image`` (the image
     ``source`` -- :data:`SKIMAGE_NAMES` or a file path -- brought to the background's size
     by ``fit``: ``stretch`` resizes, ``tile`` repeats, ``crop`` scales to cover and takes
-    the centre). With a :class:`Camera` the background is larger than the frame by the
+    the centre; multiplied per channel by ``color`` / 255, so the default white leaves it
+    unchanged). With a :class:`Camera` the background is larger than the frame by the
     camera's ``extent`` on every side."""
 
     kind: Literal["uniform", "noise", "texture", "perlin", "image"] = "uniform"

@@ -8,6 +8,8 @@ same bytes as rendering at once.
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import cv2
 import numpy as np
 from numpy.typing import NDArray
@@ -48,9 +50,10 @@ def illuminate(rgb: NDArray[np.uint8], gain: float, offset: float) -> NDArray[np
     return lut[rgb]
 
 
+@lru_cache(maxsize=4096)
 def line_kernel(dx: float, dy: float) -> NDArray[np.float32]:
     """Normalised box kernel along the segment from -(dx, dy)/2 to (dx, dy)/2, shape
-    (2r+1, 2r+1) with r = ceil(max(|dx|, |dy|) / 2)."""
+    (2r+1, 2r+1) with r = ceil(max(|dx|, |dy|) / 2) (cached: read-only)."""
     r = int(np.ceil(max(abs(dx), abs(dy)) / 2))
     k = np.zeros((2 * r + 1, 2 * r + 1), dtype=np.float32)
     n = max(2, int(np.ceil(np.hypot(dx, dy))) * 2 + 1)
@@ -58,7 +61,9 @@ def line_kernel(dx: float, dy: float) -> NDArray[np.float32]:
     xs = np.clip(np.rint(r + s * dx).astype(np.intp), 0, 2 * r)
     ys = np.clip(np.rint(r + s * dy).astype(np.intp), 0, 2 * r)
     np.add.at(k, (ys, xs), 1.0)
-    return k / k.sum()
+    k /= k.sum()
+    k.setflags(write=False)
+    return k
 
 
 def motion_blur(
@@ -84,8 +89,10 @@ def motion_blur(
     velocity : (vx, vy)
         Image velocity, pixels per frame.
     exposure : float
+        The smear is ``exposure * velocity``, rounded to a quarter pixel.
     """
-    dx, dy = velocity[0] * exposure, velocity[1] * exposure
+    dx = round(velocity[0] * exposure * 4) / 4
+    dy = round(velocity[1] * exposure * 4) / 4
     if max(abs(dx), abs(dy)) < 1.0:
         return
     kern = line_kernel(dx, dy)
@@ -104,7 +111,8 @@ def motion_blur(
 
 def jpeg(rgb: NDArray[np.uint8], quality: int) -> NDArray[np.uint8]:
     """One frame (H, W, 3) through JPEG encoding and decoding at ``quality`` (1..100)."""
-    ok, buf = cv2.imencode(".jpg", rgb[..., ::-1], [cv2.IMWRITE_JPEG_QUALITY, int(quality)])
+    bgr = cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR)
+    ok, buf = cv2.imencode(".jpg", bgr, [cv2.IMWRITE_JPEG_QUALITY, int(quality)])
     if not ok:  # pragma: no cover - OpenCV encodes any uint8 image
         raise RuntimeError("JPEG encoding failed")
-    return cv2.imdecode(buf, cv2.IMREAD_COLOR)[..., ::-1]
+    return cv2.cvtColor(cv2.imdecode(buf, cv2.IMREAD_COLOR), cv2.COLOR_BGR2RGB)

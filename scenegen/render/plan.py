@@ -67,7 +67,8 @@ def _background(bg: Background, h: int, w: int, rng: np.random.Generator) -> NDA
     if bg.kind == "image":
         assert bg.source is not None  # validated by Background
         img = textures.load_source(bg.source, "background.source")
-        return textures.fit_image(img, w, h, bg.fit)
+        tint = None if bg.color == (255, 255, 255) else bg.color
+        return textures.tinted(textures.fit_image(img, w, h, bg.fit), tint)
     if bg.kind == "perlin":
         v = textures.value_noise(w, h, bg.scale, rng)
         tint = np.asarray(bg.color, dtype=np.float32) / 255.0
