@@ -56,7 +56,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def cmd_presets(args: argparse.Namespace) -> int:
     rows = []
-    for name in presets.names():
+    for name in presets.all_names():
         cfg = presets.get(name)
         rows.append(
             {

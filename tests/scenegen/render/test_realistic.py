@@ -186,3 +186,27 @@ def test_user_image_file_is_read(tmp_path):
     seq = scenegen.generate(cfg, seed=0)
     np.testing.assert_array_equal(seq.frames[0, 0, 0], [255, 0, 0])
     np.testing.assert_array_equal(seq.frames[0, 0, 11], [0, 0, 0])
+
+
+@pytest.mark.parametrize("name", scenegen.presets.realistic_names())
+def test_realistic_presets_ground_truth_and_round_trip(name):
+    cfg = scenegen.presets.get(name)
+    assert from_dict(to_dict(cfg)) == cfg
+    assert "Differs from the paper" in scenegen.presets._REALISTIC[name].__doc__
+    short = replace(cfg, n_frames=4)
+    check_sequence(scenegen.generate(short, seed=1), plan(short, 1))
+    assert name not in scenegen.presets.names() and name in scenegen.presets.all_names()
+
+
+def test_readme_realistic_example_generates():
+    import re
+    from pathlib import Path
+
+    import yaml
+
+    text = (Path(__file__).parents[3] / "README.md").read_text(encoding="utf-8")
+    block = text[text.index("## Realistic scenes") :]
+    example = re.search(r"```yaml\n(.*?)```", block, re.S)
+    assert example is not None
+    seq = scenegen.generate(yaml.safe_load(example.group(1)), seed=0, frames=3)
+    assert seq.frames.shape == (3, 240, 320, 3)
