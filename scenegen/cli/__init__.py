@@ -30,6 +30,10 @@ def _parser() -> argparse.ArgumentParser:
     sub.required = True
     for module in (data, track, evaluate, experiment, bench, demo, fixtures):
         module.register(sub)
+    for action in sub._choices_actions:  # each verb's --help opens with its one-line summary
+        verb = sub.choices[action.dest]
+        if verb.description is None and action.help:
+            verb.description = action.help[0].upper() + action.help[1:] + "."
     return parser
 
 
