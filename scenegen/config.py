@@ -433,6 +433,13 @@ class Camera:
     initial ``velocity``; their boundary applies at the extent; ``margin`` is ignored) or
     the scripted ``keyframes`` ((frame, dx, dy), linear in between and held after the
     last). Every ground-truth field is in the coordinates of the rendered frame.
+
+    ``zoom`` (AR2 of the log zoom from 0; ``margin`` bounds ``|log zoom|``, 0 means the
+    limits 1/2 and 2) magnifies the view about the frame centre: a scene point p appears
+    at ``c + zoom * (p - d - c)`` with c the frame centre and d the offset. The background
+    is then resampled per frame (bilinear, mirrored beyond its edge) and every entity,
+    static ones included, is drawn per frame at ``scale * zoom`` (nearest neighbour, as
+    for any scale change), so labels stay exact.
     """
 
     extent: tuple[int, int] = (32, 32)
@@ -440,6 +447,7 @@ class Camera:
     y: AR2 | None = None
     velocity: tuple[float, float] = (0.0, 0.0)
     keyframes: tuple[tuple[int, float, float], ...] = ()
+    zoom: AR2 | None = _new(None)
 
     def __post_init__(self) -> None:
         if not (0 <= self.extent[0] <= MAX_SIDE and 0 <= self.extent[1] <= MAX_SIDE):

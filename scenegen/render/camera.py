@@ -14,7 +14,10 @@ from numpy.typing import NDArray
 from scenegen.config import Camera
 from scenegen.render.motion import ar2_path
 
-__all__ = ["camera_offsets", "keyframe_values"]
+__all__ = ["ZOOM_LIMITS", "camera_offsets", "camera_zoom", "keyframe_values"]
+
+ZOOM_LIMITS = (0.5, 2.0)
+"""Smallest and largest zoom factor."""
 
 
 def keyframe_values(
@@ -50,3 +53,16 @@ def camera_offsets(
     ox = np.clip(np.rint(dx), -ex, ex).astype(np.int64)
     oy = np.clip(np.rint(dy), -ey, ey).astype(np.int64)
     return ox, oy
+
+
+def camera_zoom(cam: Camera | None, n: int, rng: np.random.Generator) -> NDArray[np.float64]:
+    """Zoom factor per frame (n,), within :data:`ZOOM_LIMITS` (ones without a zoom).
+
+    ``rng`` is the zoom's own stream.
+    """
+    if cam is None or cam.zoom is None:
+        return np.ones(n)
+    lo, hi = np.log(ZOOM_LIMITS[0]), np.log(ZOOM_LIMITS[1])
+    if cam.zoom.margin > 0:
+        lo, hi = max(lo, -cam.zoom.margin), min(hi, cam.zoom.margin)
+    return np.exp(np.clip(ar2_path(cam.zoom, 0.0, 0.0, n, rng=rng, lo=lo, hi=hi), lo, hi))

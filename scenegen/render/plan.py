@@ -31,7 +31,7 @@ from scenegen.config import Background, EntitySpec, SceneConfig
 from scenegen.errors import ConfigError
 from scenegen.render import compose as kernels
 from scenegen.render import photometric, textures
-from scenegen.render.camera import camera_offsets
+from scenegen.render.camera import camera_offsets, camera_zoom
 from scenegen.render.draw import draw_template, jitter_colors, paint_template, transform_template
 from scenegen.render.motion import ar2_path
 from scenegen.sequence import Entities, GroundTruth, Sequence
@@ -126,7 +126,13 @@ class Scenario:
     cam_x, cam_y : ndarray of shape (T,), int64
         Camera offset per frame: scene point (x, y) is drawn at (x - cam_x, y - cam_y).
         ``cx``, ``cy``, ``path_x``, ``path_y`` are scene coordinates; every ground-truth
-        field is in frame coordinates.
+        field is in frame coordinates. With a zoom they are already frame coordinates
+        (the zoom is folded into them and into ``scale``) and ``cam_x = cam_y = 0``.
+    view_x, view_y : ndarray of shape (T,), int64
+        The camera offset applied to the background (equal to ``cam_x``, ``cam_y``
+        without a zoom).
+    zoom : ndarray of shape (T,)
+        Camera zoom per frame (ones without a zoom).
     gain, offset : ndarray of shape (T,)
         Global illumination per frame (``gain * pixel + offset``).
     """
@@ -151,6 +157,9 @@ class Scenario:
     background: NDArray[np.uint8]
     cam_x: NDArray[np.int64]
     cam_y: NDArray[np.int64]
+    view_x: NDArray[np.int64]
+    view_y: NDArray[np.int64]
+    zoom: NDArray[np.float64]
     gain: NDArray[np.float64]
     offset: NDArray[np.float64]
     _static_cache: tuple[NDArray[Any], ...] | None = field(default=None, repr=False)
@@ -188,7 +197,33 @@ class Scenario:
 
     @property
     def moving_camera(self) -> bool:
-        return bool(np.any(self.cam_x != 0) or np.any(self.cam_y != 0))
+        return bool(np.any(self.view_x != 0) or np.any(self.view_y != 0))
+
+    @property
+    def zoomed(self) -> bool:
+        return bool(np.any(self.zoom != 1.0))
+
+    def background_frame(self, t: int) -> NDArray[np.uint8]:
+        """The background as seen in frame ``t`` (H, W, 3): the window at the camera
+        offset, resampled about the frame centre when the camera zooms."""
+        h, w = self.config.height, self.config.width
+        px, py = self.pad
+        xs, ys = px + int(self.view_x[t]), py + int(self.view_y[t])
+        z = float(self.zoom[t])
+        if z == 1.0:
+            return self.background[ys : ys + h, xs : xs + w].copy()
+        # Frame pixel u (centre u + 1/2) shows scene point c + (u + 1/2 - c) / z.
+        cx, cy = w / 2, h / 2
+        m = np.array(
+            [
+                [1 / z, 0.0, (0.5 - cx) / z + cx + xs - 0.5],
+                [0.0, 1 / z, (0.5 - cy) / z + cy + ys - 0.5],
+            ]
+        )
+        flags = cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP
+        return cv2.warpAffine(
+            self.background, m, (w, h), flags=flags, borderMode=cv2.BORDER_REFLECT_101
+        )
 
     def _static_layer(self) -> tuple[NDArray[Any], ...]:
         if self._static_cache is not None:
@@ -275,7 +310,11 @@ class Scenario:
             # static entities' visible statistics in the cropped labels.
             px, py = self.pad
             for f in range(f_n):
-                ys, xs = py + self.cam_y[start + f], px + self.cam_x[start + f]
+                if self.zoomed:  # nothing is static: the background alone, resampled
+                    out_rgb[f] = self.background_frame(start + f)
+                    out_lab[f] = 0
+                    continue
+                ys, xs = py + self.view_y[start + f], px + self.view_x[start + f]
                 out_rgb[f] = s_rgb[ys : ys + h, xs : xs + w]
                 out_lab[f] = s_lab[ys : ys + h, xs : xs + w]
             is_static = np.zeros_like(self.in_static)
@@ -631,6 +670,21 @@ def plan(config: SceneConfig, seed: int | None = None, *, preset: str = "") -> S
     cx, cy, scale, angle, shade, path_x, path_y, alive = _per_frame(cfg, paths, clutter)
     depth_value = _depth_values(cfg, len(clutter))
     cam_x, cam_y = camera_offsets(cfg.camera, cfg.n_frames, entity_rng(seed, "camera"))
+    view_x, view_y = cam_x, cam_y
+    zoom = camera_zoom(cfg.camera, cfg.n_frames, entity_rng(seed, "camera-zoom"))
+    in_static = _static_entities(cfg, depth_value)
+    if np.any(zoom != 1.0):
+        # Fold the view into the entities: frame coordinates, scale times zoom, and
+        # everything drawn per frame.
+        z = zoom[:, None]
+        c_x, c_y = cfg.width / 2, cfg.height / 2
+        cx = c_x + z * (cx - cam_x[:, None] - c_x)
+        cy = c_y + z * (cy - cam_y[:, None] - c_y)
+        path_x = c_x + z * (path_x - cam_x[:, None] - c_x)
+        path_y = c_y + z * (path_y - cam_y[:, None] - c_y)
+        scale = scale * z
+        in_static = np.zeros_like(in_static)
+        cam_x, cam_y = np.zeros_like(cam_x), np.zeros_like(cam_y)
     gain, offset = photometric.illumination(
         cfg.photometric, cfg.n_frames, entity_rng(seed, "illumination")
     )
@@ -652,12 +706,15 @@ def plan(config: SceneConfig, seed: int | None = None, *, preset: str = "") -> S
         alive=alive,
         depth_value=depth_value,
         depth_rank=_ranks(depth_value),
-        in_static=_static_entities(cfg, depth_value),
+        in_static=in_static,
         background=_background(
             cfg.background, cfg.height + 2 * ey, cfg.width + 2 * ex, entity_rng(seed, "background")
         ),
         cam_x=cam_x,
         cam_y=cam_y,
+        view_x=view_x,
+        view_y=view_y,
+        zoom=zoom,
         gain=gain,
         offset=offset,
     )

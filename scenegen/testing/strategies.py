@@ -700,6 +700,11 @@ def _draw_camera(draw: Any, n_frames: int) -> Camera | None:
         x=AR2(boundary=draw(st.sampled_from(BOUNDARIES[:2])), sigma=_hundredths(draw, 0, 3)),
         y=AR2(boundary=draw(st.sampled_from(BOUNDARIES[:2])), sigma=_hundredths(draw, 0, 3)),
         velocity=(_hundredths(draw, -3, 3), _hundredths(draw, -3, 3)),
+        zoom=draw(
+            st.sampled_from(
+                (None, AR2(boundary="reflect", a1=1.0, a2=0.0, sigma=0.05, margin=0.4))
+            )
+        ),
     )
 
 

@@ -38,9 +38,12 @@ def reference_frame(scn: Scenario, t: int) -> tuple[np.ndarray, np.ndarray, dict
     """Labels (H, W), colours (H, W, 3) and amodal pixel counts of frame ``t``."""
     h, w = scn.config.height, scn.config.width
     labels = np.zeros((h, w), dtype=np.uint16)
-    bh, bw = scn.background.shape[:2]
-    ys, xs = (bh - h) // 2 + int(scn.cam_y[t]), (bw - w) // 2 + int(scn.cam_x[t])
-    rgb = scn.background[ys : ys + h, xs : xs + w].copy()
+    if scn.zoomed:
+        rgb = scn.background_frame(t)  # resampled: pixels only, no ground truth
+    else:
+        bh, bw = scn.background.shape[:2]
+        ys, xs = (bh - h) // 2 + int(scn.view_y[t]), (bw - w) // 2 + int(scn.view_x[t])
+        rgb = scn.background[ys : ys + h, xs : xs + w].copy()
     amodal: dict[int, int] = {}
     # Back to front by rank: nearer entities overwrite farther ones.
     for k in np.argsort(-scn.depth_rank[t].astype(np.int64), kind="stable"):

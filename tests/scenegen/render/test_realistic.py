@@ -73,6 +73,20 @@ def test_ground_truth_matches_pixels_with_camera_blur_and_light():
     check_sequence(scenegen.generate(sharp, seed=3), plan(sharp, 3), pixels=True)
 
 
+def test_ground_truth_matches_pixels_with_zoom():
+    cfg = _scene(photometric=None)
+    assert cfg.camera is not None
+    zoom = AR2(boundary="reflect", a1=1.9, a2=-0.9, sigma=0.03, margin=0.4)
+    cfg = replace(cfg, camera=replace(cfg.camera, zoom=zoom))
+    scn = plan(cfg, 2)
+    assert scn.zoomed and len(set(scn.zoom.round(3).tolist())) > 3
+    seq = scenegen.generate(cfg, seed=2)
+    check_sequence(seq, scn)
+    # The amodal size of the static occluder follows the zoom (nearest-neighbour scale).
+    w = seq.gt.box[:, 1, 2]
+    np.testing.assert_array_equal(w, np.round(30 * scn.zoom).astype(np.float32))
+
+
 def test_the_camera_moves_the_static_layer_with_the_scene():
     cfg = _scene(photometric=None)
     seq = scenegen.generate(cfg, seed=3)
@@ -210,3 +224,4 @@ def test_readme_realistic_example_generates():
     assert example is not None
     seq = scenegen.generate(yaml.safe_load(example.group(1)), seed=0, frames=3)
     assert seq.frames.shape == (3, 240, 320, 3)
+
