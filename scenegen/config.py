@@ -572,6 +572,14 @@ class SceneConfig:
                 "(planning would need too much memory)",
             )
         _check_magnitudes(self, "")
+        if self.camera is not None:
+            ex, ey = self.camera.extent
+            if self.width + 2 * ex > MAX_SIDE or self.height + 2 * ey > MAX_SIDE:
+                _fail(
+                    "camera.extent",
+                    f"the background (width + 2 ex, height + 2 ey) = "
+                    f"{self.width + 2 * ex}x{self.height + 2 * ey} exceeds {MAX_SIDE}",
+                )
         self._check_depth_ties()
 
     def _check_depth_ties(self) -> None:

@@ -462,7 +462,7 @@ _FOLIAGE = ((40, 70, 20), (90, 120, 40), (140, 110, 50), (60, 90, 60), (170, 120
 
 @_realistic("tiger-like")
 def tiger_like() -> SceneConfig:
-    """A striped, tiger-coloured target moves through textured foliage while the camera
+    """A mottled, tiger-coloured target moves through textured foliage while the camera
     pans (after the KAMS paper's tiger sequence): for KAMS and mean shift.
 
     320x240, 120 frames. The background is scikit-image's ``grass`` texture tiled and

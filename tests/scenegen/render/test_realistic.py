@@ -176,6 +176,11 @@ def test_bad_image_sources_name_the_field(data, field):
         scenegen.generate({"width": 16, "height": 16, "n_frames": 1, **data}, seed=0)
 
 
+def test_camera_extent_is_bounded():
+    with pytest.raises(ConfigError, match=r"^camera\.extent: the background"):
+        from_dict({"width": 100, "height": 10, "n_frames": 1, "camera": {"extent": [4050, 0]}})
+
+
 def test_cli_exits_2_naming_the_field_and_file(tmp_path, capsys):
     import yaml
 
