@@ -475,8 +475,10 @@ class Photometric:
     keyframes : tuple of (frame, gain, offset)
         Scripted illumination instead (linear in between, held after the last).
     motion_blur : float
-        Exposure as a fraction of the frame interval: each moving entity's visible pixels
-        are smeared along its image velocity over ``motion_blur * |velocity|`` pixels.
+        Exposure as a fraction of the frame interval: the visible pixels of each entity
+        drawn per frame are smeared along its image velocity (camera motion included)
+        over ``motion_blur * |velocity|`` pixels. The static layer (background, clutter,
+        static occluders) is not blurred, unless a zoom makes every entity per-frame.
     jpeg_quality : int or None
         Compress every frame as JPEG at this quality (1..100).
     """
