@@ -230,3 +230,12 @@ def test_readme_realistic_example_generates():
     seq = scenegen.generate(yaml.safe_load(example.group(1)), seed=0, frames=3)
     assert seq.frames.shape == (3, 240, 320, 3)
 
+
+
+@pytest.mark.slow
+@settings(max_examples=150, deadline=None)
+@given(cfg=scene_configs(realistic=True, occlusion=True, clutter=True, distractors=True,
+                         exits=True, noise=True, max_frames=10, max_entities=5),
+       seed=st.integers(0, 2**32 - 1))  # fmt: skip
+def test_drawn_realistic_scenes_ground_truth_many(cfg, seed):
+    check_sequence(scenegen.generate(cfg, seed=seed), plan(cfg, seed))
