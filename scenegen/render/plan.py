@@ -331,8 +331,13 @@ class Scenario:
         if self.config.sensor_noise > 0:
             for f in range(f_n):
                 rng = entity_rng(self.seed, "sensor", start + f)
-                noisy = out_rgb[f] + rng.standard_normal((h, w, 3)) * self.config.sensor_noise
-                out_rgb[f] = np.clip(np.rint(noisy), 0, 255).astype(np.uint8)
+                # frame + N(0, 1) * sigma, rounded and clipped (in place: same bytes).
+                noisy = rng.standard_normal((h, w, 3))
+                noisy *= self.config.sensor_noise
+                noisy += out_rgb[f]
+                np.rint(noisy, out=noisy)
+                np.clip(noisy, 0, 255, out=noisy)
+                out_rgb[f] = noisy
         p = self.config.photometric
         if p is not None and p.jpeg_quality is not None:
             for f in range(f_n):
