@@ -239,3 +239,18 @@ def test_readme_realistic_example_generates():
        seed=st.integers(0, 2**32 - 1))  # fmt: skip
 def test_drawn_realistic_scenes_ground_truth_many(cfg, seed):
     check_sequence(scenegen.generate(cfg, seed=seed), plan(cfg, seed))
+
+
+def test_textures_are_keyed_by_the_entity_name():
+    cfg = _scene(photometric=None)
+    extra = EntitySpec(name="extra", role="distractor", position=(10, 10), depth=((0, 5),),
+                       appearance=Appearance(pattern="perlin", colors=((0, 0, 255),)))  # fmt: skip
+    more = replace(cfg, entities=(extra, *cfg.entities))
+    a, b = plan(cfg, 9), plan(more, 9)
+    for k in range(len(cfg.entities)):
+        np.testing.assert_array_equal(a.templates[k], b.templates[k + 1])
+    np.testing.assert_array_equal(a.cam_x, b.cam_x)
+    # Another seed draws another texture (Perlin noise, tile offset).
+    c = plan(cfg, 10)
+    assert not np.array_equal(a.templates[2], c.templates[2])
+    assert not np.array_equal(a.templates[1], c.templates[1])
