@@ -40,9 +40,12 @@ __all__ = [
     "MAX_SIDE",
     "Appearance",
     "Background",
+    "Camera",
     "ClutterSpec",
     "EntitySpec",
     "Motion",
+    "Photometric",
+    "SKIMAGE_NAMES",
     "SceneConfig",
     "Variation",
     "from_dict",
@@ -52,7 +55,10 @@ __all__ = [
 
 Color = tuple[int, int, int]
 Shape = Literal["rect", "ellipse", "triangle", "diamond"]
-Pattern = Literal["solid", "rings", "sectors", "stripes", "bands", "checker", "texture"]
+Pattern = Literal[
+    "solid", "rings", "sectors", "stripes", "bands", "checker", "texture", "image", "perlin"
+]
+Fit = Literal["stretch", "tile", "crop"]
 Boundary = Literal["reflect", "clamp", "free"]
 Role = Literal["target", "distractor", "occluder", "clutter"]
 
@@ -77,6 +83,8 @@ MAX_COLORS = 256
 MAX_BLUR = 256.0
 """Largest background texture ``scale`` (Gaussian std, pixels): the blur costs time in
 proportion to it."""
+MAX_MOTION_BLUR = 4.0
+"""Largest ``Photometric.motion_blur`` (exposure in frame intervals)."""
 
 
 def _fail(path: str, msg: str) -> typing.NoReturn:
@@ -86,6 +94,46 @@ def _fail(path: str, msg: str) -> typing.NoReturn:
 def _check_color(path: str, c: Color) -> None:
     if len(c) != 3 or any(not 0 <= v <= 255 for v in c):
         _fail(path, f"colour must be three integers in 0..255, got {list(c)}")
+
+
+SKIMAGE_NAMES = (
+    "astronaut", "brick", "camera", "cell", "chelsea", "clock", "coffee", "coins",
+    "colorwheel", "grass", "gravel", "hubble_deep_field", "immunohistochemistry",
+    "microaneurysms", "moon", "page", "retina", "rocket", "text",
+)  # fmt: skip
+"""Images of ``skimage.data`` an image ``source`` may name (``skimage:coffee``); all ship
+with scikit-image (no download). ``skimage:lfw_subset[i]`` (``0 <= i < 200``) names one of
+the 200 faces of ``skimage.data.lfw_subset``."""
+N_FACES = 200
+
+
+def check_source(source: str) -> None:
+    """Validate the syntax of an image source (a file is read only when planning).
+
+    Raises
+    ------
+    ConfigError
+        Unknown ``skimage:`` name, face index out of range, or an empty source.
+    """
+    if not source:
+        raise ConfigError("must be 'skimage:NAME' or a path to an image file, got ''")
+    if not source.startswith("skimage:"):
+        return
+    name = source[len("skimage:") :]
+    if name.startswith("lfw_subset[") and name.endswith("]") and name[11:-1].isdigit():
+        if int(name[11:-1]) >= N_FACES:
+            raise ConfigError(f"lfw_subset has faces 0..{N_FACES - 1}, got {source!r}")
+        return
+    if name not in SKIMAGE_NAMES:
+        raise ConfigError(
+            f"unknown image {source!r}; known: {', '.join(SKIMAGE_NAMES)}, lfw_subset[0..199]"
+        )
+
+
+def _new(default: Any) -> Any:
+    """A field added after the first release: left out of :func:`to_dict` while it holds
+    its default, so configs written before it existed still compare equal."""
+    return field(default=default, metadata={"omit_default": True})
 
 
 @dataclass(frozen=True)
@@ -140,7 +188,14 @@ class Appearance:
     wedges: a multicoloured disc), ``stripes`` (diagonal stripes of ``stripe_width``),
     ``bands`` (horizontal parts, top to bottom: per-part colours such as head/torso/legs),
     ``checker`` (squares of ``stripe_width``), ``texture`` (the colours plus Gaussian
-    texture of std ``texture_sigma``, drawn from the entity's random stream).
+    texture of std ``texture_sigma``, drawn from the entity's random stream), ``perlin``
+    (Perlin-like value noise of feature size ``noise_scale`` pixels mapped along the
+    colours, from the entity's stream), ``image`` (the image ``source`` -- see
+    :data:`SKIMAGE_NAMES` or a file path -- cut to ``crop`` = [x, y, w, h] if given and
+    brought to ``size`` by ``fit``: ``stretch`` resizes, ``tile`` repeats from a window
+    offset drawn from the entity's stream, ``crop`` covers and centres). The silhouette
+    ``shape`` masks every pattern. ``tint`` multiplies ``image`` pixels per channel
+    (``[255, 140, 0]`` turns a grey texture orange).
     """
 
     shape: Shape = "rect"
@@ -149,8 +204,14 @@ class Appearance:
     colors: tuple[Color, ...] = ((255, 0, 0),)
     stripe_width: int = 4
     texture_sigma: float = 20.0
+    source: str | None = _new(None)
+    crop: tuple[int, int, int, int] | None = _new(None)
+    fit: Fit = _new("stretch")
+    tint: Color | None = _new(None)
+    noise_scale: float = _new(8.0)
 
     def __post_init__(self) -> None:
+        self._check_image()
         if self.size[0] < 1 or self.size[1] < 1:
             _fail("size", f"width and height must be >= 1, got {list(self.size)}")
         if max(self.size) > MAX_SIDE:
@@ -163,6 +224,24 @@ class Appearance:
             _fail("stripe_width", f"must be >= 1, got {self.stripe_width}")
         if self.texture_sigma < 0:
             _fail("texture_sigma", f"must be >= 0, got {self.texture_sigma}")
+        if not 1 <= self.noise_scale <= MAX_SIDE:
+            _fail("noise_scale", f"must be in 1..{MAX_SIDE}, got {self.noise_scale}")
+
+    def _check_image(self) -> None:
+        if self.pattern == "image" and self.source is None:
+            _fail("source", "is required by the image pattern")
+        if self.source is not None:
+            if self.pattern != "image":
+                _fail("source", f"needs pattern: image (the pattern is {self.pattern!r})")
+            try:
+                check_source(self.source)
+            except ConfigError as err:
+                _fail("source", str(err))
+        if self.crop is not None:
+            if self.crop[0] < 0 or self.crop[1] < 0 or self.crop[2] < 1 or self.crop[3] < 1:
+                _fail("crop", f"needs x, y >= 0 and w, h >= 1, got {list(self.crop)}")
+        if self.tint is not None:
+            _check_color("tint", self.tint)
 
 
 @dataclass(frozen=True)
@@ -300,21 +379,126 @@ class ClutterSpec:
 @dataclass(frozen=True)
 class Background:
     """The static background: ``uniform`` (``color``), ``noise`` (i.i.d. uniform pixels in
-    ``[low, high]`` per channel) or ``texture`` (noise smoothed by a Gaussian of std
-    ``scale`` pixels, tinted by ``color``)."""
+    ``[low, high]`` per channel), ``texture`` (noise smoothed by a Gaussian of std
+    ``scale`` pixels, tinted by ``color``), ``perlin`` (Perlin-like value noise of feature
+    size ``scale`` pixels in ``[low, high]``, tinted by ``color``) or ``image`` (the image
+    ``source`` -- :data:`SKIMAGE_NAMES` or a file path -- brought to the background's size
+    by ``fit``: ``stretch`` resizes, ``tile`` repeats, ``crop`` scales to cover and takes
+    the centre; multiplied per channel by ``color`` / 255, so the default white leaves it
+    unchanged). With a :class:`Camera` the background is larger than the frame by the
+    camera's ``extent`` on every side."""
 
-    kind: Literal["uniform", "noise", "texture"] = "uniform"
+    kind: Literal["uniform", "noise", "texture", "perlin", "image"] = "uniform"
     color: Color = (255, 255, 255)
     low: int = 0
     high: int = 255
     scale: float = 4.0
+    source: str | None = _new(None)
+    fit: Fit = _new("crop")
 
     def __post_init__(self) -> None:
+        if self.kind == "image" and self.source is None:
+            _fail("source", "is required by kind: image")
+        if self.source is not None:
+            if self.kind != "image":
+                _fail("source", f"needs kind: image (the kind is {self.kind!r})")
+            try:
+                check_source(self.source)
+            except ConfigError as err:
+                _fail("source", str(err))
         _check_color("color", self.color)
         if not 0 <= self.low <= self.high <= 255:
             _fail("low", f"need 0 <= low <= high <= 255, got low={self.low} high={self.high}")
         if not 0 < self.scale <= MAX_BLUR:
             _fail("scale", f"must be in (0, {MAX_BLUR:g}], got {self.scale}")
+
+
+def _check_keyframes(name: str, keys: tuple[tuple[int, float, float], ...]) -> None:
+    frames = [k[0] for k in keys]
+    if frames and frames[0] < 0:
+        _fail(name, f"frames must be >= 0, got {frames}")
+    if any(b <= a for a, b in zip(frames, frames[1:], strict=False)):
+        _fail(name, f"keyframe frames must increase, got {frames}")
+
+
+@dataclass(frozen=True)
+class Camera:
+    """A camera panning over a background larger than the frame.
+
+    The background (and everything static: clutter, static occluders) extends ``extent``
+    = (ex, ey) pixels beyond the frame on every side. Entity positions and motion are in
+    *scene* coordinates, which equal frame coordinates when the camera is at rest; the
+    frame shows the scene shifted by the camera offset (dx, dy), a whole number of pixels
+    with ``|dx| <= ex``, ``|dy| <= ey``. The offset follows ``x`` and ``y`` (AR2 from 0 with
+    initial ``velocity``; their boundary applies at the extent; ``margin`` is ignored) or
+    the scripted ``keyframes`` ((frame, dx, dy), linear in between and held after the
+    last). Every ground-truth field is in the coordinates of the rendered frame.
+
+    ``zoom`` (AR2 of the log zoom from 0; ``margin`` bounds ``|log zoom|``, 0 means the
+    limits 1/2 and 2) magnifies the view about the frame centre: a scene point p appears
+    at ``c + zoom * (p - d - c)`` with c the frame centre and d the offset. The background
+    is then resampled per frame (bilinear, mirrored beyond its edge) and every entity,
+    static ones included, is drawn per frame at ``scale * zoom`` (nearest neighbour, as
+    for any scale change), so labels stay exact.
+    """
+
+    extent: tuple[int, int] = (32, 32)
+    x: AR2 | None = None
+    y: AR2 | None = None
+    velocity: tuple[float, float] = (0.0, 0.0)
+    keyframes: tuple[tuple[int, float, float], ...] = ()
+    zoom: AR2 | None = _new(None)
+
+    def __post_init__(self) -> None:
+        if not (0 <= self.extent[0] <= MAX_SIDE and 0 <= self.extent[1] <= MAX_SIDE):
+            _fail("extent", f"must be in 0..{MAX_SIDE}, got {list(self.extent)}")
+        if self.keyframes and (self.x is not None or self.y is not None):
+            _fail("keyframes", "cannot be combined with x or y motion")
+        _check_keyframes("keyframes", self.keyframes)
+
+
+@dataclass(frozen=True)
+class Photometric:
+    """Photometric effects applied to the frames after compositing, in this order:
+    motion blur, illumination, then (``SceneConfig.sensor_noise``) noise, then JPEG.
+
+    They change pixels only: labels, boxes, visibility and depth are those of the sharp
+    silhouettes (computed before any effect), so ground truth stays exact.
+
+    Attributes
+    ----------
+    gain, offset : AR2 or None
+        Global illumination over time: every pixel becomes ``gain_t * p + offset_t``.
+        ``gain`` is an AR2 of the *log* gain starting at 0 (its ``margin`` bounds
+        ``|log gain|``; 0 means unbounded), ``offset`` an AR2 in grey levels starting at 0
+        (``margin`` bounds ``|offset|``).
+    keyframes : tuple of (frame, gain, offset)
+        Scripted illumination instead (linear in between, held after the last).
+    motion_blur : float
+        Exposure as a fraction of the frame interval: the visible pixels of each entity
+        drawn per frame are smeared along its image velocity (camera motion included)
+        over ``motion_blur * |velocity|`` pixels. The static layer (background, clutter,
+        static occluders) is not blurred, unless a zoom makes every entity per-frame.
+    jpeg_quality : int or None
+        Compress every frame as JPEG at this quality (1..100).
+    """
+
+    gain: AR2 | None = None
+    offset: AR2 | None = None
+    keyframes: tuple[tuple[int, float, float], ...] = ()
+    motion_blur: float = 0.0
+    jpeg_quality: int | None = None
+
+    def __post_init__(self) -> None:
+        if self.keyframes and (self.gain is not None or self.offset is not None):
+            _fail("keyframes", "cannot be combined with gain or offset motion")
+        _check_keyframes("keyframes", self.keyframes)
+        if any(k[1] < 0 for k in self.keyframes):
+            _fail("keyframes", "gains must be >= 0")
+        if not 0 <= self.motion_blur <= MAX_MOTION_BLUR:
+            _fail("motion_blur", f"must be in [0, {MAX_MOTION_BLUR:g}], got {self.motion_blur}")
+        if self.jpeg_quality is not None and not 1 <= self.jpeg_quality <= 100:
+            _fail("jpeg_quality", f"must be in 1..100, got {self.jpeg_quality}")
 
 
 @dataclass(frozen=True)
@@ -336,6 +520,10 @@ class SceneConfig:
         Std of i.i.d. Gaussian pixel noise added to every frame (frames only, not labels).
     name : str
         The sequence name used in HDF5 files.
+    camera : Camera or None
+        A panning camera (``None``: fixed).
+    photometric : Photometric or None
+        Illumination change, motion blur and JPEG compression (``None``: none).
     """
 
     width: int
@@ -346,6 +534,8 @@ class SceneConfig:
     clutter: tuple[ClutterSpec, ...] = ()
     sensor_noise: float = 0.0
     name: str = "scene"
+    camera: Camera | None = _new(None)
+    photometric: Photometric | None = _new(None)
 
     def __post_init__(self) -> None:
         for f in ("width", "height", "n_frames"):
@@ -384,6 +574,14 @@ class SceneConfig:
                 "(planning would need too much memory)",
             )
         _check_magnitudes(self, "")
+        if self.camera is not None:
+            ex, ey = self.camera.extent
+            if self.width + 2 * ex > MAX_SIDE or self.height + 2 * ey > MAX_SIDE:
+                _fail(
+                    "camera.extent",
+                    f"the background (width + 2 ex, height + 2 ey) = "
+                    f"{self.width + 2 * ex}x{self.height + 2 * ey} exceeds {MAX_SIDE}",
+                )
         self._check_depth_ties()
 
     def __repr__(self) -> str:
@@ -549,7 +747,11 @@ def from_dict(data: Any) -> SceneConfig:
 
 def _plain(value: Any) -> Any:
     if dataclasses.is_dataclass(value):
-        return {f.name: _plain(getattr(value, f.name)) for f in dataclasses.fields(value)}
+        return {
+            f.name: _plain(getattr(value, f.name))
+            for f in dataclasses.fields(value)
+            if not (f.metadata.get("omit_default") and getattr(value, f.name) == f.default)
+        }
     if isinstance(value, tuple):
         return [_plain(v) for v in value]
     return value

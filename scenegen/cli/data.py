@@ -77,7 +77,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def cmd_presets(args: argparse.Namespace) -> int:
     rows = []
-    for name in presets.names():
+    for name in presets.all_names():
         cfg = presets.get(name)
         rows.append(
             {
@@ -92,9 +92,10 @@ def cmd_presets(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(rows, indent=2))
         return 0
+    wide = max((len(r["name"]) for r in rows), default=14)
     for r in rows:
         size = f"{r['width']}x{r['height']}x{r['n_frames']}"
-        print(f"{r['name']:<14} {size:<12} {r['entities']:>4} entities  {r['description']}")
+        print(f"{r['name']:<{wide}} {size:<12} {r['entities']:>4} entities  {r['description']}")
     return 0
 
 

@@ -14,6 +14,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from scenegen.config import Appearance
+from scenegen.errors import ConfigError
+from scenegen.render import textures
 
 __all__ = ["draw_template", "jitter_colors", "shape_mask", "transform_template"]
 
@@ -68,7 +70,11 @@ def _pattern_index(pattern: str, w: int, h: int, n: int, stripe: int) -> NDArray
 
 
 def draw_template(
-    app: Appearance, *, rng: np.random.Generator | None = None, size: tuple[int, int] | None = None
+    app: Appearance,
+    *,
+    rng: np.random.Generator | None = None,
+    size: tuple[int, int] | None = None,
+    field: str = "appearance",
 ) -> NDArray[np.uint8]:
     """Draw the entity alone as an RGBA template.
 
@@ -79,6 +85,8 @@ def draw_template(
         Needed only by the ``texture`` pattern.
     size : (w, h), optional
         Overrides ``app.size`` (clutter items of varying size).
+    field : str
+        Config path of ``app``, named by errors about its image source.
 
     Returns
     -------
@@ -88,6 +96,10 @@ def draw_template(
     """
     w, h = size if size is not None else app.size
     colors = np.asarray(app.colors, dtype=np.uint8)
+    if app.pattern in ("image", "perlin"):
+        if rng is None:
+            raise ValueError(f"the {app.pattern} pattern needs an rng")
+        return _masked(app.shape, w, h, _textured_rgb(app, w, h, rng, field))
     return paint_template(
         app.shape, app.pattern, w, h, colors,
         stripe_width=app.stripe_width, texture_sigma=app.texture_sigma, rng=rng,
@@ -124,6 +136,39 @@ def paint_template(
         tint = cv2.resize(tint.astype(np.float32), (w, h), interpolation=cv2.INTER_NEAREST)
         idx = tint.astype(np.intp)
     rgb = np.clip(np.rint(colors[idx] + noise), 0, 255).astype(np.uint8)
+    out = np.zeros((h, w, 4), dtype=np.uint8)
+    out[mask, :3] = rgb[mask]
+    out[mask, 3] = 255
+    return out if crop is None else np.ascontiguousarray(out[crop])
+
+
+def _textured_rgb(
+    app: Appearance, w: int, h: int, rng: np.random.Generator, field: str
+) -> NDArray[np.uint8]:
+    """The (h, w, 3) pixels of an ``image`` or ``perlin`` appearance before masking."""
+    if app.pattern == "perlin":
+        v = textures.value_noise(w, h, app.noise_scale, rng)
+        return textures.palette_map(v, np.asarray(app.colors, dtype=np.uint8))
+    assert app.source is not None  # validated by Appearance
+    img = textures.load_source(app.source, f"{field}.source")
+    if app.crop is not None:
+        x, y, cw, ch = app.crop
+        ih, iw = img.shape[:2]
+        if x + cw > iw or y + ch > ih:
+            raise ConfigError(
+                f"{field}.crop: {list(app.crop)} exceeds the {iw}x{ih} image {app.source!r}"
+            )
+        img = img[y : y + ch, x : x + cw]
+    if app.fit == "tile":
+        rgb = textures.random_window(img, w, h, rng)
+    else:
+        rgb = textures.fit_image(img, w, h, app.fit)
+    return textures.tinted(rgb, app.tint)
+
+
+def _masked(shape: str, w: int, h: int, rgb: NDArray[np.uint8]) -> NDArray[np.uint8]:
+    """RGBA template of ``rgb`` (h, w, 3) inside the silhouette, cropped to its box."""
+    mask, crop = _mask_and_crop(shape, w, h)
     out = np.zeros((h, w, 4), dtype=np.uint8)
     out[mask, :3] = rgb[mask]
     out[mask, 3] = 255

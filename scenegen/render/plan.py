@@ -30,6 +30,8 @@ from numpy.typing import NDArray
 from scenegen.config import Background, EntitySpec, SceneConfig
 from scenegen.errors import ConfigError
 from scenegen.render import compose as kernels
+from scenegen.render import photometric, textures
+from scenegen.render.camera import camera_offsets, camera_zoom
 from scenegen.render.draw import draw_template, jitter_colors, paint_template, transform_template
 from scenegen.render.motion import ar2_path
 from scenegen.sequence import Entities, GroundTruth, Sequence
@@ -62,6 +64,16 @@ def _background(bg: Background, h: int, w: int, rng: np.random.Generator) -> NDA
         out = np.empty((h, w, 3), dtype=np.uint8)
         out[:] = bg.color
         return out
+    if bg.kind == "image":
+        assert bg.source is not None  # validated by Background
+        img = textures.load_source(bg.source, "background.source")
+        tint = None if bg.color == (255, 255, 255) else bg.color
+        return textures.tinted(textures.fit_image(img, w, h, bg.fit), tint)
+    if bg.kind == "perlin":
+        v = textures.value_noise(w, h, bg.scale, rng)
+        tint = np.asarray(bg.color, dtype=np.float32) / 255.0
+        out = bg.low + v[..., None] * (bg.high - bg.low) * tint
+        return np.clip(np.rint(out), 0, 255).astype(np.uint8)
     noise = rng.integers(bg.low, bg.high + 1, size=(h, w, 3), dtype=np.uint8)
     if bg.kind == "noise":
         return noise
@@ -109,7 +121,20 @@ class Scenario:
     depth_rank : ndarray of shape (T, K), int16
     in_static : ndarray of shape (K,), bool
         Entities drawn once into the static layer.
-    background : ndarray of shape (H, W, 3), uint8
+    background : ndarray of shape (H + 2 ey, W + 2 ex, 3), uint8
+        The static background; (ex, ey) is the camera's extent, (0, 0) without a camera.
+    cam_x, cam_y : ndarray of shape (T,), int64
+        Camera offset per frame: scene point (x, y) is drawn at (x - cam_x, y - cam_y).
+        ``cx``, ``cy``, ``path_x``, ``path_y`` are scene coordinates; every ground-truth
+        field is in frame coordinates. With a zoom they are already frame coordinates
+        (the zoom is folded into them and into ``scale``) and ``cam_x = cam_y = 0``.
+    view_x, view_y : ndarray of shape (T,), int64
+        The camera offset applied to the background (equal to ``cam_x``, ``cam_y``
+        without a zoom).
+    zoom : ndarray of shape (T,)
+        Camera zoom per frame (ones without a zoom).
+    gain, offset : ndarray of shape (T,)
+        Global illumination per frame (``gain * pixel + offset``).
     """
 
     config: SceneConfig
@@ -130,6 +155,13 @@ class Scenario:
     depth_rank: NDArray[np.int16]
     in_static: NDArray[np.bool_]
     background: NDArray[np.uint8]
+    cam_x: NDArray[np.int64]
+    cam_y: NDArray[np.int64]
+    view_x: NDArray[np.int64]
+    view_y: NDArray[np.int64]
+    zoom: NDArray[np.float64]
+    gain: NDArray[np.float64]
+    offset: NDArray[np.float64]
     _static_cache: tuple[NDArray[Any], ...] | None = field(default=None, repr=False)
 
     @property
@@ -157,10 +189,47 @@ class Scenario:
             | np.any(self.shade != 1.0, axis=0)
         )
 
+    @property
+    def pad(self) -> tuple[int, int]:
+        """(ex, ey): how far the background extends beyond the frame on each side."""
+        bh, bw = self.background.shape[:2]
+        return (bw - self.config.width) // 2, (bh - self.config.height) // 2
+
+    @property
+    def moving_camera(self) -> bool:
+        return bool(np.any(self.view_x != 0) or np.any(self.view_y != 0))
+
+    @property
+    def zoomed(self) -> bool:
+        return bool(np.any(self.zoom != 1.0))
+
+    def background_frame(self, t: int) -> NDArray[np.uint8]:
+        """The background as seen in frame ``t`` (H, W, 3): the window at the camera
+        offset, resampled about the frame centre when the camera zooms."""
+        h, w = self.config.height, self.config.width
+        px, py = self.pad
+        xs, ys = px + int(self.view_x[t]), py + int(self.view_y[t])
+        z = float(self.zoom[t])
+        if z == 1.0:
+            return self.background[ys : ys + h, xs : xs + w].copy()
+        # Frame pixel u (centre u + 1/2) shows scene point c + (u + 1/2 - c) / z.
+        cx, cy = w / 2, h / 2
+        m = np.array(
+            [
+                [1 / z, 0.0, (0.5 - cx) / z + cx + xs - 0.5],
+                [0.0, 1 / z, (0.5 - cy) / z + cy + ys - 0.5],
+            ]
+        )
+        flags = cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP
+        return cv2.warpAffine(
+            self.background, m, (w, h), flags=flags, borderMode=cv2.BORDER_REFLECT_101
+        )
+
     def _static_layer(self) -> tuple[NDArray[Any], ...]:
         if self._static_cache is not None:
             return self._static_cache
-        h, w = self.config.height, self.config.width
+        h, w = self.background.shape[:2]
+        px, py = self.pad
         rgb = self.background.copy()
         lab = np.zeros((h, w), dtype=np.uint16)
         k_n = self.n_entities
@@ -173,6 +242,8 @@ class Scenario:
             i = int(np.searchsorted(static, k))
             tidx[k] = i
             x0[k], y0[k] = _top_left(self.cx[0, k], self.cy[0, k], tw[i], th[i])
+            x0[k] += px
+            y0[k] += py
             kernels.paint(rgb, lab, tbuf, toff[i], th[i], tw[i], x0[k], y0[k], k + 1)
         box = np.zeros((k_n, 4), dtype=np.int64)
         count = np.zeros(k_n, dtype=np.int64)
@@ -216,6 +287,10 @@ class Scenario:
         safe = np.maximum(tidx, 0)
         x0 = np.floor(self.cx[start:stop] - tw[safe] / 2 + 0.5).astype(np.int64)
         y0 = np.floor(self.cy[start:stop] - th[safe] / 2 + 0.5).astype(np.int64)
+        moving = self.config.camera is not None
+        if moving:
+            x0 -= self.cam_x[start:stop, None]
+            y0 -= self.cam_y[start:stop, None]
         # Alive and overlapping the frame.
         inside = (x0 < w) & (y0 < h) & (x0 + tw[safe] > 0) & (y0 + th[safe] > 0)
         present = (tidx >= 0) & inside
@@ -229,26 +304,89 @@ class Scenario:
 
         out_rgb = np.empty((f_n, h, w, 3), dtype=np.uint8)
         out_lab = np.empty((f_n, h, w), dtype=np.uint16)
-        out_rgb[:] = s_rgb
-        out_lab[:] = s_lab
+        is_static = self.in_static
+        if moving:
+            # The static layer moves under the frame: crop it per frame and rescan the
+            # static entities' visible statistics in the cropped labels.
+            px, py = self.pad
+            for f in range(f_n):
+                if self.zoomed:  # nothing is static: the background alone, resampled
+                    out_rgb[f] = self.background_frame(start + f)
+                    out_lab[f] = 0
+                    continue
+                ys, xs = py + self.view_y[start + f], px + self.view_x[start + f]
+                out_rgb[f] = s_rgb[ys : ys + h, xs : xs + w]
+                out_lab[f] = s_lab[ys : ys + h, xs : xs + w]
+            is_static = np.zeros_like(self.in_static)
+        else:
+            out_rgb[:] = s_rgb
+            out_lab[:] = s_lab
         out_box = np.zeros((f_n, k_n, 4), dtype=np.int64)
         out_count = np.zeros((f_n, k_n), dtype=np.int64)
         kernels.render_chunk(
             tbuf, toff, th, tw, order, tidx, x0, y0,
-            self.in_static, s_box, s_count, out_rgb, out_lab, out_box, out_count,
+            is_static, s_box, s_count, out_rgb, out_lab, out_box, out_count,
         )  # fmt: skip
+        self._photometric(start, out_rgb, out_lab, tidx, out_box, out_count)
         if self.config.sensor_noise > 0:
             for f in range(f_n):
                 rng = entity_rng(self.seed, "sensor", start + f)
-                noisy = out_rgb[f] + rng.standard_normal((h, w, 3)) * self.config.sensor_noise
-                out_rgb[f] = np.clip(np.rint(noisy), 0, 255).astype(np.uint8)
+                # frame + N(0, 1) * sigma, rounded and clipped (in place: same bytes).
+                noisy = rng.standard_normal((h, w, 3))
+                noisy *= self.config.sensor_noise
+                noisy += out_rgb[f]
+                np.rint(noisy, out=noisy)
+                np.clip(noisy, 0, 255, out=noisy)
+                out_rgb[f] = noisy
+        p = self.config.photometric
+        if p is not None and p.jpeg_quality is not None:
+            for f in range(f_n):
+                out_rgb[f] = photometric.jpeg(out_rgb[f], p.jpeg_quality)
 
         gt = _ground_truth(tidx, x0, y0, th, tw, toff, tbuf, out_box, out_count)
         gt["depth"] = self.depth_rank[start:stop].copy()
         path = np.stack([self.path_x[start:stop], self.path_y[start:stop]], axis=-1)
+        if moving:
+            path -= np.stack([self.cam_x[start:stop], self.cam_y[start:stop]], axis=-1)[:, None]
         path[~gt["present"]] = np.nan
         gt["path_center"] = path.astype(np.float32)
         return Chunk(start=start, frames=out_rgb, labels=out_lab, gt=gt)
+
+    def _photometric(self, start, rgb, lab, tidx, vbox, vcount) -> None:
+        """Motion blur of the moving entities, then the illumination, in place on frames
+        ``start:start+F``; labels and visible statistics (of the sharp silhouettes) are
+        read, never changed."""
+        p = self.config.photometric
+        if p is None:
+            return
+        f_n = rgb.shape[0]
+        if p.motion_blur > 0:
+            vx, vy = self.image_velocity()
+            for f in range(f_n):
+                t = start + f
+                for k in np.flatnonzero((tidx[f] >= 0) & (vcount[f] > 0) & ~self.in_static):
+                    box = (
+                        int(vbox[f, k, 0]), int(vbox[f, k, 1]),
+                        int(vbox[f, k, 2]), int(vbox[f, k, 3]),
+                    )  # fmt: skip
+                    photometric.motion_blur(
+                        rgb[f], lab[f], k + 1, box, (vx[t, k], vy[t, k]), p.motion_blur
+                    )
+        for f in range(f_n):
+            g, o = float(self.gain[start + f]), float(self.offset[start + f])
+            if g != 1.0 or o != 0.0:
+                rgb[f] = photometric.illuminate(rgb[f], g, o)
+
+    def image_velocity(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Velocity (T, K) of every entity in frame coordinates, pixels per frame (the
+        backward difference; frame 0 takes frame 1's)."""
+        x = self.cx - self.cam_x[:, None]
+        y = self.cy - self.cam_y[:, None]
+        vx, vy = np.zeros_like(x), np.zeros_like(y)
+        if x.shape[0] > 1:
+            vx[1:], vy[1:] = np.diff(x, axis=0), np.diff(y, axis=0)
+            vx[0], vy[0] = vx[1], vy[1]
+        return vx, vy
 
     def chunks(self, size: int = 64) -> Iterator[Chunk]:
         """Render the whole scenario in chunks of ``size`` frames (bounded memory)."""
@@ -368,7 +506,7 @@ def _entity_plan(
 
 def _clutter(cfg: SceneConfig, seed: int) -> list[tuple[str, NDArray[np.uint8], float, float]]:
     items = []
-    for spec in cfg.clutter:
+    for i, spec in enumerate(cfg.clutter):
         rng = entity_rng(seed, f"clutter:{spec.name}")
         n = spec.count
         if spec.region is None:
@@ -390,8 +528,17 @@ def _clutter(cfg: SceneConfig, seed: int) -> list[tuple[str, NDArray[np.uint8], 
             cx = rx + rng.uniform(0, rw, n)
             cy = ry + rng.uniform(0, rh, n)
         app = spec.appearance
+        textured = app.pattern in ("image", "perlin")
         for j in range(n):
             size = (max(1, int(round(bw * frac[j]))), max(1, int(round(bh * frac[j]))))
+            if textured:
+                colors = tuple(tuple(int(v) for v in c) for c in pal[cols[j]])
+                tpl = draw_template(
+                    replace(app, colors=colors), rng=rng, size=size,
+                    field=f"clutter[{i}].appearance",
+                )  # fmt: skip
+                items.append((f"{spec.name}-{j}", tpl, float(cx[j]), float(cy[j])))
+                continue
             tpl = paint_template(
                 app.shape, app.pattern, size[0], size[1], pal[cols[j]],
                 stripe_width=app.stripe_width, texture_sigma=app.texture_sigma, rng=rng,
@@ -415,12 +562,15 @@ def _entity_paths(
     by_name = {e.name: e for e in cfg.entities}
     templates: dict[str, NDArray[np.uint8]] = {}
     paths: dict[str, _Path] = {}
+    index = {e.name: i for i, e in enumerate(cfg.entities)}
     for e in sorted(cfg.entities, key=lambda e: e.mimic is not None):
         app_rng = entity_rng(seed, e.name, 0)
         app = e.appearance
+        where = f"entities[{index[e.name]}].appearance"
         if e.mimic is not None:
             app = jitter_colors(by_name[e.mimic].appearance, e.color_jitter, rng=app_rng)
-        tpl = draw_template(app, rng=app_rng)
+            where = f"entities[{index[e.mimic]}].appearance"
+        tpl = draw_template(app, rng=app_rng, field=where)
         templates[e.name] = tpl
         if e.position is not None:
             start = (float(e.position[0]), float(e.position[1]))
@@ -524,6 +674,26 @@ def plan(config: SceneConfig, seed: int | None = None, *, preset: str = "") -> S
     tpls = [templates[e.name] for e in cfg.entities] + [c[1] for c in clutter]
     cx, cy, scale, angle, shade, path_x, path_y, alive = _per_frame(cfg, paths, clutter)
     depth_value = _depth_values(cfg, len(clutter))
+    cam_x, cam_y = camera_offsets(cfg.camera, cfg.n_frames, entity_rng(seed, "camera"))
+    view_x, view_y = cam_x, cam_y
+    zoom = camera_zoom(cfg.camera, cfg.n_frames, entity_rng(seed, "camera-zoom"))
+    in_static = _static_entities(cfg, depth_value)
+    if np.any(zoom != 1.0):
+        # Fold the view into the entities: frame coordinates, scale times zoom, and
+        # everything drawn per frame.
+        z = zoom[:, None]
+        c_x, c_y = cfg.width / 2, cfg.height / 2
+        cx = c_x + z * (cx - cam_x[:, None] - c_x)
+        cy = c_y + z * (cy - cam_y[:, None] - c_y)
+        path_x = c_x + z * (path_x - cam_x[:, None] - c_x)
+        path_y = c_y + z * (path_y - cam_y[:, None] - c_y)
+        scale = scale * z
+        in_static = np.zeros_like(in_static)
+        cam_x, cam_y = np.zeros_like(cam_x), np.zeros_like(cam_y)
+    gain, offset = photometric.illumination(
+        cfg.photometric, cfg.n_frames, entity_rng(seed, "illumination")
+    )
+    ex, ey = cfg.camera.extent if cfg.camera is not None else (0, 0)
     return Scenario(
         config=cfg,
         seed=seed,
@@ -541,10 +711,17 @@ def plan(config: SceneConfig, seed: int | None = None, *, preset: str = "") -> S
         alive=alive,
         depth_value=depth_value,
         depth_rank=_ranks(depth_value),
-        in_static=_static_entities(cfg, depth_value),
+        in_static=in_static,
         background=_background(
-            cfg.background, cfg.height, cfg.width, entity_rng(seed, "background")
+            cfg.background, cfg.height + 2 * ey, cfg.width + 2 * ex, entity_rng(seed, "background")
         ),
+        cam_x=cam_x,
+        cam_y=cam_y,
+        view_x=view_x,
+        view_y=view_y,
+        zoom=zoom,
+        gain=gain,
+        offset=offset,
     )
 
 

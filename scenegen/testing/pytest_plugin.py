@@ -97,8 +97,11 @@ _GENERATOR_MODULES = (
     "presets.py",
     "render/compose.py",
     "render/draw.py",
+    "render/camera.py",
     "render/motion.py",
+    "render/photometric.py",
     "render/plan.py",
+    "render/textures.py",
     "sequence.py",
 )
 _written_key = pytest.StashKey[list[tuple[str, str]]]()

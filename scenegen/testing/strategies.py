@@ -12,7 +12,8 @@ strategy           draws
 ``ar2_params``     :class:`~scenegen.config.AR2` motion of one coordinate
 ``entity_specs``   one :class:`~scenegen.config.EntitySpec` on a given canvas
 ``scene_configs``  a whole :class:`~scenegen.config.SceneConfig`, with switches for
-                   occlusion, clutter, distractors, noise and entities leaving the frame
+                   occlusion, clutter, distractors, noise, entities leaving the frame
+                   and realistic appearance (images, textures, camera, blur, light)
 ``sequences``      a rendered :class:`~scenegen.sequence.Sequence` (config + seed)
 ``boxes``          one box ``[x, y, w, h]`` (ndarray of shape (4,)) on a given canvas
 =================  ======================================================================
@@ -59,9 +60,11 @@ from scenegen.config import (
     AR2,
     Appearance,
     Background,
+    Camera,
     ClutterSpec,
     EntitySpec,
     Motion,
+    Photometric,
     SceneConfig,
 )
 from scenegen.sequence import Sequence
@@ -88,6 +91,12 @@ _BACKGROUND_COLORS = ((255, 255, 255), (128, 128, 128), (0, 0, 0), (200, 200, 18
 _OCCLUDER_COLORS = ((90, 90, 90), (160, 120, 80), (20, 20, 60))
 _MAX_CLUTTER = 100  # "clutter everywhere" on a 120x90 canvas, still fast to render
 _MAX_SENSOR_NOISE = 10.0
+# Real images and textures shipped with scikit-image (no download), simplest first.
+_IMAGE_SOURCES = (
+    "skimage:coffee", "skimage:chelsea", "skimage:lfw_subset[12]", "skimage:brick",
+    "skimage:grass", "skimage:gravel", "skimage:astronaut",
+)  # fmt: skip
+_FITS = ("stretch", "tile", "crop")
 _MAX_POSITION_NOISE = 3.0
 
 
@@ -399,6 +408,7 @@ def scene_configs(
     distractors: bool = False,
     noise: bool = False,
     exits: bool = False,
+    realistic: bool = False,
 ) -> SearchStrategy[SceneConfig]:
     """Whole scenes: canvas, background, entities (targets first), clutter, noise.
 
@@ -439,6 +449,10 @@ def scene_configs(
     exits : bool
         Allow entities to leave the frame (``free`` boundaries), to start half outside it
         (all but the first target), and to appear or vanish mid-sequence.
+    realistic : bool
+        Allow image and Perlin-texture appearances (``skimage:`` photographs, faces and
+        textures), image or Perlin backgrounds, a panning camera (AR2 or scripted), and
+        photometric effects (illumination change, motion blur, JPEG).
 
     Returns
     -------
@@ -468,6 +482,7 @@ def scene_configs(
             ("distractors", distractors),
             ("noise", noise),
             ("exits", exits),
+            ("realistic", realistic),
         )
     }
     m = _check_margin(margin, BOUNDARIES if switches["exits"] else ())
@@ -629,17 +644,92 @@ def _scene_configs(
     if switches["clutter"] and draw(st.booleans()):
         clutter = (_draw_clutter(draw, width, height, sizes[0], margin),)
     sensor_noise = _hundredths(draw, 0, _MAX_SENSOR_NOISE) if noise else 0.0
+    background = _draw_background(draw, noise)
+    camera = photo = None
+    if switches["realistic"] and draw(st.booleans()):
+        ordered = tuple(_realistic_entity(draw, e) for e in ordered)
+        if clutter:
+            clutter = tuple(replace(c, appearance=_textured(draw, c.appearance)) for c in clutter)
+        background = _draw_real_background(draw)
+        camera = _draw_camera(draw, n_frames)
+        photo = _draw_photometric(draw)
     config = SceneConfig(
         width=width,
         height=height,
         n_frames=n_frames,
-        background=_draw_background(draw, noise),
+        background=background,
         entities=ordered,
         clutter=clutter,
         sensor_noise=sensor_noise,
+        camera=camera,
+        photometric=photo,
     )
     _note_config(config, None)
     return config
+
+
+def _textured(draw: Any, app: Appearance) -> Appearance:
+    """``app`` with an image or Perlin-texture pattern (or unchanged)."""
+    kind = draw(st.sampled_from(("keep", "image", "perlin")))
+    if kind == "keep":
+        return app
+    if kind == "perlin":
+        return replace(app, pattern="perlin", noise_scale=_hundredths(draw, 1, 16))
+    tint = draw(st.sampled_from((None, *_COLORS)))
+    return replace(
+        app,
+        pattern="image",
+        source=draw(st.sampled_from(_IMAGE_SOURCES)),
+        fit=draw(st.sampled_from(_FITS)),
+        tint=tint,
+    )
+
+
+def _realistic_entity(draw: Any, e: EntitySpec) -> EntitySpec:
+    return e if e.mimic is not None else replace(e, appearance=_textured(draw, e.appearance))
+
+
+def _draw_real_background(draw: Any) -> Background:
+    kind = draw(st.sampled_from(("image", "perlin")))
+    if kind == "perlin":
+        return Background(kind="perlin", scale=_hundredths(draw, 1, 32), low=40, high=220)
+    return Background(
+        kind="image", source=draw(st.sampled_from(_IMAGE_SOURCES)), fit=draw(st.sampled_from(_FITS))
+    )
+
+
+def _draw_camera(draw: Any, n_frames: int) -> Camera | None:
+    kind = draw(st.sampled_from(("none", "ar2", "scripted")))
+    if kind == "none":
+        return None
+    extent = (draw(st.integers(0, 24)), draw(st.integers(0, 24)))
+    if kind == "scripted":
+        dx, dy = extent[0], extent[1]
+        end = max(n_frames - 1, 1)
+        return Camera(extent=extent, keyframes=((0, -dx, -dy), (end, dx, dy)))
+    return Camera(
+        extent=extent,
+        x=AR2(boundary=draw(st.sampled_from(BOUNDARIES[:2])), sigma=_hundredths(draw, 0, 3)),
+        y=AR2(boundary=draw(st.sampled_from(BOUNDARIES[:2])), sigma=_hundredths(draw, 0, 3)),
+        velocity=(_hundredths(draw, -3, 3), _hundredths(draw, -3, 3)),
+        zoom=draw(
+            st.sampled_from(
+                (None, AR2(boundary="reflect", a1=1.0, a2=0.0, sigma=0.05, margin=0.4))
+            )
+        ),
+    )
+
+
+def _draw_photometric(draw: Any) -> Photometric | None:
+    if not draw(st.booleans()):
+        return None
+    gain = AR2(boundary="reflect", a1=1.0, a2=0.0, sigma=_hundredths(draw, 0, 0.1), margin=0.5)
+    return Photometric(
+        gain=gain,
+        offset=AR2(boundary="reflect", a1=1.0, a2=0.0, sigma=_hundredths(draw, 0, 5), margin=40),
+        motion_blur=_hundredths(draw, 0, 2),
+        jpeg_quality=draw(st.one_of(st.none(), st.integers(20, 95))),
+    )
 
 
 # --------------------------------------------------------------------------------------

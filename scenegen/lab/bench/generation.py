@@ -7,8 +7,10 @@ assignment) for rendering, and h5py writing the same arrays with the same filter
 from __future__ import annotations
 
 import tempfile
+from dataclasses import replace
 from pathlib import Path
 
+import cv2
 import h5py
 import numpy as np
 
@@ -17,7 +19,7 @@ from scenegen.io import COMPRESSIONS, filter_options, write, write_scenario
 from scenegen.lab.bench.core import BenchRow, median_time
 from scenegen.render.plan import generate, plan
 
-__all__ = ["numpy_render", "run", "sizes"]
+__all__ = ["numpy_render", "realistic_rows", "run", "sizes"]
 
 
 def numpy_render(scn) -> np.ndarray:
@@ -62,6 +64,7 @@ def run(repeats: int = 5) -> list[BenchRow]:
                 goal=f">= {goal:.0f} frames/s", met=t_n / ours >= goal,
             )
         )  # fmt: skip
+    rows += realistic_rows(repeats)
     seq = generate("kams-d", seed=0)
     t_n = seq.n_frames
     with tempfile.TemporaryDirectory() as d:
@@ -95,6 +98,44 @@ def run(repeats: int = 5) -> list[BenchRow]:
                     goal="~1x baseline (no more than h5py's own cost)", met=b / o >= 0.8,
                 )
             )  # fmt: skip
+    return rows
+
+
+def realistic_rows(repeats: int = 5) -> list[BenchRow]:
+    """The realistic preset ``tiger-like`` (320x240: textured target and clutter, camera
+    pan, motion blur, JPEG) beside the flat ``kams-d`` at the same size, OpenCV on one
+    thread: the ratio says what realism costs on the same machine in the same run."""
+    flat = presets.get("kams-d")
+    real = presets.get("tiger-like")
+    assert real.photometric is not None
+    no_jpeg = replace(real, photometric=replace(real.photometric, jpeg_quality=None))
+    threads = cv2.getNumThreads()
+    cv2.setNumThreads(1)
+    try:
+        times = {
+            label: (median_time(lambda c=cfg: generate(c, seed=0), repeats), cfg.n_frames)
+            for label, cfg in (
+                ("kams-d, flat colours (baseline)", flat),
+                ("tiger-like: textures, camera pan, motion blur, JPEG q80", real),
+                ("tiger-like without JPEG", no_jpeg),
+            )
+        }
+    finally:
+        cv2.setNumThreads(threads)
+    group = "generate 320x240, flat vs realistic (one OpenCV thread, file I/O excluded)"
+    base_name = next(iter(times))
+    base = times[base_name][0] / times[base_name][1]
+    rows = []
+    for label, (sec, t_n) in times.items():
+        per = sec / t_n
+        goal = label.startswith("tiger-like:")
+        rows.append(
+            BenchRow(
+                group, label, per, 1.0 / per, "frames/s",
+                baseline="" if label == base_name else base_name, ratio=base / per,
+                goal=">= 500 frames/s" if goal else "", met=(1.0 / per >= 500) if goal else None,
+            )
+        )  # fmt: skip
     return rows
 
 

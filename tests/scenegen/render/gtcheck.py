@@ -2,7 +2,9 @@
 
 Everything here is plain numpy, written without the compiled compositor, so the tests
 compare two implementations: the amodal masks of every entity are placed from the plan,
-composited by depth rank, and every ground-truth array is recomputed from them.
+composited by depth rank, and every ground-truth array is recomputed from them. With a
+camera, entities are placed at their scene position less the camera offset and the
+reference background is the frame's window of the larger background.
 """
 
 from __future__ import annotations
@@ -27,8 +29,8 @@ def entity_template(scn: Scenario, t: int, k: int) -> np.ndarray:
 def placed(scn: Scenario, t: int, k: int) -> tuple[np.ndarray, int, int]:
     tpl = entity_template(scn, t, k)
     th, tw = tpl.shape[:2]
-    x0 = int(np.floor(scn.cx[t, k] - tw / 2 + 0.5))
-    y0 = int(np.floor(scn.cy[t, k] - th / 2 + 0.5))
+    x0 = int(np.floor(scn.cx[t, k] - tw / 2 + 0.5)) - int(scn.cam_x[t])
+    y0 = int(np.floor(scn.cy[t, k] - th / 2 + 0.5)) - int(scn.cam_y[t])
     return tpl, x0, y0
 
 
@@ -36,7 +38,12 @@ def reference_frame(scn: Scenario, t: int) -> tuple[np.ndarray, np.ndarray, dict
     """Labels (H, W), colours (H, W, 3) and amodal pixel counts of frame ``t``."""
     h, w = scn.config.height, scn.config.width
     labels = np.zeros((h, w), dtype=np.uint16)
-    rgb = scn.background.copy()
+    if scn.zoomed:
+        rgb = scn.background_frame(t)  # resampled: pixels only, no ground truth
+    else:
+        bh, bw = scn.background.shape[:2]
+        ys, xs = (bh - h) // 2 + int(scn.view_y[t]), (bw - w) // 2 + int(scn.view_x[t])
+        rgb = scn.background[ys : ys + h, xs : xs + w].copy()
     amodal: dict[int, int] = {}
     # Back to front by rank: nearer entities overwrite farther ones.
     for k in np.argsort(-scn.depth_rank[t].astype(np.int64), kind="stable"):
@@ -64,7 +71,7 @@ def check_sequence(seq, scn: Scenario, *, pixels: bool = True) -> None:
         lab = np.asarray(seq.labels[t])
         # The pixel shows the nearest entity whose amodal mask covers it.
         np.testing.assert_array_equal(lab, ref_labels, err_msg=f"labels differ at frame {t}")
-        if pixels and scn.config.sensor_noise == 0:
+        if pixels and scn.config.sensor_noise == 0 and scn.config.photometric is None:
             np.testing.assert_array_equal(np.asarray(seq.frames[t]), ref_rgb, err_msg=f"frame {t}")
         counts = np.bincount(lab.ravel(), minlength=k_n + 1)
         for k in range(k_n):
@@ -87,7 +94,8 @@ def check_sequence(seq, scn: Scenario, *, pixels: bool = True) -> None:
             np.testing.assert_allclose(seq.gt.center[t, k], [x0 + tw / 2, y0 + th / 2])
             # path_center: the planned centre before position noise, float32.
             np.testing.assert_array_equal(
-                seq.gt.path_center[t, k], np.float32([scn.path_x[t, k], scn.path_y[t, k]])
+                seq.gt.path_center[t, k],
+                np.float32([scn.path_x[t, k] - scn.cam_x[t], scn.path_y[t, k] - scn.cam_y[t]]),
             )
             # visible_box is the box of the entity's pixels in labels.
             rows, cols = np.nonzero(lab == k + 1)
