@@ -18,7 +18,17 @@ __all__ = ["main"]
 
 def _parser() -> argparse.ArgumentParser:
     from scenegen import __version__
-    from scenegen.cli import bench, data, demo, evaluate, experiment, fixtures, track
+    from scenegen.cli import (
+        bench,
+        benchmark,
+        data,
+        dataset,
+        demo,
+        evaluate,
+        experiment,
+        fixtures,
+        track,
+    )
 
     parser = argparse.ArgumentParser(
         prog="scenegen",
@@ -29,6 +39,8 @@ def _parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="verb", metavar="VERB")
     sub.required = True
     for module in (data, track, evaluate, experiment, bench, demo, fixtures):
+        module.register(sub)
+    for module in (dataset, benchmark):
         module.register(sub)
     return parser
 

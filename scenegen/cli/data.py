@@ -171,7 +171,12 @@ def cmd_validate(args: argparse.Namespace) -> int:
 
     from scenegen.io.validate import check_file
 
-    problems = check_file(args.file, isolate=True)
+    if args.file.is_dir():  # a dataset folder (scenegen dataset): every shard and digest
+        from scenegen.datasets import validate_dataset
+
+        problems = validate_dataset(args.file)
+    else:
+        problems = check_file(args.file, isolate=True)
     if problems:
         for line in problems:
             print(line, file=sys.stderr)

@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import json
 import time
-import uuid
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -374,7 +373,7 @@ def build_dataset(
     try:
         run_tasks(
             make_shard, tasks, store, jobs=jobs, scheduler=scheduler,
-            key=lambda t: t.file, name=f"scenegen-dataset-{uuid.uuid4().hex[:8]}",
+            key=lambda t: t.file, name="scenegen-dataset",
         )  # fmt: skip
     finally:
         bar.close()

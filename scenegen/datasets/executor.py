@@ -108,7 +108,7 @@ def run_tasks(
     key : callable
         A unique text key per task (Dask task keys).
     name : str
-        Prefix of the Dask task keys.
+        Prefix of the Dask task keys (a random part follows it).
 
     Raises
     ------
@@ -160,9 +160,12 @@ def _run_dask(
     key: Callable[[Any], Hashable],
     name: str,
 ) -> None:
+    import uuid
+
     from distributed import as_completed as dask_completed
 
     client = connect(address)
+    name = f"{name}-{uuid.uuid4().hex[:8]}"  # two runs on one cluster never share keys
     try:
         futures = {}
         for t in tasks:
