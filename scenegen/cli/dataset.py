@@ -24,6 +24,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("-o", "--output", type=Path, required=True, help="dataset folder DIR")
     p.add_argument("--count", type=int, default=None, help="sequences (default: the family's)")
     p.add_argument("--seed", type=int, default=None, help="base seed (default: the family's)")
+    p.add_argument("--frames", type=int, default=None,
+                   help="override every sequence's frame count")  # fmt: skip
     where = p.add_mutually_exclusive_group()
     where.add_argument("--jobs", type=int, default=None, help="local processes (default: all)")
     where.add_argument("--scheduler", default=None, metavar="ADDRESS",
@@ -57,6 +59,7 @@ def cmd_dataset(args: argparse.Namespace) -> int:
         args.output,
         count=args.count,
         seed=args.seed,
+        frames=args.frames,
         jobs=args.jobs,
         scheduler=args.scheduler,
         shard_size=args.shard_size or DEFAULT_SHARD_SIZE,

@@ -159,19 +159,33 @@ def make_shard(task: ShardTask) -> dict[str, Any]:
     Returns
     -------
     dict
-        ``shard``, ``reused`` (the file existed and verified) and ``entries`` (manifest
-        entries, one per sequence, with digests).
+        ``shard``, ``reused`` (the file existed and verified), ``entries`` (manifest
+        entries, one per sequence, with digests), and the worker's ``pid`` and
+        ``peak_rss_mb`` (peak resident memory so far, MiB).
     """
     from scenegen.io import write
     from scenegen.testing.fixtures import digests
 
     kept = _verify(task)
     if kept is not None:
-        return {"shard": task.shard, "reused": True, "entries": kept}
+        return {"shard": task.shard, "reused": True, "entries": kept, **_worker()}
     seqs = [_generate(d) for d in task.draws]
     entries = [_entry(d, task.file, s, digests(s)) for d, s in zip(task.draws, seqs, strict=True)]
     write(Path(task.root) / task.file, *seqs, compression=task.compression)
-    return {"shard": task.shard, "reused": False, "entries": entries}
+    return {"shard": task.shard, "reused": False, "entries": entries, **_worker()}
+
+
+def _worker() -> dict[str, Any]:
+    """Which process made a shard and its peak memory so far (for the bench)."""
+    import os
+
+    try:
+        import resource
+
+        rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0  # Linux: KiB
+    except (ImportError, OSError):
+        rss = float("nan")
+    return {"pid": os.getpid(), "peak_rss_mb": rss}
 
 
 def plan_shards(
@@ -261,6 +275,7 @@ def build_dataset(
     *,
     count: int | None = None,
     seed: int | None = None,
+    frames: int | None = None,
     jobs: int | None = None,
     scheduler: str | None = None,
     shard_size: int = DEFAULT_SHARD_SIZE,
@@ -280,6 +295,9 @@ def build_dataset(
         Sequences (default: the family's ``count``).
     seed : int, optional
         Base seed (default: the family's ``seed``).
+    frames : int, optional
+        Override every sequence's frame count (a ``set: {n_frames: ...}`` entry, so it
+        makes a different dataset).
     jobs : int or None
         Local worker processes (None: all cores; 1: this process).
     scheduler : str or None
@@ -308,6 +326,10 @@ def build_dataset(
     from scenegen.io import filter_options
 
     fam = resolve_family(family)
+    if frames is not None:
+        if isinstance(frames, bool) or not isinstance(frames, int) or frames < 1:
+            raise ConfigError(f"--frames must be >= 1, got {frames}")
+        fam = fam.with_overrides({"n_frames": frames})
     check_executor(jobs, scheduler)
     filter_options(compression)
     n = fam.count if count is None else count

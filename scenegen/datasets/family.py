@@ -191,6 +191,7 @@ class Family:
     seed: int
     source: str = ""
     spec: dict[str, Any] = field(default_factory=dict, compare=False)
+    folder: Path | None = field(default=None, compare=False)
 
     @property
     def grid_size(self) -> int:
@@ -207,6 +208,13 @@ class Family:
                     out.append(n)
         out += [d.path for d in self.distributions if d.path not in out]
         return out
+
+    def with_overrides(self, overrides: dict[str, Any]) -> Family:
+        """The family with more ``set`` entries (applied after its own); re-validated."""
+        spec = copy.deepcopy(self.spec)
+        spec["set"] = {**(spec.get("set") or {}), **overrides}
+        spec.setdefault("count", self.count)
+        return family_from_dict(spec, source=self.source, folder=self.folder)
 
     def digest(self) -> str:
         """SHA-256 (hex) of everything that defines the sequences except the count and seed."""
@@ -527,6 +535,7 @@ def family_from_dict(data: Any, *, source: str = "family", folder: Path | None =
         seed=0,
         source=source,
         spec=copy.deepcopy(data),
+        folder=folder,
     )
     grid = fam.grid_size
     count = data.get("count", grid)
