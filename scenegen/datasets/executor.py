@@ -130,7 +130,7 @@ def run_tasks(
     # Bounded in-flight work: at most 2 tasks per worker are submitted at once, so a long
     # run's results never pile up in the parent.
     ctx = get_context("forkserver")
-    with ProcessPoolExecutor(max_workers=n, mp_context=ctx) as pool:
+    with ProcessPoolExecutor(max_workers=n, mp_context=ctx, initializer=_ignore_sigint) as pool:
         pending: dict[Any, Any] = {}
         it = iter(tasks)
         try:
@@ -147,9 +147,17 @@ def run_tasks(
                     if nxt is not None:
                         pending[pool.submit(fn, nxt)] = nxt
         except BaseException:
-            for fut in pending:
-                fut.cancel()
+            # Ctrl-C or a failed task: drop the queued tasks; the running ones finish
+            # (each writes its own file atomically, so a rerun finds them done).
+            pool.shutdown(wait=True, cancel_futures=True)
             raise
+
+
+def _ignore_sigint() -> None:
+    """Pool workers leave Ctrl-C to the parent, which stops the pool cleanly."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def _run_dask(
