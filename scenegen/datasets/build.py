@@ -170,6 +170,7 @@ def make_shard(task: ShardTask) -> dict[str, Any]:
     if kept is not None:
         return {"shard": task.shard, "reused": True, "entries": kept, **_worker()}
     seqs = [_generate(d) for d in task.draws]
+    Path(task.root).mkdir(parents=True, exist_ok=True)  # a worker without the shared folder
     entries = [_entry(d, task.file, s, digests(s)) for d, s in zip(task.draws, seqs, strict=True)]
     write(Path(task.root) / task.file, *seqs, compression=task.compression)
     return {"shard": task.shard, "reused": False, "entries": entries, **_worker()}
