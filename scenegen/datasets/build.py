@@ -160,24 +160,26 @@ def make_shard(task: ShardTask) -> dict[str, Any]:
     -------
     dict
         ``shard``, ``reused`` (the file existed and verified), ``entries`` (manifest
-        entries, one per sequence, with digests), and the worker's ``pid`` and
-        ``peak_rss_mb`` (peak resident memory so far, MiB).
+        entries, one per sequence, with digests), and the worker's ``pid``,
+        ``cpu_seconds`` (CPU time of this shard) and ``peak_rss_mb`` (peak resident memory
+        so far, MiB).
     """
     from scenegen.io import write
     from scenegen.testing.fixtures import digests
 
+    cpu = time.process_time()
     kept = _verify(task)
     if kept is not None:
-        return {"shard": task.shard, "reused": True, "entries": kept, **_worker()}
+        return {"shard": task.shard, "reused": True, "entries": kept, **_worker(cpu)}
     seqs = [_generate(d) for d in task.draws]
     Path(task.root).mkdir(parents=True, exist_ok=True)  # a worker without the shared folder
     entries = [_entry(d, task.file, s, digests(s)) for d, s in zip(task.draws, seqs, strict=True)]
     write(Path(task.root) / task.file, *seqs, compression=task.compression)
-    return {"shard": task.shard, "reused": False, "entries": entries, **_worker()}
+    return {"shard": task.shard, "reused": False, "entries": entries, **_worker(cpu)}
 
 
-def _worker() -> dict[str, Any]:
-    """Which process made a shard and its peak memory so far (for the bench)."""
+def _worker(cpu_start: float) -> dict[str, Any]:
+    """Which process made a shard, the CPU time it took and the peak memory so far."""
     import os
 
     try:
@@ -186,7 +188,7 @@ def _worker() -> dict[str, Any]:
         rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0  # Linux: KiB
     except (ImportError, OSError):
         rss = float("nan")
-    return {"pid": os.getpid(), "peak_rss_mb": rss}
+    return {"pid": os.getpid(), "peak_rss_mb": rss, "cpu_seconds": time.process_time() - cpu_start}
 
 
 def plan_shards(

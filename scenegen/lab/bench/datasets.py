@@ -54,7 +54,9 @@ def measure(variant: str, folder: Path, **executor: Any) -> dict[str, float]:
     )  # fmt: skip
     wall = time.perf_counter() - t0
     rss = max(float(r["peak_rss_mb"]) for _, r in results)
-    return {"wall": wall, "rate": COUNT / wall, "steady": _steady(results), "rss": rss}
+    cpu = sum(float(r["cpu_seconds"]) for _, r in results) / COUNT
+    return {"wall": wall, "rate": 60 * COUNT / wall, "steady": 60 * _steady(results),
+            "rss": rss, "cpu": cpu}  # fmt: skip
 
 
 def run(repeats: int = 5) -> list[BenchRow]:
@@ -72,15 +74,19 @@ def run(repeats: int = 5) -> list[BenchRow]:
     rows = []
     for kind, key in (("end to end", "rate"), ("steady state", "steady")):
         base = f"1 local worker, {kind}"
-        rows.append(BenchRow(group, base, _inv(one[key]), one[key], "seq/s"))
+        rows.append(BenchRow(group, base, 60 * _inv(one[key]), one[key], "seq/min"))
         for label, m in (("2 local workers", two), ("2-worker LocalCluster", dask)):
             ratio = m[key] / one[key]
             goal = ">= 1.8x 1 worker" if key == "steady" else ""
             rows.append(
-                BenchRow(group, f"{label}, {kind}", _inv(m[key]), m[key], "seq/s",
+                BenchRow(group, f"{label}, {kind}", 60 * _inv(m[key]), m[key], "seq/min",
                          baseline=base, ratio=ratio, goal=goal,
                          met=(ratio >= 1.8) if goal else None)
             )  # fmt: skip
+    for label, m in (("1 local worker", one), ("2 local workers", two),
+                     ("2-worker LocalCluster", dask)):  # fmt: skip
+        rows.append(BenchRow(group, f"{label}, CPU time per sequence", m["cpu"],
+                             60 / m["cpu"], "seq/min per core"))  # fmt: skip
     peak = max(one["rss"], two["rss"], dask["rss"])
     rows.append(BenchRow(group, "peak memory of a worker (MiB)", 0.0, peak, "MiB"))
     return rows

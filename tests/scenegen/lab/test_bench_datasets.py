@@ -18,6 +18,6 @@ def test_scaled_down_rows(monkeypatch):
     monkeypatch.setattr(bench, "COUNT", 8)
     monkeypatch.setattr(bench, "FRAMES", 2)
     rows = bench.run(1)
-    assert [r.unit for r in rows] == ["seq/s"] * 6 + ["MiB"]
+    assert [r.unit for r in rows] == ["seq/min"] * 6 + ["seq/min per core"] * 3 + ["MiB"]
     assert all(r.rate > 0 for r in rows)
     assert sum(r.goal != "" for r in rows) == 2
