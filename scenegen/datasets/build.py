@@ -384,16 +384,19 @@ def build_dataset(
     flush(False)
     bar = tqdm(total=n, disable=not progress, unit="seq", desc=f"dataset {fam.name}",
                leave=False)  # fmt: skip
-    last = [time.monotonic()]
+    last, wait = [time.monotonic()], [_FLUSH_SECONDS]
 
     def store(task: ShardTask, res: dict[str, Any]) -> None:
         done[task.shard] = res["entries"]
         bar.update(len(res["entries"]))
         if on_shard is not None:
             on_shard(res)
-        if time.monotonic() - last[0] >= _FLUSH_SECONDS:
+        if time.monotonic() - last[0] >= wait[0]:
+            t0 = time.monotonic()
             flush(False)
             last[0] = time.monotonic()
+            # A 10,000-sequence manifest is ~13 MB: rewrite it at most 5% of the time.
+            wait[0] = max(_FLUSH_SECONDS, 20.0 * (last[0] - t0))
 
     try:
         run_tasks(
