@@ -16,6 +16,8 @@ Resumable: a shard is written atomically (a temporary file renamed into place), 
 manifest is rewritten atomically as shards finish. Running the same command again keeps
 every shard file whose sequences have the expected names, seeds and configs and whose
 contents match their digests (the manifest's, when it lists them), and makes the rest.
+A larger ``--count`` extends a dataset the same way (the first sequences do not depend
+on the count), remaking only its last, partial shard.
 """
 
 from __future__ import annotations
@@ -238,7 +240,7 @@ def _header(fam: Family, count: int, seed: int, shard_size: int, compression: st
     }
 
 
-_IDENTITY = ("schema", "family_digest", "seed", "count", "shard_size", "compression")
+_IDENTITY = ("schema", "family_digest", "seed", "shard_size", "compression")
 
 
 def write_manifest(root: Path, manifest: dict[str, Any]) -> None:
@@ -361,6 +363,11 @@ def build_dataset(
             raise ConfigError(
                 f"{root}: holds a different dataset ({old.get('family')!r}: {what}); "
                 "choose another output folder or remove it"
+            )
+        if isinstance(old.get("count"), int) and old["count"] > n:
+            raise ConfigError(
+                f"{root}: holds {old['count']} sequences of {old.get('family')!r}; a rerun "
+                f"may extend it (--count >= {old['count']}) but not shrink it"
             )
         previous = {int(e["index"]): e for e in old["sequences"] if isinstance(e, dict)}
     else:

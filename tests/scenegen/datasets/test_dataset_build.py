@@ -140,6 +140,18 @@ def test_folder_of_another_dataset_is_refused(reference, tmp_path):
         build_dataset({**TINY, "sweep": {"clutter[0].count": [1]}}, out, shard_size=SHARD)
 
 
+def test_a_larger_count_extends_the_dataset(reference, tmp_path):
+    out = tmp_path / "ds"
+    build_dataset(TINY, out, jobs=1, shard_size=SHARD, count=5)
+    again = []
+    build_dataset(TINY, out, jobs=1, shard_size=SHARD, on_shard=again.append)  # 7
+    assert sorted((r["shard"], r["reused"]) for r in again) == [
+        (0, True), (1, True), (2, False), (3, False)]  # fmt: skip
+    assert files(out) == files(reference)
+    with pytest.raises(ConfigError, match="may extend it .--count >= 7. but not shrink it"):
+        build_dataset(TINY, out, jobs=1, shard_size=SHARD, count=3)
+
+
 def test_open_dataset(reference):
     ds = open_dataset(reference)
     assert len(ds) == 7 and ds.params == ["clutter[0].count", "entities[0].position_noise"]
