@@ -30,7 +30,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     where.add_argument("--jobs", type=int, default=None, help="local processes (default: all)")
     where.add_argument("--scheduler", default=None, metavar="ADDRESS",
                        help="dask.distributed scheduler, e.g. tcp://host:8786 (its workers "
-                       "must see DIR and OUT)")  # fmt: skip
+                       "read DIR; this process writes OUT)")  # fmt: skip
     p.add_argument("-o", "--output", type=Path, required=True, help="output folder OUT")
     p.set_defaults(func=cmd_benchmark)
 

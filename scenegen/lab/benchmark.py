@@ -440,7 +440,8 @@ def run_benchmark(
     params : dict, optional
         Tracker parameters, given to every tracker that takes them.
     jobs, scheduler
-        Local processes, or a Dask scheduler address (its workers must see both folders).
+        Local processes, or a Dask scheduler address (its workers read ``dataset``; results
+        come back to this process, which writes ``out``).
     progress : bool
         Show a tqdm bar on stderr.
     on_done : callable, optional
