@@ -9,21 +9,31 @@ layers m = M … 0 weight by w^β_m with β_M < … < β_0 = 1 (KAMS eq. 1–4).
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
-from trackers.base import Estimate, RngLike, Tracker
+from trackers.base import Estimate, Tracker
 from trackers.filters.resampling import RESAMPLERS, resample_groups
-from trackers.meanshift import ColourTargets, check_kernel_bins, keep_inside
+from trackers.filters.weights import normalised_weights
+from trackers.meanshift import (
+    ColourParams,
+    colour_model,
+    keep_inside,
+    set_distances,
+    set_log_likelihoods,
+    window_boxes,
+)
 from trackers.models.observation import FrameObservation
+from trackers.params import check_choice, check_integer, check_number
 
 __all__ = [
     "ESTIMATES",
     "SCHEDULES",
     "AnnealedPF",
+    "AnnealedParams",
     "check_particles",
-    "normalised_weights",
     "resample_targets",
     "survival_beta",
     "survival_rate",
@@ -35,12 +45,6 @@ SCHEDULES = ("adaptive", "geometric")
 
 #: Estimators of ``AnnealedPF``.
 ESTIMATES = ("mean", "mode")
-
-
-def normalised_weights(log_w: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Weights (K, N) proportional to exp(log_w), each row summing to 1."""
-    w = np.exp(log_w - log_w.max(axis=1, keepdims=True))
-    return w / w.sum(axis=1, keepdims=True)
 
 
 def survival_rate(log_w: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -129,6 +133,44 @@ def check_particles(n_particles: int, lam: float, resampler: str) -> None:
         raise ValueError(f"unknown resampler {resampler!r}; valid: {', '.join(RESAMPLERS)}")
 
 
+@dataclass(frozen=True)
+class AnnealedParams(ColourParams):
+    """Parameters of the annealed particle filter (documented on ``AnnealedPF``).
+
+    ``sigma`` is stored as a float, or as a tuple of ``n_layers`` floats.
+    """
+
+    n_particles: int = 100
+    n_layers: int = 3
+    lam: float = 1000.0
+    sigma: float | tuple[float, ...] = 12.0
+    sigma_decay: float = 0.5
+    schedule: str = "adaptive"
+    alpha: float = 0.5
+    beta_ratio: float = 0.5
+    estimate: str = "mean"
+    resampler: str = "systematic"
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        check_particles(self.n_particles, self.lam, self.resampler)
+        self._set("n_particles", int(self.n_particles))
+        self._set("lam", float(self.lam))
+        check_integer(self, "n_layers", low=1)
+        check_choice(self, "schedule", SCHEDULES)
+        check_choice(self, "estimate", ESTIMATES)
+        check_number(self, "alpha", low=0.0, high=1.0, low_open=True, high_open=True)
+        check_number(self, "beta_ratio", low=0.0, high=1.0, low_open=True)
+        check_number(self, "sigma_decay", low=0.0, high=1.0, low_open=True)
+        sigmas = _layer_sigmas(self.sigma, self.sigma_decay, self.n_layers)
+        self._set("sigma", float(self.sigma) if np.ndim(self.sigma) == 0
+                  else tuple(sigmas.tolist()))
+
+    def layer_sigmas(self) -> NDArray[np.float64]:
+        """Noise standard deviation (n_layers,) of each layer, first layer first."""
+        return _layer_sigmas(self.sigma, self.sigma_decay, self.n_layers)
+
+
 class AnnealedPF(Tracker):
     """Annealed particle filter on colour histograms, one particle set per target.
 
@@ -146,6 +188,8 @@ class AnnealedPF(Tracker):
     The estimate is the weighted mean of the last layer (β_0 = 1), or of its main mode
     (``estimate``). With one layer this is
     the bootstrap (SIR) filter with random-walk noise ``sigma``.
+
+    The parameters are the fields of ``AnnealedParams``, and ``rng``.
 
     Parameters
     ----------
@@ -195,10 +239,10 @@ class AnnealedPF(Tracker):
 
     Attributes
     ----------
-    particles : ndarray of shape (K, N, 2)
+    particles : ndarray of shape (N, K, 2)
         Particle centres after the last step.
-    weights : ndarray of shape (K, N)
-        Their normalised weights of the last layer.
+    weights : ndarray of shape (N, K)
+        Their normalised weights of the last layer (each column sums to 1).
 
     Notes
     -----
@@ -212,70 +256,53 @@ class AnnealedPF(Tracker):
     """
 
     name = "annealed"
+    Params = AnnealedParams
 
-    def __init__(self, *, n_particles: int = 100, n_layers: int = 3, lam: float = 1000.0,
-                 sigma: float | Sequence[float] = 12.0, sigma_decay: float = 0.5,
-                 schedule: str = "adaptive", alpha: float = 0.5, beta_ratio: float = 0.5,
-                 estimate: str = "mean", resampler: str = "systematic", kernel: str = "cone",
-                 bins: int = 10, rng: RngLike = None) -> None:
-        super().__init__(rng=rng)
-        check_particles(n_particles, lam, resampler)
-        if int(n_layers) != n_layers or n_layers < 1:
-            raise ValueError(f"n_layers must be an integer >= 1, got {n_layers!r}")
-        if schedule not in SCHEDULES:
-            raise ValueError(f"unknown schedule {schedule!r}; valid schedules: "
-                             f"{', '.join(SCHEDULES)}")
-        if estimate not in ESTIMATES:
-            raise ValueError(f"unknown estimate {estimate!r}; valid estimates: "
-                             f"{', '.join(ESTIMATES)}")
-        if not 0.0 < alpha < 1.0:
-            raise ValueError(f"alpha must lie in (0, 1), got {alpha!r}")
-        if not 0.0 < beta_ratio <= 1.0:
-            raise ValueError(f"beta_ratio must lie in (0, 1], got {beta_ratio!r}")
-        if not 0.0 < sigma_decay <= 1.0:
-            raise ValueError(f"sigma_decay must lie in (0, 1], got {sigma_decay!r}")
-        check_kernel_bins(kernel, bins)
-        self.n_particles = int(n_particles)
-        self.n_layers = int(n_layers)
-        self.lam = float(lam)
-        self.sigmas = _layer_sigmas(sigma, sigma_decay, self.n_layers)
-        self.schedule = schedule
-        self.alpha = float(alpha)
-        self.beta_ratio = float(beta_ratio)
-        self.estimate = estimate
-        self.resampler = resampler
-        self.kernel = kernel
-        self.bins = int(bins)
+    def _configure(self, params: AnnealedParams) -> None:
+        self.sigmas = params.layer_sigmas()
+
+    @property
+    def particles(self) -> NDArray[np.float64]:
+        """Particle centres (N, K, 2) after the last step (a view of the object-major sets)."""
+        return self._sets.swapaxes(0, 1)
+
+    @property
+    def weights(self) -> NDArray[np.float64]:
+        """Normalised weights (N, K) of the last layer; each column sums to 1."""
+        return self._set_weights.swapaxes(0, 1)
 
     def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
-        self.targets = ColourTargets(frame, boxes, kernel=self.kernel, bins=self.bins,
-                                     lam=self.lam)
+        p = self.params
+        self.model = colour_model(frame, boxes, p, lam=p.lam)
+        self.sizes = boxes[:, 2:4].copy()
         centres = boxes[:, :2] + 0.5 * boxes[:, 2:4]
-        self.particles = np.repeat(centres[:, None, :], self.n_particles, axis=1)
-        self.weights = np.full((self.n_targets, self.n_particles), 1.0 / self.n_particles)
+        # Object-major sets (K, N, 2) and weights (K, N) (``trackers.meanshift``).
+        self._sets = np.repeat(centres[:, None, :], p.n_particles, axis=1)
+        self._set_weights = np.full((self.n_targets, p.n_particles), 1.0 / p.n_particles)
 
-    def _move(self, obs: FrameObservation, particles: NDArray[np.float64]) -> None:
-        """Move the particles (K, N, 2) in place after a layer's noise; the annealed PF
-        does not."""
+    def _move(self, obs: FrameObservation, sets: NDArray[np.float64]) -> None:
+        """Move the per-object sets (K, N, 2) in place after a layer's noise; the annealed
+        PF does not."""
 
     def _step(self, frame: NDArray[np.uint8]) -> Estimate:
-        obs = self.targets.observe(frame)
-        x, w = self.particles, self.weights
-        betas = np.empty((self.n_targets, self.n_layers))
-        for j in range(self.n_layers):
-            m = self.n_layers - 1 - j
-            x = resample_targets(x, w, self.rng, self.resampler)
+        p = self.params
+        obs = self.model.observe(frame)
+        x, w = self._sets, self._set_weights
+        betas = np.empty((self.n_targets, p.n_layers))
+        for j in range(p.n_layers):
+            m = p.n_layers - 1 - j
+            x = resample_targets(x, w, self.rng, p.resampler)
             x += self.sigmas[j] * self.rng.standard_normal(x.shape)
             keep_inside(x, frame.shape)
             self._move(obs, x)
-            log_lik = self.targets.log_likelihoods(obs, x)
+            log_lik = set_log_likelihoods(obs, x, self.sizes)
             betas[:, j] = self._beta(log_lik, m)
             w = normalised_weights(betas[:, j, None] * log_lik)
-        self.particles, self.weights = x, w
-        radius = 0.5 * self.targets.sizes.min(axis=1) if self.estimate == "mode" else None
+        self._sets, self._set_weights = x, w
+        radius = 0.5 * self.sizes.min(axis=1) if p.estimate == "mode" else None
         centres = weighted_estimate(x, w, radius)[:, None, :]
-        confidence = 1.0 - self.targets.distances(obs, centres)[:, 0]
-        return Estimate(self.targets.boxes(centres)[:, 0],
+        confidence = 1.0 - set_distances(obs, centres, self.sizes)[:, 0]
+        return Estimate(window_boxes(centres, self.sizes)[:, 0],
                         {"confidence": confidence, "beta": betas})
 
     def _beta(self, log_lik: NDArray[np.float64], m: int) -> NDArray[np.float64]:
@@ -283,9 +310,9 @@ class AnnealedPF(Tracker):
         k = log_lik.shape[0]
         if m == 0:
             return np.ones(k)
-        if self.schedule == "geometric":
-            return np.full(k, self.beta_ratio**m)
-        return survival_beta(log_lik, self.alpha)
+        if self.params.schedule == "geometric":
+            return np.full(k, self.params.beta_ratio**m)
+        return survival_beta(log_lik, self.params.alpha)
 
 
 def _layer_sigmas(sigma: float | Sequence[float], decay: float,

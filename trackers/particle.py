@@ -3,16 +3,21 @@
 All four share the observation model (``trackers.models.observation``: colour histograms, one
 compiled call per sampling stage for every particle of every object), the AR2 dynamics of
 (u, v, a) (``trackers.models.dynamics``) and the resamplers (``trackers.filters.resampling``); they
-differ only in how they sample the joint state (ALGORITHMS.md §3):
+differ only in how they sample the joint state (docs/algorithms.md §2):
 
 - ``Condensation`` ("condensation"): one independent single-object filter per target
-  (Isard & Blake 1998); the M = 1 case of §3.1, run side by side.
+  (Isard & Blake 1998); the one-object joint filter, run side by side.
 - ``JointPF`` ("joint-pf", the paper's "Non-PS"): one filter over the joint state;
   resample, propagate every object, weight by the joint likelihood Π_i p(Z | X_i).
-- ``PartitionedSampling`` ("ps", §3.3): objects one at a time in an ``ordering``;
+- ``PartitionedSampling`` ("ps", DPS §3): objects one at a time in an ``ordering``;
   weighted resampling by each object's likelihood before the next object moves.
-- ``DistributedPartitionedSampling`` ("dps", §3.4): the set split into ``n_groups``
+- ``DistributedPartitionedSampling`` ("dps", DPS §4): the set split into ``n_groups``
   mixture components, each running PS with its own circular-shift ordering.
+
+The observation model is swappable: the keyword ``observation`` takes any
+``trackers.models.observation.ObservationModel`` (e.g. ``PositionModel``, a Gaussian
+likelihood of the box centre around measured positions) in place of the colour model.
+Parameters are the fields of ``ParticleParams`` (``PSParams``, ``DPSParams``).
 
 Every step starts by resampling the set by the previous step's weights, so after a step
 ``self.particles`` (N, K, 3) and ``self.weights`` are the weighted set that represents
@@ -37,22 +42,33 @@ True
 from __future__ import annotations
 
 from abc import abstractmethod
-from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
-from trackers.base import Estimate, RngLike, Tracker
+from trackers.base import Estimate, Tracker
 from trackers.filters.diagnostics import effective_dynamics, uniqueness
 from trackers.filters.resampling import RESAMPLERS, resample, weighted_resample_groups
+from trackers.filters.weights import log_sum_exp_groups, normalised_weights
+from trackers.kernels.histogram import DEFAULT_BOX_LEVELS, KERNELS
 from trackers.models.dynamics import AR2, boxes_from_states, states_from_boxes
-from trackers.models.observation import ColourModel, FrameObservation
+from trackers.models.observation import (
+    MODELS,
+    ColourModel,
+    FrameLikelihood,
+    ObservationModel,
+)
+from trackers.params import TrackerParams, check_choice, check_integer, check_number
 
 __all__ = [
     "ASSIGNMENTS",
     "Condensation",
+    "DPSParams",
     "DistributedPartitionedSampling",
     "JointPF",
+    "PSParams",
+    "ParticleParams",
     "PartitionedSampling",
     "circular_shift",
 ]
@@ -66,70 +82,159 @@ def circular_shift(n_objects: int, k: int) -> NDArray[np.int64]:
     return (np.arange(n_objects) + k) % n_objects
 
 
-def _normalised_weights(logw: NDArray[np.float64]) -> NDArray[np.float64]:
-    """exp(logw) / Σ exp(logw), computed without overflow."""
-    w = np.exp(logw - logw.max())
-    return w / w.sum()
-
-
-def _group_log_sum_exp(x: NDArray[np.float64], starts: NDArray[np.int64],
-                       sizes: NDArray[np.int64]) -> NDArray[np.float64]:
-    """log Σ exp(x) over each contiguous group, shape (C,), without overflow."""
-    m = np.maximum.reduceat(x, starts)
-    return m + np.log(np.add.reduceat(np.exp(x - np.repeat(m, sizes)), starts))
-
-
-class _ParticleTracker(Tracker):
-    """Shared parameters, initialisation, estimate and diagnostics of the four filters.
+@dataclass(frozen=True)
+class ParticleParams(TrackerParams):
+    """Parameters of the four particle filters (condensation, joint-pf; PS and DPS add theirs).
 
     Parameters
     ----------
     n_particles : int, optional
         N, particles of the whole set (DPS: 300 synthetic, 200 real).
     lam : float, optional
-        λ of the likelihood exp(−λ d²).
+        λ of the likelihood exp(−λ d²), > 0.
     model : {"hsv", "rgb"}, optional
-        Observation model (``trackers.models.observation``).
+        Colour-histogram observation model (``trackers.models.observation``).
     bins : int, optional
-        Histogram bins per colour channel.
+        Histogram bins per colour channel, in [1, 256].
     n_parts : int or None, optional
         Spatial components (horizontal bands) of a region; None: the model's default.
-    kernel : {"uniform", "epanechnikov", "cone"} or None, optional
+    kernel : {"uniform", "epanechnikov", "cone", "box"} or None, optional
         Kernel weighting the pixels of a region; None: the model's default.
+    box_levels : int, optional
+        Levels of the "box" kernel (nested rectangles), in [1, 16].
     sigma : tuple of 3 floats, optional
         (σ_u, σ_v, σ_a) of the AR2 tracking dynamics (DPS: 2, 2, 0.001).
     a1, a2 : float, optional
         AR2 coefficients (2, −1: constant velocity).
     resampler : {"systematic", "multinomial", "stratified", "residual"}, optional
         Resampling scheme of every (weighted) resampling step.
-    rng : numpy.random.Generator, int or None, optional
-        Source of randomness; the same seed gives the same track.
+    observation : ObservationModel or None, optional
+        The observation model, replacing the colour-histogram model built from ``lam``,
+        ``model``, ``bins``, ``n_parts`` and ``kernel`` (which are then unused): any object
+        with ``set_references(frame, boxes)`` and ``observe(frame)`` returning per-box
+        log-likelihoods (the protocol ``trackers.models.observation.ObservationModel``).
     """
 
-    def __init__(
-        self,
-        *,
-        n_particles: int = 300,
-        lam: float = 20.0,
-        model: str = "hsv",
-        bins: int = 10,
-        n_parts: int | None = None,
-        kernel: str | None = None,
-        sigma: Sequence[float] = (2.0, 2.0, 0.001),
-        a1: float = 2.0,
-        a2: float = -1.0,
-        resampler: str = "systematic",
-        rng: RngLike = None,
-    ) -> None:
-        super().__init__(rng=rng)
-        if isinstance(n_particles, bool) or int(n_particles) != n_particles or n_particles < 1:
-            raise ValueError(f"n_particles must be a positive integer, got {n_particles!r}")
-        if resampler not in RESAMPLERS:
-            raise ValueError(f"unknown resampler {resampler!r}; valid: {', '.join(RESAMPLERS)}")
-        self.n_particles = int(n_particles)
-        self.resampler = resampler
-        self.model = ColourModel(model, bins=bins, n_parts=n_parts, kernel=kernel, lam=lam)
-        self.dynamics = AR2(sigma=tuple(float(s) for s in sigma), a1=float(a1), a2=float(a2))
+    n_particles: int = 300
+    lam: float = 20.0
+    model: str = "hsv"
+    bins: int = 10
+    n_parts: int | None = None
+    kernel: str | None = None
+    box_levels: int = DEFAULT_BOX_LEVELS
+    sigma: tuple[float, float, float] = (2.0, 2.0, 0.001)
+    a1: float = 2.0
+    a2: float = -1.0
+    resampler: str = "systematic"
+    observation: ObservationModel | None = None
+
+    def __post_init__(self) -> None:
+        check_integer(self, "n_particles", low=1)
+        check_number(self, "lam", low=0.0, low_open=True)
+        check_choice(self, "model", MODELS, what="observation model")
+        check_integer(self, "bins", low=1, high=256)
+        check_integer(self, "n_parts", low=1, optional=True)
+        if self.kernel is not None:
+            check_choice(self, "kernel", KERNELS)
+        check_integer(self, "box_levels", low=1, high=16)
+        check_sigma3(self, "sigma")
+        check_number(self, "a1")
+        check_number(self, "a2")
+        check_choice(self, "resampler", RESAMPLERS, what="resampler")
+        check_observation(self, "observation")
+
+
+@dataclass(frozen=True)
+class PSParams(ParticleParams):
+    """Parameters of partitioned sampling: ``ParticleParams`` and ``ordering``.
+
+    Parameters
+    ----------
+    ordering : int or tuple of int, optional
+        The order in which objects are sampled: an int k is the k-th circular shift
+        (k, k+1, …, K−1, 0, …, k−1) of the targets (0 ≤ k < K; the paper's orderings),
+        a sequence is an explicit permutation of 0…K−1 (stored as a tuple).
+    """
+
+    ordering: int | tuple[int, ...] = 0
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        order = self.ordering
+        if isinstance(order, (int, np.integer)) and not isinstance(order, bool):
+            if order < 0:
+                raise ValueError(f"ordering must be a circular shift >= 0 or a permutation, "
+                                 f"got {order!r}")
+            self._set("ordering", int(order))
+            return
+        try:
+            self._set("ordering", tuple(int(o) for o in order))
+        except (TypeError, ValueError):
+            raise ValueError(f"ordering must be an int (circular shift) or a sequence of "
+                             f"target indices, got {order!r}") from None
+
+
+@dataclass(frozen=True)
+class DPSParams(ParticleParams):
+    """Parameters of distributed partitioned sampling: ``ParticleParams`` and the groups.
+
+    Parameters
+    ----------
+    n_groups : int or None, optional
+        C, the number of mixture components, in [1, n_particles]; None: one per target
+        (the paper's C = M).
+    assignment : {"random", "interleaved"}, optional
+        How particles are assigned to components (``DistributedPartitionedSampling``).
+    """
+
+    n_groups: int | None = None
+    assignment: str = "random"
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        check_integer(self, "n_groups", low=1, high=self.n_particles, optional=True)
+        check_choice(self, "assignment", ASSIGNMENTS)
+
+
+def check_sigma3(params: TrackerParams, name: str) -> None:
+    """Field ``name``: three finite numbers >= 0 (σ_u, σ_v, σ_a), stored as a tuple."""
+    value = getattr(params, name)
+    try:
+        sig = tuple(float(v) for v in value)
+    except (TypeError, ValueError):
+        sig = ()
+    if len(sig) != 3 or not all(np.isfinite(v) and v >= 0 for v in sig):
+        raise ValueError(f"{name} must be 3 finite non-negative numbers (u, v, a), got "
+                         f"{value!r}")
+    params._set(name, sig)
+
+
+def check_observation(params: TrackerParams, name: str) -> None:
+    """Field ``name``: None or an object with ``set_references`` and ``observe``."""
+    value = getattr(params, name)
+    if value is not None and not isinstance(value, ObservationModel):
+        raise ValueError(f"{name} must be None or an observation model with methods "
+                         f"set_references(frame, boxes) and observe(frame), got "
+                         f"{type(value).__name__}")
+
+
+class _ParticleTracker(Tracker):
+    """Shared initialisation, estimate and diagnostics of the four filters.
+
+    Parameters: ``ParticleParams`` (fields as keywords), and ``rng``: the source of
+    randomness; the same seed gives the same track.
+    """
+
+    Params = ParticleParams
+
+    def _configure(self, params: ParticleParams) -> None:
+        if params.observation is not None:
+            self.model = params.observation
+        else:
+            self.model = ColourModel(params.model, bins=params.bins, n_parts=params.n_parts,
+                                     kernel=params.kernel, lam=params.lam,
+                                     box_levels=params.box_levels)
+        self.dynamics = AR2(sigma=params.sigma, a1=params.a1, a2=params.a2)
         self.particles = np.empty((0, 0, 3))
         self.weights = np.empty(0)
 
@@ -137,7 +242,7 @@ class _ParticleTracker(Tracker):
         self.model.set_references(frame, boxes)
         states, self._sizes = states_from_boxes(boxes)
         self._mean = states
-        n = self.n_particles
+        n = self.params.n_particles
         self.particles = np.repeat(states[None], n, axis=0)
         self._prev = self.particles.copy()
         self.weights = np.full(n, 1.0 / n)
@@ -166,19 +271,20 @@ class Condensation(_ParticleTracker):
     With one target it is PS with one object, draw for draw.
 
     After a step ``weights`` has shape (N, K): column k weights target k's filter.
-    Parameters: see ``_ParticleTracker``.
+    Parameters: ``ParticleParams`` as keywords, and ``rng``.
     """
 
     name = "condensation"
 
     def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
         super()._init(frame, boxes)
-        self.weights = np.full((self.n_particles, self.n_targets), 1.0 / self.n_particles)
+        n = self.params.n_particles
+        self.weights = np.full((n, self.n_targets), 1.0 / n)
 
     def _step(self, frame: NDArray[np.uint8]) -> Estimate:
         obs = self.model.observe(frame)
-        n, k = self.n_particles, self.n_targets
-        idx = np.column_stack([resample(self.weights[:, i], method=self.resampler,
+        n, k = self.params.n_particles, self.n_targets
+        idx = np.column_stack([resample(self.weights[:, i], method=self.params.resampler,
                                         rng=self.rng) for i in range(k)])
         cols = np.arange(k)
         x = self.particles[idx, cols]
@@ -189,24 +295,24 @@ class Condensation(_ParticleTracker):
         ll = ll.reshape(n, k)
         self._prev = x
         self.particles = new
-        self.weights = np.column_stack([_normalised_weights(ll[:, i]) for i in range(k)])
+        self.weights = np.column_stack([normalised_weights(ll[:, i]) for i in range(k)])
         return self._estimate(self.weights)
 
 
 class JointPF(_ParticleTracker):
-    """Joint particle filter over all targets ("Non-PS", ALGORITHMS.md §3.1).
+    """Joint particle filter over all targets ("Non-PS", docs/algorithms.md §2.3).
 
     Resample the joint set, propagate every object, weight by Π_i p(Z | X_i). The
     likelihoods of all N × K candidate boxes come from one kernel call.
-    Parameters: see ``_ParticleTracker``.
+    Parameters: ``ParticleParams`` as keywords, and ``rng``.
     """
 
     name = "joint-pf"
 
     def _step(self, frame: NDArray[np.uint8]) -> Estimate:
         obs = self.model.observe(frame)
-        n, k = self.n_particles, self.n_targets
-        idx = resample(self.weights, method=self.resampler, rng=self.rng)
+        n, k = self.params.n_particles, self.n_targets
+        idx = resample(self.weights, method=self.params.resampler, rng=self.rng)
         x = self.particles[idx]
         prev = self._prev[idx]
         new = self.dynamics.propagate(x, prev, self._mean, rng=self.rng)
@@ -214,7 +320,7 @@ class JointPF(_ParticleTracker):
         ll = obs.log_likelihoods(self._boxes(new.reshape(-1, 3), objects), objects)
         self._prev = x
         self.particles = new
-        self.weights = _normalised_weights(ll.reshape(n, k).sum(axis=1))
+        self.weights = normalised_weights(ll.reshape(n, k).sum(axis=1))
         return self._estimate(np.repeat(self.weights[:, None], k, axis=1))
 
 
@@ -229,9 +335,9 @@ class _Partitioned(_ParticleTracker):
         are contiguous, the group sizes (C,) and each group's ordering (C, M)."""
 
     def _partitioned_step(self, frame: NDArray[np.uint8]) -> tuple[Estimate, NDArray]:
-        obs: FrameObservation = self.model.observe(frame)
-        n, m = self.n_particles, self.n_targets
-        idx = resample(self.weights, method=self.resampler, rng=self.rng)
+        obs: FrameLikelihood = self.model.observe(frame)
+        n, m = self.params.n_particles, self.n_targets
+        idx = resample(self.weights, method=self.params.resampler, rng=self.rng)
         x, prev, sizes, orderings = self._groups(self.particles[idx], self._prev[idx])
         group = np.repeat(np.arange(sizes.size), sizes)
         rows = np.arange(n)
@@ -247,7 +353,7 @@ class _Partitioned(_ParticleTracker):
             stage = obs.log_likelihoods(self._boxes(new, obj), obj)
             ll[rows, obj] = stage
             if j < m - 1:
-                # §3.3 weighted resampling inside each group with the weighting function
+                # Weighted resampling (DPS §3) inside each group with the weighting function
                 # g_j = Π_{i<=j} p(Z | X_{o_i}) of the objects placed so far. The carried
                 # weights are π ∝ 1 / g_{j-1}, so ancestors are drawn ∝ p(Z | X_{o_j}) and
                 # the particles stay concentrated where every placed object is likely;
@@ -256,7 +362,7 @@ class _Partitioned(_ParticleTracker):
                 log_g += stage
                 k, w = weighted_resample_groups(
                     np.exp(logpi - logpi.max()), np.exp(log_g - log_g.max()), sizes,
-                    method=self.resampler, rng=self.rng)
+                    method=self.params.resampler, rng=self.rng)
                 x, prev, ll, log_g = x[k], prev[k], ll[k], log_g[k]
                 logpi = np.log(w)
         # The set {x, π'} still represents the predicted joint state (weighted resampling
@@ -272,7 +378,7 @@ class _Partitioned(_ParticleTracker):
     @staticmethod
     def _reassemble(logw: NDArray[np.float64], logpi: NDArray[np.float64],
                     sizes: NDArray[np.int64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Mixture reassembly (§3.4, after Vermaak, Doucet & Pérez 2003).
+        """Mixture reassembly (DPS §4, after Vermaak, Doucet & Pérez 2003).
 
         π_c,t ∝ π_c,t−1 Σ_{n∈c} w̃_n, and particle n of group c gets π_c,t w̃_n / Σ_c w̃,
         with w̃_n = π'_n Π_i p(Z | X_i) (log ``logw``) and π' the group's proposal weights
@@ -282,79 +388,42 @@ class _Partitioned(_ParticleTracker):
         plain normalisation. Returns the weights (N,) and the mixture weights (C,).
         """
         if sizes.size == 1:
-            return _normalised_weights(logw), np.ones(1)
+            return normalised_weights(logw), np.ones(1)
         starts = np.cumsum(sizes) - sizes
-        log_total = _group_log_sum_exp(logw, starts, sizes)
-        log_evidence = log_total - _group_log_sum_exp(logpi, starts, sizes)
-        mixture = _normalised_weights(np.log(sizes / sizes.sum()) + log_evidence)
+        log_total = log_sum_exp_groups(logw, starts, sizes)
+        log_evidence = log_total - log_sum_exp_groups(logpi, starts, sizes)
+        mixture = normalised_weights(np.log(sizes / sizes.sum()) + log_evidence)
         logw_final = logw + np.repeat(np.log(mixture) - log_total, sizes)
-        return _normalised_weights(logw_final), mixture
+        return normalised_weights(logw_final), mixture
 
 
 class PartitionedSampling(_Partitioned):
-    """Partitioned sampling (MacCormick & Blake 2000; ALGORITHMS.md §3.3).
+    """Partitioned sampling (MacCormick & Blake 2000; docs/algorithms.md §2.5).
 
-    Parameters
-    ----------
-    ordering : int or sequence of int, optional
-        The order in which objects are sampled: an int k is the k-th circular shift
-        (k, k+1, …, K−1, 0, …, k−1) of the targets (0 ≤ k < K; the paper's orderings),
-        a sequence is an explicit permutation of 0…K−1.
-    **params
-        See ``_ParticleTracker`` (n_particles, lam, model, bins, n_parts, kernel, sigma,
-        a1, a2, resampler, rng).
+    Parameters: ``PSParams`` (``ordering`` and the ``ParticleParams``) as keywords, and
+    ``rng``.
     """
 
     name = "ps"
-
-    def __init__(
-        self,
-        *,
-        ordering: int | Sequence[int] = 0,
-        n_particles: int = 300,
-        lam: float = 20.0,
-        model: str = "hsv",
-        bins: int = 10,
-        n_parts: int | None = None,
-        kernel: str | None = None,
-        sigma: Sequence[float] = (2.0, 2.0, 0.001),
-        a1: float = 2.0,
-        a2: float = -1.0,
-        resampler: str = "systematic",
-        rng: RngLike = None,
-    ) -> None:
-        super().__init__(n_particles=n_particles, lam=lam, model=model, bins=bins,
-                         n_parts=n_parts, kernel=kernel, sigma=sigma, a1=a1, a2=a2,
-                         resampler=resampler, rng=rng)
-        if isinstance(ordering, (int, np.integer)) and not isinstance(ordering, bool):
-            if ordering < 0:
-                raise ValueError(f"ordering must be a circular shift >= 0 or a permutation, "
-                                 f"got {ordering!r}")
-        else:
-            try:
-                ordering = [int(o) for o in ordering]
-            except (TypeError, ValueError):
-                raise ValueError(f"ordering must be an int (circular shift) or a sequence of "
-                                 f"target indices, got {ordering!r}") from None
-        self.ordering = ordering
+    Params = PSParams
 
     def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
         k = boxes.shape[0]
-        if isinstance(self.ordering, list):
-            order = np.asarray(self.ordering, dtype=np.int64)
+        if isinstance(self.params.ordering, tuple):
+            order = np.asarray(self.params.ordering, dtype=np.int64)
             if sorted(order.tolist()) != list(range(k)):
-                raise ValueError(f"ordering {self.ordering} is not a permutation of the "
-                                 f"{k} targets 0..{k - 1}")
+                raise ValueError(f"ordering {list(self.params.ordering)} is not a permutation "
+                                 f"of the {k} targets 0..{k - 1}")
         else:
-            if self.ordering >= k:
+            if self.params.ordering >= k:
                 raise ValueError(f"ordering (circular shift) must lie in [0, {k}) for {k} "
-                                 f"targets, got {self.ordering}")
-            order = circular_shift(k, int(self.ordering))
+                                 f"targets, got {self.params.ordering}")
+            order = circular_shift(k, int(self.params.ordering))
         self._order = order[None, :]
         super()._init(frame, boxes)
 
     def _groups(self, x, prev):
-        return x, prev, np.array([self.n_particles]), self._order
+        return x, prev, np.array([self.params.n_particles]), self._order
 
     def _step(self, frame: NDArray[np.uint8]) -> Estimate:
         est, _ = self._partitioned_step(frame)
@@ -362,7 +431,7 @@ class PartitionedSampling(_Partitioned):
 
 
 class DistributedPartitionedSampling(_Partitioned):
-    """Distributed partitioned sampling (Smith & Gatica-Perez 2004; ALGORITHMS.md §3.4).
+    """Distributed partitioned sampling (Smith & Gatica-Perez 2004; docs/algorithms.md §2.6).
 
     Each step the resampled set is divided into ``n_groups`` mixture components of
     N / C particles (the remainder spread over the first groups); component c runs PS
@@ -370,71 +439,35 @@ class DistributedPartitionedSampling(_Partitioned):
     mixture weights π_c,t ∝ π_c,t−1 Σ_{n∈c} w̃_n. All components of a sampling stage are
     scored in one kernel call. ``Estimate.extras["mixture_weights"]`` is (C,).
 
-    Parameters
-    ----------
-    n_groups : int or None, optional
-        C, the number of mixture components; None: one per target (the paper's C = M).
-        1 gives PS with the identity ordering, draw for draw.
-    assignment : {"random", "interleaved"}, optional
-        **(open)** How particles are assigned to components. "random" (the paper): a
-        uniformly random partition, drawn each step. "interleaved": particle n of the
-        resampled set goes to component n mod C; systematic resampling leaves copies of
-        one ancestor next to each other, so this spreads them over the components
-        (stratified assignment) and uses no randomness.
-    **params
-        See ``_ParticleTracker`` (n_particles, lam, model, bins, n_parts, kernel, sigma,
-        a1, a2, resampler, rng).
+    Parameters: ``DPSParams`` (``n_groups``, ``assignment`` and the ``ParticleParams``)
+    as keywords, and ``rng``. ``n_groups=1`` gives PS with the identity ordering, draw
+    for draw. **(open)** ``assignment``: "random" (the paper) draws a uniformly random
+    partition each step; "interleaved" sends particle n of the resampled set to
+    component n mod C: systematic resampling leaves copies of one ancestor next to each
+    other, so this spreads them over the components (stratified assignment) and uses no
+    randomness.
     """
 
     name = "dps"
-
-    def __init__(
-        self,
-        *,
-        n_groups: int | None = None,
-        assignment: str = "random",
-        n_particles: int = 300,
-        lam: float = 20.0,
-        model: str = "hsv",
-        bins: int = 10,
-        n_parts: int | None = None,
-        kernel: str | None = None,
-        sigma: Sequence[float] = (2.0, 2.0, 0.001),
-        a1: float = 2.0,
-        a2: float = -1.0,
-        resampler: str = "systematic",
-        rng: RngLike = None,
-    ) -> None:
-        super().__init__(n_particles=n_particles, lam=lam, model=model, bins=bins,
-                         n_parts=n_parts, kernel=kernel, sigma=sigma, a1=a1, a2=a2,
-                         resampler=resampler, rng=rng)
-        if n_groups is not None and (isinstance(n_groups, bool) or int(n_groups) != n_groups
-                                     or not 1 <= n_groups <= self.n_particles):
-            raise ValueError(f"n_groups must be an integer in [1, n_particles = "
-                             f"{self.n_particles}] or None, got {n_groups!r}")
-        if assignment not in ASSIGNMENTS:
-            raise ValueError(f"unknown assignment {assignment!r}; valid: "
-                             f"{', '.join(ASSIGNMENTS)}")
-        self.n_groups = None if n_groups is None else int(n_groups)
-        self.assignment = assignment
+    Params = DPSParams
 
     def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
         k = boxes.shape[0]
-        c = k if self.n_groups is None else self.n_groups
-        if c > self.n_particles:
+        c = k if self.params.n_groups is None else self.params.n_groups
+        if c > self.params.n_particles:
             raise ValueError(f"n_groups = {c} (one per target) exceeds n_particles = "
-                             f"{self.n_particles}")
-        n = self.n_particles
+                             f"{self.params.n_particles}")
+        n = self.params.n_particles
         self._sizes_c = np.array([n // c + (i < n % c) for i in range(c)], dtype=np.int64)
         self._orders = np.stack([circular_shift(k, i % k) for i in range(c)])
-        if self.assignment == "interleaved":
+        if self.params.assignment == "interleaved":
             self._interleave = np.concatenate([np.arange(i, n, c) for i in range(c)])
         super()._init(frame, boxes)
 
     def _groups(self, x, prev):
         if self._sizes_c.size > 1:
-            if self.assignment == "random":
-                order = self.rng.permutation(self.n_particles)
+            if self.params.assignment == "random":
+                order = self.rng.permutation(self.params.n_particles)
             else:
                 order = self._interleave
             x, prev = x[order], prev[order]

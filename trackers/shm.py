@@ -1,7 +1,7 @@
 """Switching hypothesized measurements (SHM) trackers: positions and depth order.
 
 Wang, Tan & Loe, "Switching hypothesized measurements: a dynamic model with applications
-to occlusion adaptive joint tracking" (IJCAI 2007); ALGORITHMS.md §5.
+to occlusion adaptive joint tracking" (IJCAI 2007); docs/algorithms.md §4.
 
 Model (§2.2). ``M`` objects, ``L = M!`` depth orderings ``s_t`` (``self.orderings``, each
 row nearest first). ``s_t`` is a first-order Markov chain (eq. 1) that stays with
@@ -67,20 +67,26 @@ objects (two crossing, 30x30 px) about 12 ms per frame for ``shm-fast`` and 70 m
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from numpy.typing import NDArray
 
-from trackers.base import Estimate, RngLike, Tracker
+from trackers.base import Estimate, Tracker
 from trackers.filters.kalman import KalmanFilter
-from trackers.kalman import (
-    boxes_at,
-    check_noise,
-    measurement_cov,
-    motion_model,
-)
-from trackers.models.layered import LayeredMatcher, check_matcher_params, orderings
+from trackers.filters.weights import normalised_weights
+from trackers.kalman import KalmanParams, boxes_at, measurement_cov
+from trackers.models.layered import LayeredMatcher, orderings
+from trackers.params import check_choice, check_number
 
-__all__ = ["EVIDENCES", "FastSHMTracker", "SHMTracker", "transition_matrix"]
+__all__ = [
+    "EVIDENCES",
+    "FastSHMTracker",
+    "FastShmParams",
+    "SHMTracker",
+    "ShmParams",
+    "transition_matrix",
+]
 
 
 def transition_matrix(n_orderings: int, p_stay: float) -> NDArray[np.float64]:
@@ -90,11 +96,6 @@ def transition_matrix(n_orderings: int, p_stay: float) -> NDArray[np.float64]:
     pi = np.full((n_orderings, n_orderings), (1.0 - p_stay) / (n_orderings - 1))
     np.fill_diagonal(pi, p_stay)
     return pi
-
-
-def _softmax(logw: NDArray[np.float64], axis: int = -1) -> NDArray[np.float64]:
-    w = np.exp(logw - np.max(logw, axis=axis, keepdims=True))
-    return w / np.sum(w, axis=axis, keepdims=True)
 
 
 EVIDENCES = ("union", "objects")
@@ -142,62 +143,45 @@ class _OrderingEvidence:
         return out
 
 
-def _check_shm(
-    p_stay: float, lam: float, mse_rate: float, mse_floor: float, evidence: str
-) -> None:
-    if evidence not in EVIDENCES:
-        raise ValueError(f"unknown evidence {evidence!r}; valid: {', '.join(EVIDENCES)}")
-    if not (np.isfinite(p_stay) and 0 < p_stay <= 1):
-        raise ValueError(f"p_stay must be in (0, 1], got {p_stay!r}")
-    if not (np.isfinite(lam) and lam >= 0):
-        raise ValueError(f"lam must be finite and >= 0, got {lam!r}")
-    if not (np.isfinite(mse_rate) and 0 < mse_rate <= 1):
-        raise ValueError(f"mse_rate must be in (0, 1], got {mse_rate!r}")
-    if not (np.isfinite(mse_floor) and mse_floor > 0):
-        raise ValueError(f"mse_floor must be finite and > 0, got {mse_floor!r}")
+@dataclass(frozen=True)
+class FastShmParams(KalmanParams):
+    """Parameters of "shm-fast": ``KalmanParams`` and the ordering evidence's (documented on
+    ``SHMTracker``)."""
+
+    p_stay: float = 0.8
+    lam: float = 1.0
+    mse_rate: float = 0.1
+    mse_floor: float = 25.0
+    evidence: str = "union"
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        check_choice(self, "evidence", EVIDENCES)
+        check_number(self, "p_stay", low=0.0, high=1.0, low_open=True)
+        check_number(self, "lam", low=0.0)
+        check_number(self, "mse_rate", low=0.0, high=1.0, low_open=True)
+        check_number(self, "mse_floor", low=0.0, low_open=True)
+
+
+@dataclass(frozen=True)
+class ShmParams(FastShmParams):
+    """Parameters of "shm": ``FastShmParams`` and ``use_mse`` (documented on ``SHMTracker``)."""
+
+    use_mse: bool = True
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if self.use_mse not in (True, False):  # bool, numpy bool, 0 or 1
+            raise ValueError(f"use_mse must be True or False, got {self.use_mse!r}")
+        self._set("use_mse", bool(self.use_mse))
 
 
 class _SHMBase(Tracker):
     """Parameter handling and measurement shared by the two SHM trackers."""
 
-    def _configure(
-        self,
-        motion: str,
-        process_std: float,
-        a1: float,
-        a2: float,
-        velocity_std: float,
-        r_gain: float,
-        r_floor: float,
-        search_radius: int,
-        step: int,
-        min_visible: float,
-        support: str,
-        blur: float,
-        p_stay: float,
-        lam: float,
-        mse_rate: float,
-        mse_floor: float,
-        evidence: str,
-    ) -> None:
-        self.model = motion_model(motion, process_std, a1, a2, velocity_std)
-        check_noise(r_gain, r_floor)
-        check_matcher_params(search_radius, step, min_visible, support, blur)
-        _check_shm(p_stay, lam, mse_rate, mse_floor, evidence)
-        self.evidence = evidence
-        self.r_gain = float(r_gain)
-        self.r_floor = float(r_floor)
-        self.p_stay = float(p_stay)
-        self.lam = float(lam)
-        self.mse_rate = float(mse_rate)
-        self.mse_floor = float(mse_floor)
-        self._matcher_params = dict(
-            search_radius=search_radius,
-            step=step,
-            min_visible=min_visible,
-            support=support,
-            blur=blur,
-        )
+    def _configure(self, params: FastShmParams) -> None:
+        self.model = params.motion_model()
+        self._matcher_params = params.matcher_params()
 
     def _init_common(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
         # orderings() refuses more than 4 objects with a message saying what to do.
@@ -208,14 +192,17 @@ class _SHMBase(Tracker):
         self._origin = boxes[:, :2] + boxes[:, 2:] / 2
         n_order = self.orderings.shape[0]
         self.order_prob = np.full(n_order, 1.0 / n_order)
+        p = self.params
         self._evidence = _OrderingEvidence(
-            n_order, self.p_stay, self.lam, self.mse_rate, self.mse_floor, self.evidence
+            n_order, p.p_stay, p.lam, p.mse_rate, p.mse_floor, p.evidence
         )
         self._log_u = -np.log(float(frame.shape[0] * frame.shape[1]))
 
 
 class SHMTracker(_SHMBase):
     """SHM filter (§3.2): Gaussian sum over depth orderings with GPB2 collapsing.
+
+    The parameters are the fields of ``ShmParams``, and ``rng``.
 
     Parameters
     ----------
@@ -257,36 +244,7 @@ min_visible, support, blur
     """
 
     name = "shm"
-
-    def __init__(
-        self,
-        *,
-        motion: str = "cv",
-        process_std: float = 1.5,
-        a1: float = 2.0,
-        a2: float = -1.0,
-        velocity_std: float = 5.0,
-        r_gain: float = 0.01,
-        r_floor: float = 0.5,
-        search_radius: int = 12,
-        step: int = 2,
-        min_visible: float = 0.25,
-        support: str = "ellipse",
-        blur: float = 2.0,
-        p_stay: float = 0.8,
-        lam: float = 1.0,
-        mse_rate: float = 0.1,
-        mse_floor: float = 25.0,
-        evidence: str = "union",
-        use_mse: bool = True,
-        rng: RngLike = None,
-    ) -> None:
-        super().__init__(rng=rng)
-        self._configure(
-            motion, process_std, a1, a2, velocity_std, r_gain, r_floor, search_radius, step,
-            min_visible, support, blur, p_stay, lam, mse_rate, mse_floor, evidence,
-        )
-        self.use_mse = bool(use_mse)
+    Params = ShmParams
 
     def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
         self._init_common(frame, boxes)
@@ -298,7 +256,7 @@ min_visible, support, blur
         # One Gaussian per ordering; the state is the displacement from the first centres.
         self.kf = KalmanFilter(
             np.zeros((n_order, self.joint.dim)), self.joint.P0, self.joint.F, self.joint.Q,
-            self.joint.H, np.eye(2 * n_obj) * self.r_floor,
+            self.joint.H, np.eye(2 * n_obj) * self.params.r_floor,
         )
         ii, jj = np.divmod(np.arange(n_order * n_order), n_order)
         self._ii, self._jj = ii, jj
@@ -311,7 +269,7 @@ min_visible, support, blur
         mean = self.order_prob @ kf.x
         meas = self.matcher.measure(frame, self._origin + mean[self._pos], self._rows)
         z = meas.centres - self._origin[None]
-        r = measurement_cov(meas.mse, self.r_gain, self.r_floor)
+        r = measurement_cov(meas.mse, self.params.r_gain, self.params.r_floor)
         ii, jj = self._ii, self._jj
         # Prediction i updated with measurement j, for every pair (i, j).
         pairs = KalmanFilter(kf.x[ii], kf.P[ii], kf.F, kf.Q, kf.H, kf.R[ii])
@@ -327,14 +285,14 @@ min_visible, support, blur
             + np.log(np.maximum(self.order_prob, 1e-300))[ii]
             + loglik
         )
-        if self.use_mse:
+        if self.params.use_mse:
             logw = logw + self._evidence.log_evidence(meas.mse, meas.counts)[jj]
         logw = logw.reshape(n_order, n_order)  # [i, j]
         top = logw.max()
         log_pj = top + np.log(np.exp(logw - top).sum(axis=0))
-        self.order_prob = _softmax(log_pj)
+        self.order_prob = normalised_weights(log_pj)
         # Collapse (moment matching) over the previous ordering i, per ordering j.
-        w = _softmax(logw, axis=0)  # P(i | j)
+        w = normalised_weights(logw, axis=0)  # P(i | j)
         mu = pairs.x.reshape(n_order, n_order, -1)
         cov = pairs.P.reshape(n_order, n_order, *pairs.P.shape[1:])
         new_mu = np.einsum("ij,ijn->jn", w, mu)
@@ -352,6 +310,8 @@ min_visible, support, blur
 
 class FastSHMTracker(_SHMBase):
     """Fast SHM filter (§3.3): ordering posterior from the matches, one Kalman filter.
+
+    The parameters are the fields of ``FastShmParams``, and ``rng``.
 
     Parameters
     ----------
@@ -375,40 +335,13 @@ min_visible, support, blur, p_stay, lam, mse_rate, mse_floor, evidence
     """
 
     name = "shm-fast"
-
-    def __init__(
-        self,
-        *,
-        motion: str = "cv",
-        process_std: float = 1.5,
-        a1: float = 2.0,
-        a2: float = -1.0,
-        velocity_std: float = 5.0,
-        r_gain: float = 0.01,
-        r_floor: float = 0.5,
-        search_radius: int = 12,
-        step: int = 2,
-        min_visible: float = 0.25,
-        support: str = "ellipse",
-        blur: float = 2.0,
-        p_stay: float = 0.8,
-        lam: float = 1.0,
-        mse_rate: float = 0.1,
-        mse_floor: float = 25.0,
-        evidence: str = "union",
-        rng: RngLike = None,
-    ) -> None:
-        super().__init__(rng=rng)
-        self._configure(
-            motion, process_std, a1, a2, velocity_std, r_gain, r_floor, search_radius, step,
-            min_visible, support, blur, p_stay, lam, mse_rate, mse_floor, evidence,
-        )
+    Params = FastShmParams
 
     def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
         self._init_common(frame, boxes)
         m = self.model
         self.kf = KalmanFilter(
-            np.zeros((boxes.shape[0], m.dim)), m.P0, m.F, m.Q, m.H, np.eye(2) * self.r_floor
+            np.zeros((boxes.shape[0], m.dim)), m.P0, m.F, m.Q, m.H, np.eye(2) * self.params.r_floor
         )
 
     def _step(self, frame: NDArray[np.uint8]) -> Estimate:
@@ -419,14 +352,14 @@ min_visible, support, blur, p_stay, lam, mse_rate, mse_floor, evidence
         prior = self.order_prob @ self._evidence.pi
         log_ev = self._evidence.log_evidence(meas.mse, meas.counts)
         logp = np.log(np.maximum(prior, 1e-300)) + log_ev
-        self.order_prob = _softmax(logp)
+        self.order_prob = normalised_weights(logp)
         valid = np.isfinite(meas.mse)  # (L, M)
         q = self.order_prob[:, None] * valid
         mass = q.sum(axis=0)  # (M,)
         seen = mass >= 0.5
         q = q / np.where(mass > 0, mass, 1.0)
         y = np.nan_to_num(meas.centres - self._origin[None])  # (L, M, 2)
-        r = measurement_cov(meas.mse, self.r_gain, self.r_floor)  # (L, M, 2, 2)
+        r = measurement_cov(meas.mse, self.params.r_gain, self.params.r_floor)  # (L, M, 2, 2)
         # Moment-matched mixture of the hypothesized measurements, per object.
         y_hat = np.einsum("lm,lmc->mc", q, y)
         dev = y - y_hat[None]

@@ -2,13 +2,22 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from numpy.typing import NDArray
 
-from trackers.base import Estimate, RngLike, Tracker
-from trackers.meanshift import ColourTargets, check_kernel_bins, check_mean_shift, keep_inside
+from trackers.base import Estimate, Tracker
+from trackers.meanshift import (
+    MeanShiftParams,
+    colour_model,
+    keep_inside,
+    set_mean_shift,
+    window_boxes,
+)
+from trackers.params import check_number
 
-__all__ = ["SOK"]
+__all__ = ["SOK", "SokParams"]
 
 # Confidences closer than this are equal: their difference is rounding.
 _TIE = 1e-9
@@ -16,6 +25,19 @@ _TIE = 1e-9
 # The 8 cells around the centre of a 3x3 grid, in units of the target's box size.
 _OCTAL = np.array([(-1, -1), (0, -1), (1, -1), (-1, 0), (1, 0), (-1, 1), (0, 1), (1, 1)],
                   dtype=np.float64)
+
+
+@dataclass(frozen=True)
+class SokParams(MeanShiftParams):
+    """Parameters of SOK: ``MeanShiftParams``, ``threshold`` and ``spacing`` (see ``SOK``)."""
+
+    threshold: float = 0.9
+    spacing: float = 0.5
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        check_number(self, "threshold", low=0.0, high=1.0)
+        check_number(self, "spacing", low=0.0, low_open=True)
 
 
 class SOK(Tracker):
@@ -27,7 +49,7 @@ class SOK(Tracker):
     spacing ``spacing`` times the target's box size; KAMS Fig. 2), all in one call; the
     most confident of the nine results is kept (of confidences equal to 1e-9, the one
     nearest the primary estimate). Deterministic: ``rng`` is accepted for the
-    common protocol.
+    common protocol. The parameters are the fields of ``SokParams``, and ``rng``.
 
     Parameters
     ----------
@@ -42,14 +64,8 @@ class SOK(Tracker):
         default to 0.5 (about four times), because jumps on the kams presets stay within
         about one radius and the outer cells mostly meet clutter (sok on kams-a, seeds
         0–9: 8/10 runs tracked to the end at 0.5, 5/10 at 1).
-    max_iter : int, optional
-        Mean-shift iterations per tracker and frame.
-    eps : float, optional
-        Mean-shift stopping shift, in pixels.
-    kernel : str, optional
-        ``"cone"`` (KAMS) or ``"epanechnikov"``.
-    bins : int, optional
-        Bins per RGB channel.
+    max_iter, eps, kernel, bins
+        As for ``MeanShiftTracker`` (``MeanShiftParams``): per tracker and frame.
     rng : Generator, int or None, optional
         Unused (the tracker is deterministic).
 
@@ -65,42 +81,28 @@ class SOK(Tracker):
     """
 
     name = "sok"
-
-    def __init__(self, *, threshold: float = 0.9, spacing: float = 0.5, max_iter: int = 20,
-                 eps: float = 0.5, kernel: str = "cone", bins: int = 10,
-                 rng: RngLike = None) -> None:
-        super().__init__(rng=rng)
-        if not 0.0 <= threshold <= 1.0:
-            raise ValueError(f"threshold must lie in [0, 1], got {threshold!r}")
-        if not spacing > 0.0:
-            raise ValueError(f"spacing must be > 0, got {spacing!r}")
-        check_mean_shift(max_iter, eps)
-        check_kernel_bins(kernel, bins)
-        self.threshold = float(threshold)
-        self.spacing = float(spacing)
-        self.max_iter = int(max_iter)
-        self.eps = float(eps)
-        self.kernel = kernel
-        self.bins = int(bins)
+    Params = SokParams
 
     def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
-        self.targets = ColourTargets(frame, boxes, kernel=self.kernel, bins=self.bins)
+        self.model = colour_model(frame, boxes, self.params)
+        self.sizes = boxes[:, 2:4].copy()
         self.centres = boxes[:, :2] + 0.5 * boxes[:, 2:4]
 
     def _step(self, frame: NDArray[np.uint8]) -> Estimate:
-        obs = self.targets.observe(frame)
-        res = self.targets.shift(obs, self.centres[:, None, :], max_iter=self.max_iter,
-                                 eps=self.eps)
+        p = self.params
+        obs = self.model.observe(frame)
+        res = set_mean_shift(obs, self.centres[:, None, :], self.sizes, max_iter=p.max_iter,
+                             eps=p.eps)
         centres = res.centres[:, 0]
         confidence = 1.0 - res.distances[:, 0]
-        spawned = confidence < self.threshold
+        spawned = confidence < p.threshold
         low = np.flatnonzero(spawned)
         if low.size:
-            grid = self.spacing * _OCTAL[None] * self.targets.sizes[low, None, :]
+            grid = p.spacing * _OCTAL[None] * self.sizes[low, None, :]
             starts = centres[low, None, :] + grid
             keep_inside(starts, frame.shape)
-            extra = self.targets.shift(obs, starts, max_iter=self.max_iter, eps=self.eps,
-                                       which=low)
+            extra = set_mean_shift(obs, starts, self.sizes, max_iter=p.max_iter, eps=p.eps,
+                                   which=low)
             cand = np.concatenate([centres[low, None, :], extra.centres], axis=1)
             cand_conf = np.concatenate([confidence[low, None], 1.0 - extra.distances], axis=1)
             # The most confident of the nine; confidences equal up to rounding are a tie,
@@ -114,5 +116,5 @@ class SOK(Tracker):
             confidence[low] = cand_conf[rows, pick]
         keep_inside(centres, frame.shape)
         self.centres = centres
-        return Estimate(self.targets.boxes(centres[:, None, :])[:, 0],
+        return Estimate(window_boxes(centres[:, None, :], self.sizes)[:, 0],
                         {"confidence": confidence, "spawned": spawned})

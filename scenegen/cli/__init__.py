@@ -42,6 +42,10 @@ def _parser() -> argparse.ArgumentParser:
         module.register(sub)
     for module in (dataset, benchmark):
         module.register(sub)
+    for action in sub._choices_actions:  # each verb's --help opens with its one-line summary
+        verb = sub.choices[action.dest]
+        if verb.description is None and action.help:
+            verb.description = action.help[0].upper() + action.help[1:] + "."
     return parser
 
 
@@ -77,7 +81,3 @@ def main(argv: Sequence[str] | None = None) -> int:
             file=sys.stderr,
         )
         return 1
-
-
-def entry() -> None:  # pragma: no cover - console script wrapper
-    sys.exit(main())

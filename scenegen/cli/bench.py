@@ -14,6 +14,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--json", action="store_true", help="print one JSON document")
     p.add_argument("--repeats", type=int, default=7, help="timed repeats per row (default 7)")
     p.add_argument("--only", default=None, help="only modules whose name contains this")
+    p.add_argument("--figure", default=None, metavar="PNG",
+                   help="write the scaling figure here (when the scaling rows are run)")
     p.set_defaults(func=cmd_bench)
 
 
@@ -24,6 +26,10 @@ def cmd_bench(args: argparse.Namespace) -> int:
     if args.repeats < 1:
         raise ConfigError(f"--repeats must be >= 1, got {args.repeats}")
     rows = run_all(args.repeats, only=args.only, log=lambda m: print(m, file=sys.stderr))
+    if args.figure is not None and any(r.params.get("axis") for r in rows):
+        from scenegen.lab.bench.scaling import write_figure
+
+        print(f"wrote {write_figure(rows, args.figure)}", file=sys.stderr)
     sizes = []
     if args.only is None or args.only in "scenegen.lab.bench.generation":
         from scenegen.lab.bench.generation import sizes as measure_sizes

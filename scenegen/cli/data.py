@@ -46,11 +46,32 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--sequence", default=None, help="sequence name if the file holds several")
     p.set_defaults(func=cmd_preview)
 
-    p = sub.add_parser("export", help="export a sequence (MOTChallenge layout)")
-    p.add_argument("file", type=Path)
-    p.add_argument("--format", required=True, choices=["mot"], help="output format")
-    p.add_argument("-o", "--output", type=Path, required=True, help="output folder")
+    p = sub.add_parser(
+        "export",
+        help="export a sequence (mot, otb, got10k, vot) or a result (mot tracker file)",
+    )
+    p.add_argument("file", type=Path, help="scenegen .h5 file, or a result .h5 file")
+    p.add_argument(
+        "--format", required=True, choices=["mot", "otb", "got10k", "vot"], help="output format"
+    )
+    p.add_argument(
+        "-o", "--output", type=Path, required=True,
+        help="output folder (a .txt file for a result exported to MOT)",
+    )  # fmt: skip
     p.add_argument("--sequence", default=None, help="sequence name if the file holds several")
+    p.add_argument("--tracker", default=None, help="tracker name if the result holds several")
+    p.add_argument(
+        "--image-format", choices=["png", "jpg"], default=None,
+        help="frame files (default: png for mot and vot, jpg for otb and got10k)",
+    )  # fmt: skip
+    p.add_argument(
+        "--gt-mode", choices=["amodal", "visible"], default="amodal",
+        help="mot: amodal boxes in every frame (default) or MOTChallenge's visible convention",
+    )  # fmt: skip
+    p.add_argument(
+        "--visibility-threshold", type=float, default=0.0,
+        help="visible mode: rows with visibility at most this get conf 0 (default 0)",
+    )  # fmt: skip
     p.set_defaults(func=cmd_export)
 
 
@@ -209,10 +230,49 @@ def cmd_preview(args: argparse.Namespace) -> int:
     return 0
 
 
+def _is_result_file(path: Path, output: Path) -> bool:
+    """True if ``path`` should be exported as a tracker result (it holds results, and
+    either no sequence or the output is a ``.txt`` file)."""
+    from scenegen.io import open_checked
+
+    with open_checked(path) as f:
+        has_results = "results" in f and len(f["results"]) > 0
+        has_sequences = "sequences" in f and len(f["sequences"]) > 0
+    return has_results and (not has_sequences or output.suffix == ".txt")
+
+
 def cmd_export(args: argparse.Namespace) -> int:
+    from scenegen.io.mot import write_mot_tracker
+
+    if _is_result_file(args.file, args.output):
+        from scenegen.io import read_result
+
+        if args.format != "mot":
+            raise ConfigError(
+                f"{args.file}: a tracker result exports only to --format mot, not {args.format}"
+            )
+        res = read_result(args.file, args.tracker)
+        n = write_mot_tracker(args.output, res.boxes, res.target_ids)
+        print(f"wrote {args.output} ({n} boxes of {res.tracker!r}, MOTChallenge tracker file)")
+        return 0
+    from scenegen.io.benchmarks import export_benchmark
     from scenegen.io.export import export_mot
 
     seq = _read(args.file, args.sequence)
-    export_mot(seq, args.output)
+    with bar(seq.n_frames, f"export {args.format}", unit="frame") as pb:
+
+        def progress(n: int) -> None:
+            pb.update(n - pb.n)
+
+        if args.format == "mot":
+            export_mot(
+                seq, args.output, gt_mode=args.gt_mode,
+                visibility_threshold=args.visibility_threshold,
+                image_format=args.image_format or "png", progress=progress,
+            )  # fmt: skip
+        else:
+            export_benchmark(
+                seq, args.output, args.format, image_format=args.image_format, progress=progress
+            )
     print(f"wrote {args.output}")
     return 0

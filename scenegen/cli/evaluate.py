@@ -1,20 +1,55 @@
-"""The ``evaluate`` verb: score a tracker result file against its sequence."""
+"""The ``evaluate`` verb: score a tracker result (scenegen .h5 or MOTChallenge .txt)."""
 
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 __all__ = ["cmd_evaluate", "register"]
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("evaluate", help="score a tracker result against the ground truth")
+    p = sub.add_parser(
+        "evaluate",
+        help="score a tracker result (.h5 or MOTChallenge .txt) against the ground truth",
+    )
     p.add_argument("file", help="scenegen .h5 file holding the sequence")
-    p.add_argument("result", help="result .h5 file written by `scenegen track`")
+    p.add_argument(
+        "result",
+        help="result .h5 file written by `scenegen track`, or a MOTChallenge tracker .txt file",
+    )
     p.add_argument("--sequence", default=None, help="sequence name if the file holds several")
     p.add_argument("--tracker", default=None, help="tracker name if the result holds several")
+    p.add_argument(
+        "--gt-mode",
+        choices=["amodal", "visible"],
+        default="amodal",
+        help="amodal: every frame a target is in the scene counts (default); visible: "
+        "MOTChallenge's convention, targets with visibility <= the threshold are ignored",
+    )
+    p.add_argument(
+        "--visibility-threshold",
+        type=float,
+        default=0.0,
+        help="visible mode: a target counts where its visible fraction exceeds this (default 0)",
+    )
+    p.add_argument(
+        "--otb-average",
+        choices=["sequence", "frames"],
+        default="sequence",
+        help="overall AUC and P@20: mean over targets as OTB averages sequences (default), "
+        "or pooled frames",
+    )
     p.add_argument("--json", action="store_true", help="print one JSON document")
     p.set_defaults(func=cmd_evaluate)
+
+
+def _is_hdf5(path: Path) -> bool:
+    try:
+        with open(path, "rb") as f:
+            return f.read(8) == b"\x89HDF\r\n\x1a\n"
+    except OSError:
+        return path.suffix.lower() in (".h5", ".hdf5")
 
 
 def cmd_evaluate(args: argparse.Namespace) -> int:
@@ -27,11 +62,29 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
         target count or ids), naming the mismatch and the files.
     """
     from scenegen.errors import DataError
-    from scenegen.evaluation.evaluate import evaluate, format_table, to_json
+    from scenegen.evaluation.evaluate import (
+        check_options,
+        evaluate,
+        evaluate_tracks,
+        format_table,
+    )
     from scenegen.io import read, read_result
+    from scenegen.io.mot import read_mot_tracker
 
+    check_options(args.gt_mode, args.visibility_threshold, args.otb_average)
     seq = read(args.file, args.sequence)
-    res = read_result(args.result, args.tracker)
+    options = {
+        "gt_mode": args.gt_mode,
+        "visibility_threshold": args.visibility_threshold,
+        "otb_average": args.otb_average,
+    }
+    result = Path(args.result)
+    if not _is_hdf5(result):
+        ids, boxes = read_mot_tracker(result, seq.n_frames)
+        report = evaluate_tracks(seq, boxes, ids, tracker=result.stem, **options)
+        print(report.to_json() if args.json else format_table(report))
+        return 0
+    res = read_result(result, args.tracker)
     if res.sequence and res.sequence != seq.name:
         raise DataError(
             f"{args.result}: result is for sequence {res.sequence!r}, but {args.file} holds "
@@ -45,8 +98,9 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
             tracker=res.tracker,
             order_prob=res.order_prob,
             orderings=res.orderings,
+            **options,
         )
     except DataError as err:
         raise DataError(f"{args.result} does not match {args.file}: {err}") from None
-    print(to_json(report) if args.json else format_table(report))
+    print(report.to_json() if args.json else format_table(report))
     return 0

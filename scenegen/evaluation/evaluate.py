@@ -1,9 +1,20 @@
 """Evaluate a tracker result against a sequence's ground truth.
 
-:func:`evaluate` turns estimated boxes of shape (T, M, 4) for given target ids into a dict
-of metrics (per target and overall); :func:`format_table` renders it for a terminal and
-:func:`to_json` as one JSON document. A result that does not fit its sequence raises
-:class:`~scenegen.errors.DataError` naming the mismatch.
+:func:`evaluate` scores a scenegen result (boxes of shape (T, M, 4) for given target ids);
+:func:`evaluate_tracks` scores any tracks (e.g. read from a MOTChallenge tracker file),
+pairing each target with a track. Both return a typed
+:class:`~scenegen.evaluation.report.SequenceReport` (per target and overall);
+:func:`format_table` renders it for a terminal and :func:`to_json` as one JSON document.
+A result that does not fit its sequence raises :class:`~scenegen.errors.DataError` naming
+the mismatch.
+
+Which ground truth counts (``gt_mode``): ``"amodal"`` (default) scores every frame where a
+target is in the scene, with its amodal box; ``"visible"`` follows MOTChallenge and ignores
+a target in frames where its visible fraction is at most ``visibility_threshold`` (and
+drops tracker boxes matched to a distractor). The MOT export writes the same convention,
+so TrackEval on the exported files gives the numbers of ``evaluate`` (see
+:mod:`scenegen.io.mot`). CLEAR MOT, identity and HOTA are scored over every target of the
+sequence (what the MOT ground-truth export holds), single-target scores per target row.
 
 Example
 -------
@@ -14,19 +25,38 @@ Example
 
 from __future__ import annotations
 
-import json
-import math
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+from scipy.optimize import linear_sum_assignment
 
-from scenegen.errors import DataError
+from scenegen.errors import ConfigError, DataError
 from scenegen.evaluation import metrics
+from scenegen.evaluation.mot import (
+    box_iou,
+    mot_frames,
+    remove_distractor_matches,
+    score_all,
+)
+from scenegen.evaluation.report import (
+    MotSummary,
+    OverallScores,
+    SequenceReport,
+    TargetScores,
+    format_table,
+)
 
 __all__ = [
     "DEFAULT_RECOVER_FRAMES",
+    "GT_MODES",
+    "OTB_AVERAGES",
+    "check_options",
+    "SequenceReport",
+    "TargetScores",
     "evaluate",
+    "evaluate_tracks",
     "failure_threshold",
     "format_table",
     "frame_measures",
@@ -35,6 +65,14 @@ __all__ = [
 
 DEFAULT_RECOVER_FRAMES = 5
 """Final frames that must all be tracked for a run to count as recovered."""
+
+GT_MODES = ("amodal", "visible")
+"""Ground-truth conventions: amodal boxes in every frame, or MOTChallenge's visible ones."""
+
+OTB_AVERAGES = ("sequence", "frames")
+"""Overall OTB AUC / P@20: mean over targets (as OTB averages sequences), or pooled frames."""
+
+_MOT_ROLES = ("target", "distractor", "occluder")
 
 
 def frame_measures(est: ArrayLike, gt: ArrayLike) -> dict[str, NDArray[Any]]:
@@ -91,12 +129,24 @@ def failure_threshold(gt: ArrayLike, *, fraction: float = 1.0) -> NDArray[np.flo
     return np.where(n > 0, s / np.maximum(n, 1), np.nan)
 
 
-def _finite(x: float) -> float | None:
-    return None if not math.isfinite(x) else float(x)
-
-
 def _mean(x: NDArray[Any]) -> float | None:
     return float(np.mean(x)) if x.size else None
+
+
+def _finite(x: float) -> float | None:
+    return float(x) if np.isfinite(x) else None
+
+
+def check_options(gt_mode: str, visibility_threshold: float, otb_average: str) -> None:
+    """Raise ConfigError naming an unknown ``gt_mode`` / ``otb_average`` or a bad threshold."""
+    if gt_mode not in GT_MODES:
+        raise ConfigError(f"gt_mode must be one of {', '.join(GT_MODES)}; got {gt_mode!r}")
+    if not 0.0 <= visibility_threshold < 1.0:
+        raise ConfigError(f"visibility_threshold must be in [0, 1), got {visibility_threshold}")
+    if otb_average not in OTB_AVERAGES:
+        raise ConfigError(
+            f"otb_average must be one of {', '.join(OTB_AVERAGES)}; got {otb_average!r}"
+        )
 
 
 def evaluate(
@@ -110,17 +160,21 @@ def evaluate(
     recover_frames: int = DEFAULT_RECOVER_FRAMES,
     persist: int = 10,
     iou_threshold: float = 0.5,
-) -> dict[str, Any]:
-    """Metrics of one tracker result on one sequence.
+    gt_mode: str = "amodal",
+    visibility_threshold: float = 0.0,
+    otb_average: str = "sequence",
+) -> SequenceReport:
+    """Scores of one scenegen tracker result on one sequence.
 
     Parameters
     ----------
     sequence : scenegen.Sequence
-        The sequence tracked (its ``gt.box``, ``gt.depth`` and ``entities`` are used).
+        The sequence tracked (its ``gt``, ``entities`` are used).
     boxes : array_like of shape (T, M, 4)
         Estimated boxes per frame and target.
     target_ids : array_like of int, shape (M,)
-        Entity ids tracked, in the order of ``boxes``' second axis.
+        Entity ids tracked, in the order of ``boxes``' second axis (column m is the track
+        of target ``target_ids[m]``).
     tracker : str
         Tracker name, for the report.
     order_prob : array_like of shape (T, L), optional
@@ -135,18 +189,17 @@ def evaluate(
         :func:`scenegen.evaluation.metrics.failure_frame`).
     iou_threshold : float
         IoU of a match for CLEAR MOT and IDF1.
+    gt_mode : {"amodal", "visible"}
+        Which ground truth counts (module docstring).
+    visibility_threshold : float
+        ``visible`` mode: a target counts where its visible fraction exceeds this, in [0, 1).
+    otb_average : {"sequence", "frames"}
+        Overall OTB AUC and P@20: mean of the per-target values, or pooled frames.
 
     Returns
     -------
-    dict
-        ``sequence``, ``tracker``, ``n_frames``, ``targets`` (one dict per target: ``id``,
-        ``name``, ``frames`` evaluated, ``tracked`` (% of frames with T = 1), ``success``
-        (tracked in every frame), ``recovered``, ``precision`` and ``recall`` (% over
-        tracked frames), ``mean_iou``, ``mean_centre_error`` (px, over frames with an
-        estimate), ``auc``,
-        ``precision_20``, ``failure_frame`` (-1 if none)), and ``overall`` (``mean_iou``,
-        ``auc``, ``precision_20``, ``mota``, ``motp``, ``idf1``, and ``depth_order_accuracy``
-        (%) for SHM results). Undefined numbers are None.
+    SequenceReport
+        One row per target of ``target_ids``.
 
     Raises
     ------
@@ -154,18 +207,18 @@ def evaluate(
         If the result's frame count differs from the sequence's, its target count differs
         from the number of targets present at frame 0 (those ``scenegen track`` follows),
         or a target id is not one of those targets.
+    ConfigError
+        If an option is out of range.
     """
+    check_options(gt_mode, visibility_threshold, otb_average)
     est = np.asarray(boxes, dtype=np.float64)
     ids = np.asarray(target_ids).astype(np.int64).reshape(-1)
     name = str(getattr(sequence, "name", ""))
-    gt_all = np.asarray(sequence.gt.box, dtype=np.float64)
-    t_n = gt_all.shape[0]
+    t_n = int(np.asarray(sequence.gt.box).shape[0])
     if est.ndim != 3 or est.shape[2] != 4:
         raise DataError(f"result boxes must have shape (T, M, 4), got {est.shape}")
     if est.shape[0] != t_n:
-        raise DataError(
-            f"result has {est.shape[0]} frames but sequence {name!r} has {t_n} frames"
-        )
+        raise DataError(f"result has {est.shape[0]} frames but sequence {name!r} has {t_n} frames")
     if est.shape[1] != ids.shape[0]:
         raise DataError(
             f"result boxes hold {est.shape[1]} targets but target_ids lists {ids.shape[0]}"
@@ -179,7 +232,7 @@ def evaluate(
         )
     entity_ids = np.asarray(sequence.entities.id).astype(np.int64)
     target_ids_seq = entity_ids[tracked]
-    idx = []
+    rows = []
     for i in ids:
         hit = np.flatnonzero(entity_ids == i)
         if hit.size == 0 or int(i) not in target_ids_seq:
@@ -187,119 +240,211 @@ def evaluate(
                 f"result target id {int(i)} is not a target of sequence {name!r} "
                 f"(target ids: {', '.join(str(int(x)) for x in target_ids_seq)})"
             )
-        idx.append(int(hit[0]))
-    gt = gt_all[:, idx]
-    names = np.asarray(sequence.entities.name)[idx]
-    fm = frame_measures(est, gt)
-    thresholds = failure_threshold(gt)
-    present = np.all(np.isfinite(gt), axis=-1)
-    precision, recall, tracked_all = fm["precision"], fm["recall"], fm["state"]
+        rows.append(int(hit[0]))
+    report = _report(
+        sequence, est, ids, rows, list(range(len(rows))), tracker=tracker,
+        recover_frames=recover_frames, persist=persist, iou_threshold=iou_threshold,
+        gt_mode=gt_mode, visibility_threshold=visibility_threshold, otb_average=otb_average,
+    )  # fmt: skip
+    if order_prob is None or orderings is None:
+        return report
+    prob = np.asarray(order_prob, dtype=np.float64)
+    orders = np.asarray(orderings)
+    if prob.shape[0] != t_n or orders.ndim != 2 or orders.shape[1] != ids.shape[0]:
+        raise DataError(
+            f"order_prob {prob.shape} / orderings {orders.shape} do not fit {t_n} frames "
+            f"and {ids.shape[0]} targets"
+        )
+    depth = np.asarray(sequence.gt.depth)[:, rows]
+    gt = np.asarray(sequence.gt.box, dtype=np.float64)[:, rows]
+    acc = _finite(metrics.depth_order_accuracy(prob, orders, depth, gt))
+    return replace(report, overall=replace(report.overall, depth_order_accuracy=acc))
+
+
+def _pair_tracks(
+    gt: NDArray[np.float64], est: NDArray[np.float64], gt_ids: NDArray[np.int64],
+    track_ids: NDArray[np.int64], iou_threshold: float,
+) -> list[int]:  # fmt: skip
+    """Track column paired with each target column (-1 for none).
+
+    A target pairs with the track of the same id; the others with the track the identity
+    (IDF1) matching assigns them among the remaining tracks, if they share a matched frame.
+    """
+    pair = [-1] * gt.shape[1]
+    by_id = {int(i): c for c, i in enumerate(track_ids)}
+    for m, i in enumerate(gt_ids):
+        pair[m] = by_id.get(int(i), -1)
+    free_g = [m for m in range(gt.shape[1]) if pair[m] < 0]
+    free_e = [c for c in range(est.shape[1]) if c not in set(pair)]
+    if not free_g or not free_e:
+        return pair
+    count = np.zeros((len(free_g), len(free_e)))
+    for t in range(gt.shape[0]):
+        g, e = gt[t, free_g], est[t, free_e]
+        ok = np.all(np.isfinite(g), axis=-1)[:, None] & np.all(np.isfinite(e), axis=-1)[None]
+        if ok.any():
+            sim = box_iou(np.nan_to_num(g), np.nan_to_num(e))
+            count += ok & (sim >= iou_threshold)
+    r, c = linear_sum_assignment(-count)
+    for a, b in zip(r, c, strict=True):
+        if count[a, b] > 0:
+            pair[free_g[a]] = free_e[b]
+    return pair
+
+
+def evaluate_tracks(
+    sequence: Any,
+    boxes: ArrayLike,
+    track_ids: ArrayLike,
+    *,
+    tracker: str = "",
+    recover_frames: int = DEFAULT_RECOVER_FRAMES,
+    persist: int = 10,
+    iou_threshold: float = 0.5,
+    gt_mode: str = "amodal",
+    visibility_threshold: float = 0.0,
+    otb_average: str = "sequence",
+) -> SequenceReport:
+    """Scores of any tracks (e.g. a MOTChallenge tracker file) on one sequence.
+
+    Parameters
+    ----------
+    sequence : scenegen.Sequence
+    boxes : array_like of shape (T, H, 4)
+        Track boxes per frame (NaN where a track has none).
+    track_ids : array_like of int, shape (H,)
+        Track ids. A target is paired with the track of its own entity id (scenegen's
+        exports use those), else with the track the identity matching assigns it.
+    tracker, recover_frames, persist, iou_threshold, gt_mode, visibility_threshold, otb_average
+        As in :func:`evaluate`.
+
+    Returns
+    -------
+    SequenceReport
+        One row per target of the sequence that is in the scene in some frame.
+
+    Raises
+    ------
+    DataError
+        If the frame count differs from the sequence's.
+    """
+    check_options(gt_mode, visibility_threshold, otb_average)
+    est = np.asarray(boxes, dtype=np.float64)
+    ids = np.asarray(track_ids).astype(np.int64).reshape(-1)
+    name = str(getattr(sequence, "name", ""))
+    t_n = int(np.asarray(sequence.gt.box).shape[0])
+    if est.ndim != 3 or est.shape[2] != 4 or est.shape[1] != ids.shape[0]:
+        raise DataError(f"track boxes must have shape (T, {ids.shape[0]}, 4), got {est.shape}")
+    if est.shape[0] != t_n:
+        raise DataError(f"tracks span {est.shape[0]} frames but sequence {name!r} has {t_n}")
+    idx = np.asarray(sequence.target_indices())
+    idx = idx[np.asarray(sequence.gt.present)[:, idx].any(axis=0)]
+    gt = np.asarray(sequence.gt.box, dtype=np.float64)[:, idx]
+    entity_ids = np.asarray(sequence.entities.id).astype(np.int64)
+    pair = _pair_tracks(gt, est, entity_ids[idx], ids, iou_threshold)
+    return _report(
+        sequence, est, ids, [int(k) for k in idx], pair, tracker=tracker,
+        recover_frames=recover_frames, persist=persist, iou_threshold=iou_threshold,
+        gt_mode=gt_mode, visibility_threshold=visibility_threshold, otb_average=otb_average,
+    )  # fmt: skip
+
+
+def _report(
+    sequence: Any, est: NDArray[np.float64], track_ids: NDArray[np.int64], rows: list[int],
+    pair: list[int], *, tracker: str, recover_frames: int, persist: int, iou_threshold: float,
+    gt_mode: str, visibility_threshold: float, otb_average: str,
+) -> SequenceReport:  # fmt: skip
+    """The report of tracks ``est`` (T, H, 4); row ``rows[m]`` (entity index) pairs ``pair[m]``."""
+    gt_box = np.asarray(sequence.gt.box, dtype=np.float64)
+    present = np.asarray(sequence.gt.present, dtype=bool)
+    keep = present.copy()
+    if gt_mode == "visible":
+        keep &= np.asarray(sequence.gt.visibility, dtype=np.float64) > visibility_threshold
+    gt_all = np.where(keep[..., None], gt_box, np.nan)
+    roles = np.asarray(sequence.entities.role).astype(str)
+    entity_ids = np.asarray(sequence.entities.id).astype(np.int64)
+    est_keep = np.all(np.isfinite(est), axis=-1)
+    if gt_mode == "visible":
+        # MOTChallenge preprocessing: all rows of the ground-truth file, in file order.
+        cols = [k for k in range(len(roles)) if roles[k] in _MOT_ROLES]
+        file_gt = np.where(present[..., None], gt_box, np.nan)[:, cols]
+        est_keep &= remove_distractor_matches(file_gt, roles[cols] == "distractor", est)
+    est_scored = np.where(est_keep[..., None], est, np.nan)
+    # Multi-object scores over every target of the sequence.
+    targets_all = np.flatnonzero(roles == "target")
+    overall_mot = MotSummary.from_scores(
+        score_all(mot_frames(gt_all[:, targets_all], est_scored), threshold=iou_threshold)
+    )
+    nan_track = np.full((est.shape[0], 1, 4), np.nan)
+    rows_gt = gt_all[:, rows]
+    rows_est = np.concatenate(
+        [est_scored[:, [p]] if p >= 0 else nan_track for p in pair], axis=1
+    ) if rows else np.zeros((est.shape[0], 0, 4))  # fmt: skip
+    fm = frame_measures(rows_est, rows_gt)
+    thresholds = failure_threshold(rows_gt)
+    has_gt = np.all(np.isfinite(rows_gt), axis=-1)
     targets = []
-    for m, ident in enumerate(ids):
-        keep = present[:, m]
-        state = fm["state"][keep, m][None, :]
-        curves = metrics.otb_curves(est[:, m], gt[:, m])
-        err = np.nan_to_num(fm["centre_error"][keep, m], nan=np.inf)
+    for m, k in enumerate(rows):
+        ok = has_gt[:, m]
+        state = fm["state"][ok, m][None, :]
+        curves = metrics.otb_curves(rows_est[:, m], rows_gt[:, m])
+        err = np.nan_to_num(fm["centre_error"][ok, m], nan=np.inf)
+        mot = score_all(mot_frames(rows_gt[:, [m]], rows_est[:, [m]]), threshold=iou_threshold)
         targets.append(
-            {
-                "id": int(ident),
-                "name": str(names[m]),
-                "frames": int(keep.sum()),
-                "tracked": 100.0 * float(np.mean(state)) if keep.any() else None,
-                "success": bool(metrics.success_rate(state) == 100.0) if keep.any() else None,
-                "recovered": (
+            TargetScores(
+                id=int(entity_ids[k]),
+                name=str(np.asarray(sequence.entities.name)[k]),
+                track_id=int(track_ids[pair[m]]) if pair[m] >= 0 else None,
+                frames=int(ok.sum()),
+                tracked=100.0 * float(np.mean(state)) if ok.any() else None,
+                success=bool(metrics.success_rate(state) == 100.0) if ok.any() else None,
+                recovered=(
                     bool(metrics.recovery_rate(state, last_k=recover_frames) == 100.0)
-                    if keep.any()
+                    if ok.any()
                     else None
                 ),
-                "precision": _finite(metrics.mean_over_tracked(precision[:, m], tracked_all[:, m])),
-                "recall": _finite(metrics.mean_over_tracked(recall[:, m], tracked_all[:, m])),
-                "mean_iou": _mean(np.nan_to_num(fm["iou"][keep, m])),
-                "mean_centre_error": _mean(err[np.isfinite(err)]),
-                "auc": _finite(curves.auc),
-                "precision_20": _finite(curves.precision_20),
-                "failure_frame": (
+                precision=_finite(
+                    metrics.mean_over_tracked(fm["precision"][:, m], fm["state"][:, m])
+                ),
+                recall=_finite(metrics.mean_over_tracked(fm["recall"][:, m], fm["state"][:, m])),
+                mean_iou=_mean(np.nan_to_num(fm["iou"][ok, m])),
+                mean_centre_error=_mean(err[np.isfinite(err)]),
+                auc=_finite(curves.auc),
+                precision_20=_finite(curves.precision_20),
+                failure_frame=(
                     metrics.failure_frame(err, float(thresholds[m]), persist=persist)
-                    if keep.any()
+                    if ok.any()
                     else -1
                 ),
-            }
-        )
-    curves_all = metrics.otb_curves(est, gt)
-    mot = metrics.clear_mot(gt, est, iou_threshold=iou_threshold)
-    overall: dict[str, Any] = {
-        "mean_iou": _mean(np.nan_to_num(fm["iou"][present])),
-        "auc": _finite(curves_all.auc),
-        "precision_20": _finite(curves_all.precision_20),
-        "mota": _finite(mot.mota),
-        "motp": _finite(mot.motp),
-        "idf1": _finite(metrics.idf1(gt, est, iou_threshold=iou_threshold)),
-    }
-    if order_prob is not None and orderings is not None:
-        prob = np.asarray(order_prob, dtype=np.float64)
-        orders = np.asarray(orderings)
-        if prob.shape[0] != t_n or orders.ndim != 2 or orders.shape[1] != ids.shape[0]:
-            raise DataError(
-                f"order_prob {prob.shape} / orderings {orders.shape} do not fit {t_n} frames "
-                f"and {ids.shape[0]} targets"
+                mot=MotSummary.from_scores(mot),
             )
-        depth = np.asarray(sequence.gt.depth)[:, idx]
-        overall["depth_order_accuracy"] = _finite(
-            metrics.depth_order_accuracy(prob, orders, depth, gt)
         )
-    return {
-        "sequence": name,
-        "tracker": tracker,
-        "n_frames": int(t_n),
-        "targets": targets,
-        "overall": overall,
-    }
-
-
-def _fmt(v: Any, digits: int = 1) -> str:
-    if v is None:
-        return "-"
-    if isinstance(v, bool):
-        return "yes" if v else "no"
-    if isinstance(v, int):
-        return str(v)
-    return f"{v:.{digits}f}"
-
-
-def format_table(report: dict[str, Any]) -> str:
-    """Render an :func:`evaluate` report as a plain-text table for a terminal."""
-    head = ["id", "name", "tracked%", "success", "recovered", "prec%", "rec%", "IoU",
-            "err px", "AUC", "P@20", "fail@"]
-    rows = [
-        [
-            _fmt(t["id"]), t["name"], _fmt(t["tracked"]), _fmt(t["success"]),
-            _fmt(t["recovered"]), _fmt(t["precision"]), _fmt(t["recall"]),
-            _fmt(t["mean_iou"], 3), _fmt(t["mean_centre_error"]), _fmt(t["auc"], 3),
-            _fmt(t["precision_20"], 3),
-            "-" if t["failure_frame"] < 0 else str(t["failure_frame"]),
-        ]
-        for t in report["targets"]
-    ]
-    widths = [max(len(r[i]) for r in [head, *rows]) for i in range(len(head))]
-    lines = [
-        f"sequence {report['sequence']!r}, tracker {report['tracker']!r}, "
-        f"{report['n_frames']} frames",
-        "  ".join(h.rjust(w) for h, w in zip(head, widths, strict=True)),
-        "  ".join("-" * w for w in widths),
-    ]
-    lines += ["  ".join(c.rjust(w) for c, w in zip(r, widths, strict=True)) for r in rows]
-    o = report["overall"]
-    overall = (
-        f"overall: IoU {_fmt(o['mean_iou'], 3)}  AUC {_fmt(o['auc'], 3)}  "
-        f"P@20 {_fmt(o['precision_20'], 3)}  MOTA {_fmt(o['mota'], 3)}  "
-        f"MOTP {_fmt(o['motp'], 3)}  IDF1 {_fmt(o['idf1'], 3)}"
+    if otb_average == "frames":
+        pooled = metrics.otb_curves(rows_est, rows_gt)
+        auc, p20 = _finite(pooled.auc), _finite(pooled.precision_20)
+    else:
+        aucs = [t.auc for t in targets if t.auc is not None]
+        p20s = [t.precision_20 for t in targets if t.precision_20 is not None]
+        auc = float(np.mean(aucs)) if aucs else None
+        p20 = float(np.mean(p20s)) if p20s else None
+    overall = OverallScores(
+        mean_iou=_mean(np.nan_to_num(fm["iou"][has_gt])),
+        auc=auc,
+        precision_20=p20,
+        otb_average=otb_average,
+        mot=overall_mot,
     )
-    if "depth_order_accuracy" in o:
-        overall += f"  depth order {_fmt(o['depth_order_accuracy'])}%"
-    lines.append(overall)
-    return "\n".join(lines)
+    return SequenceReport(
+        sequence=str(getattr(sequence, "name", "")),
+        tracker=tracker,
+        n_frames=int(gt_box.shape[0]),
+        gt_mode=gt_mode,
+        visibility_threshold=float(visibility_threshold),
+        targets=tuple(targets),
+        overall=overall,
+    )
 
 
-def to_json(report: dict[str, Any]) -> str:
-    """One JSON document for an :func:`evaluate` report (sorted keys, no NaN)."""
-    return json.dumps(report, sort_keys=True, allow_nan=False)
+def to_json(report: SequenceReport) -> str:
+    """One JSON document for a report (sorted keys, no NaN); ``report.to_json()``."""
+    return report.to_json()

@@ -1,8 +1,8 @@
 """Tracking metrics: the DPS measures, OTB curves, KAMS failure frames, McNemar, CLEAR MOT, IDF1.
 
-Everything here is pure numpy (plus ``scipy.optimize.linear_sum_assignment`` for the
-matchings of CLEAR MOT and IDF1) and works on boxes ``[x, y, w, h]`` in pixels
-(CONTRACT "Coordinates"). A box with any NaN coordinate means "no box": an absent
+Everything here is pure numpy (CLEAR MOT and IDF1 use the TrackEval-exact matchings of
+:mod:`scenegen.evaluation.mot`) and works on boxes ``[x, y, w, h]`` in pixels
+(docs/format.md, "Conventions"). A box with any NaN coordinate means "no box": an absent
 ground-truth entity or a missing estimate.
 
 Frame conventions
@@ -25,7 +25,8 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.optimize import linear_sum_assignment
+
+from scenegen.evaluation import mot
 
 __all__ = [
     "ClearMot",
@@ -383,7 +384,7 @@ def otb_curves(
 
 
 def failure_frame(error: ArrayLike, threshold: float, *, persist: int = 10) -> int:
-    """Frame at which a run fails (KAMS §3.1, ALGORITHMS §4.6), or -1 if it never does.
+    """Frame at which a run fails (KAMS §3.1, docs/algorithms.md §5), or -1 if it never does.
 
     (open) A run "fails when the error stays above a threshold". Here it fails at the first
     frame t that starts ``persist`` consecutive frames whose error is above ``threshold``
@@ -525,12 +526,13 @@ def _check_tracks(gt: ArrayLike, est: ArrayLike) -> tuple[FloatArray, FloatArray
 
 
 def clear_mot(gt: ArrayLike, est: ArrayLike, *, iou_threshold: float = 0.5) -> ClearMot:
-    """CLEAR MOT: MOTA and MOTP with IoU matching.
+    """CLEAR MOT: MOTA and MOTP with IoU matching, computed as TrackEval does.
 
-    Per frame, correspondences of the previous frame are kept while their IoU stays
-    ≥ ``iou_threshold``; the remaining objects and hypotheses are matched by the Hungarian
-    algorithm on 1 − IoU among pairs with IoU ≥ ``iou_threshold``. A ground-truth object
-    matched to a different hypothesis than at its last match is an identity switch.
+    Per frame the Hungarian algorithm maximises first the number of objects that keep
+    their hypothesis of the previous frame, then the summed IoU, among pairs with IoU ≥
+    ``iou_threshold``. A ground-truth object matched to a different hypothesis than at its
+    last match is an identity switch. See :func:`scenegen.evaluation.mot.clear` (which
+    also gives MT/PT/ML and Frag).
 
     Parameters
     ----------
@@ -544,60 +546,32 @@ def clear_mot(gt: ArrayLike, est: ArrayLike, *, iou_threshold: float = 0.5) -> C
     Returns
     -------
     ClearMot
-        MOTA is NaN when there is no ground-truth object at all.
+        MOTA is NaN when there is no ground-truth object at all, MOTP when nothing matches.
     """
     g, e = _check_tracks(gt, est)
     if not 0.0 < iou_threshold <= 1.0:
         raise ValueError(f"iou_threshold must be in (0, 1], got {iou_threshold}")
-    gp, ep = _present(g), _present(e)
-    last: dict[int, int] = {}
-    prev: dict[int, int] = {}
-    n_gt = fn = fp = idsw = matches = 0
-    overlap_sum = 0.0
-    for t in range(g.shape[0]):
-        gi = np.flatnonzero(gp[t])
-        ej = np.flatnonzero(ep[t])
-        ov = iou(g[t][gi][:, None, :], e[t][ej][None, :, :]) if gi.size and ej.size else None
-        pairs: dict[int, int] = {}
-        if ov is not None:
-            gpos = {int(k): p for p, k in enumerate(gi)}
-            epos = {int(j): p for p, j in enumerate(ej)}
-            for k, j in prev.items():
-                if k in gpos and j in epos and ov[gpos[k], epos[j]] >= iou_threshold:
-                    pairs[k] = j
-            free_g = [p for p, k in enumerate(gi) if int(k) not in pairs]
-            used = set(pairs.values())
-            free_e = [p for p, j in enumerate(ej) if int(j) not in used]
-            if free_g and free_e:
-                sub = ov[np.ix_(free_g, free_e)]
-                cost = np.where(sub >= iou_threshold, 1.0 - sub, 2.0)
-                rows, cols = linear_sum_assignment(cost)
-                for r, c in zip(rows, cols, strict=True):
-                    if sub[r, c] >= iou_threshold:
-                        pairs[int(gi[free_g[r]])] = int(ej[free_e[c]])
-            for k, j in pairs.items():
-                overlap_sum += float(ov[gpos[k], epos[j]])
-        for k, j in pairs.items():
-            if k in last and last[k] != j:
-                idsw += 1
-            last[k] = j
-        n_gt += gi.size
-        matches += len(pairs)
-        fn += gi.size - len(pairs)
-        fp += ej.size - len(pairs)
-        prev = pairs
-    mota = 1.0 - (fn + fp + idsw) / n_gt if n_gt else float("nan")
-    motp = overlap_sum / matches if matches else float("nan")
-    return ClearMot(mota=mota, motp=motp, n_gt=n_gt, matches=matches, fn=fn, fp=fp, idsw=idsw)
+    c = mot.clear(mot.mot_frames(g, e), threshold=iou_threshold)
+    n_gt = c.tp + c.fn
+    return ClearMot(
+        mota=c.mota if n_gt else float("nan"),
+        motp=c.motp if c.tp else float("nan"),
+        n_gt=n_gt,
+        matches=c.tp,
+        fn=c.fn,
+        fp=c.fp,
+        idsw=c.idsw,
+    )
 
 
 def idf1(gt: ArrayLike, est: ArrayLike, *, iou_threshold: float = 0.5) -> float:
     """IDF1 (Ristani et al. 2016): identity F1 under the best one-to-one track matching.
 
     Each ground-truth trajectory is matched to at most one hypothesis trajectory so as to
-    maximise the identity true positives IDTP (frames where both exist and IoU ≥
-    ``iou_threshold``), by the Hungarian algorithm; minimising IDFN + IDFP is the same.
-    IDF1 = 2·IDTP / (ground-truth detections + hypothesis detections).
+    minimise IDFN + IDFP (the identity true positives IDTP are the frames where both
+    exist with IoU ≥ ``iou_threshold``), by the Hungarian algorithm, as TrackEval does
+    (:func:`scenegen.evaluation.mot.identity`). IDF1 = 2·IDTP / (ground-truth detections +
+    hypothesis detections).
 
     Parameters
     ----------
@@ -611,16 +585,9 @@ def idf1(gt: ArrayLike, est: ArrayLike, *, iou_threshold: float = 0.5) -> float:
         IDF1 in [0, 1]; NaN when there are no detections on either side.
     """
     g, e = _check_tracks(gt, est)
-    n_g, n_e = int(_present(g).sum()), int(_present(e).sum())
-    if n_g + n_e == 0:
+    if int(_present(g).sum()) + int(_present(e).sum()) == 0:
         return float("nan")
-    ov = np.nan_to_num(iou(g[:, :, None, :], e[:, None, :, :]), nan=0.0)
-    idtp_pair = np.sum(ov >= iou_threshold, axis=0).astype(np.float64)
-    if idtp_pair.size == 0:
-        return 0.0
-    rows, cols = linear_sum_assignment(-idtp_pair)
-    idtp = float(idtp_pair[rows, cols].sum())
-    return 2.0 * idtp / (n_g + n_e)
+    return mot.identity(mot.mot_frames(g, e), threshold=iou_threshold).idf1
 
 
 def ordering_index(depth: ArrayLike, orderings: ArrayLike) -> NDArray[np.intp]:

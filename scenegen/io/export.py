@@ -1,17 +1,21 @@
 """Export to the MOTChallenge layout: ``gt/gt.txt``, ``seqinfo.ini`` and ``img1/`` frames.
 
-``gt.txt`` rows: ``frame, id, left, top, width, height, conf, class, visibility`` with
-1-based frames and ids (our entity ids are already >= 1). Boxes are amodal. ``conf`` is 1
-for targets that are at least partly visible, 0 otherwise (MOT's "ignore"). Classes follow
-MOT17: 1 target (pedestrian), 8 distractor, 9 occluder. Clutter is not exported. Frames
-are written as lossless PNG so that pixels stay exact.
+``gt.txt`` rows: ``frame, id, bb_left, bb_top, width, height, conf, class, visibility``
+with MOTChallenge's 1-based frames, ids (our entity ids are already >= 1) and pixel
+coordinates (``bb_left = x + 1``). Boxes are amodal. Which rows count follows
+``gt_mode`` (see :mod:`scenegen.io.mot`): ``amodal`` (default) writes every target row
+with ``conf`` 1; ``visible`` (MOTChallenge's convention) writes ``conf`` 0 where a target's
+visible fraction is at most ``visibility_threshold`` (MOT's "ignore") and adds distractors
+(class 8) and occluders (class 9). Clutter is not exported. Frames are written as lossless
+PNG by default so that pixels stay exact.
 
 The folder is written atomically: everything goes to a temporary folder beside the target
 (``.NAME.tmp-PID@HOST-RANDOM``, see :mod:`scenegen.io.atomic`), which then replaces the target
 in one step (Linux ``renameat2(RENAME_EXCHANGE)``; elsewhere two renames in quick
 succession). A process killed while exporting leaves the earlier folder untouched and its
 temporary folder behind, which the next export to the same target removes. Frames are read
-and written one at a time, so memory stays bounded whatever the sequence length.
+and written one at a time, so memory stays bounded whatever the sequence length. An output
+that cannot be written raises :class:`~scenegen.errors.ConfigError` naming the target.
 """
 
 from __future__ import annotations
@@ -22,6 +26,7 @@ import errno
 import os
 import shutil
 import tempfile
+from collections.abc import Callable
 from pathlib import Path
 
 import cv2
@@ -29,30 +34,17 @@ import numpy as np
 
 from scenegen.errors import ConfigError
 from scenegen.io.atomic import clean_temp_files, temp_prefix
+from scenegen.io.mot import gt_rows, writable
 from scenegen.sequence import Sequence
 
-__all__ = ["export_mot"]
+__all__ = ["IMAGE_FORMATS", "encode_frame", "export_mot", "write_folder"]
 
-_MOT_CLASS = {"target": 1, "distractor": 8, "occluder": 9}
+IMAGE_FORMATS = ("png", "jpg")
+"""Frame formats of the exports: lossless PNG, or JPEG (quality 95)."""
+
+Progress = Callable[[int], None] | None
 _RENAME_EXCHANGE = 2  # linux/fs.h
 _AT_FDCWD = -100
-
-
-def _gt_rows(seq: Sequence, t: int) -> list[str]:
-    """The ``gt.txt`` rows of frame ``t`` (0-based)."""
-    gt = seq.gt
-    roles = seq.entities.role
-    rows = []
-    for k in range(len(seq.entities)):
-        role = str(roles[k])
-        if role not in _MOT_CLASS or not gt.present[t, k]:
-            continue
-        x, y, w, h = (float(v) for v in gt.box[t, k])
-        vis = float(gt.visibility[t, k])
-        conf = 1 if role == "target" and vis > 0 else 0
-        eid = int(seq.entities.id[k])
-        rows.append(f"{t + 1},{eid},{x:g},{y:g},{w:g},{h:g},{conf},{_MOT_CLASS[role]},{vis:.6f}")
-    return rows
 
 
 def _exchange(a: Path, b: Path) -> bool:
@@ -116,7 +108,60 @@ def _replace_dir(tmp: Path, out: Path) -> None:
     raise OSError(errno.EBUSY, "other processes keep replacing the folder", str(out))
 
 
-def export_mot(seq: Sequence, out_dir: str | Path, *, frame_rate: int = 25) -> None:
+def encode_frame(frame: np.ndarray, image_format: str, where: Path) -> bytes:
+    """Encode an RGB frame (H, W, 3) uint8 as PNG or JPEG (quality 95) bytes."""
+    if image_format not in IMAGE_FORMATS:
+        raise ConfigError(
+            f"image format must be one of {', '.join(IMAGE_FORMATS)}; got {image_format!r}"
+        )
+    bgr = cv2.cvtColor(np.asarray(frame), cv2.COLOR_RGB2BGR)
+    params = [cv2.IMWRITE_JPEG_QUALITY, 95] if image_format == "jpg" else []
+    ok, data = cv2.imencode(f".{image_format}", bgr, params)
+    if not ok:
+        raise ConfigError(f"{where}: could not encode a frame as {image_format}")
+    return bytes(data.tobytes())
+
+
+def write_folder(out_dir: str | Path, fill: Callable[[Path], None]) -> None:
+    """Create folder ``out_dir`` atomically: ``fill(tmp)`` writes into a temporary folder.
+
+    Raises
+    ------
+    ConfigError
+        If the parent folder does not exist, ``out_dir`` is a file, or it cannot be
+        written (naming ``out_dir``, not the temporary folder).
+    """
+    out = Path(out_dir)
+    parent = out.parent if str(out.parent) else Path(".")
+    if not parent.is_dir():
+        raise ConfigError(f"{out}: folder {parent} does not exist")
+    if out.exists() and not out.is_dir():
+        raise ConfigError(f"{out}: exists and is not a folder")
+    with writable(out):
+        clean_temp_files(parent, out.name)
+        tmp = Path(tempfile.mkdtemp(prefix=temp_prefix(out.name), dir=parent))
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o777 & ~umask)  # mkdtemp makes the folder private
+        try:
+            fill(tmp)
+            _replace_dir(tmp, out)
+        except BaseException:
+            with contextlib.suppress(OSError):
+                shutil.rmtree(tmp)
+            raise
+
+
+def export_mot(
+    seq: Sequence,
+    out_dir: str | Path,
+    *,
+    frame_rate: int = 25,
+    gt_mode: str = "amodal",
+    visibility_threshold: float = 0.0,
+    image_format: str = "png",
+    progress: Progress = None,
+) -> None:
     """Write ``seq`` as a MOTChallenge sequence folder ``out_dir`` (replaced atomically).
 
     Parameters
@@ -127,45 +172,42 @@ def export_mot(seq: Sequence, out_dir: str | Path, *, frame_rate: int = 25) -> N
         The sequence folder; its parent must exist. An existing folder is replaced.
     frame_rate : int
         Written to ``seqinfo.ini``.
+    gt_mode : {"amodal", "visible"}
+        Which ground truth counts (module docstring).
+    visibility_threshold : float
+        ``visible`` mode: rows with visibility at most this get ``conf`` 0.
+    image_format : {"png", "jpg"}
+        Frame files ``img1/000001.png`` (default, lossless) or ``.jpg``.
+    progress : callable, optional
+        Called with the number of frames written so far.
 
     Raises
     ------
     ConfigError
-        If the parent folder does not exist or ``out_dir`` is a file.
+        If the parent folder does not exist, ``out_dir`` is a file or cannot be written,
+        or an option is invalid.
     DataError
         If a frame of ``seq`` cannot be read (damaged file).
     """
     out = Path(out_dir)
-    parent = out.parent if str(out.parent) else Path(".")
-    if not parent.is_dir():
-        raise ConfigError(f"{out}: folder {parent} does not exist")
-    if out.exists() and not out.is_dir():
-        raise ConfigError(f"{out}: exists and is not a folder")
-    clean_temp_files(parent, out.name)
-    tmp = Path(tempfile.mkdtemp(prefix=temp_prefix(out.name), dir=parent))
-    umask = os.umask(0)
-    os.umask(umask)
-    os.chmod(tmp, 0o777 & ~umask)  # mkdtemp makes the folder private
-    try:
+    gt_rows(seq, 0, gt_mode, visibility_threshold)  # checks the options before any work
+    encode_frame(np.zeros((1, 1, 3), np.uint8), image_format, out)
+
+    def fill(tmp: Path) -> None:
         (tmp / "gt").mkdir()
         (tmp / "img1").mkdir()
         (tmp / "seqinfo.ini").write_text(
             "[Sequence]\n"
             f"name={seq.name}\nimDir=img1\nframeRate={frame_rate}\nseqLength={seq.n_frames}\n"
-            f"imWidth={seq.width}\nimHeight={seq.height}\nimExt=.png\n"
+            f"imWidth={seq.width}\nimHeight={seq.height}\nimExt=.{image_format}\n"
         )
         with open(tmp / "gt" / "gt.txt", "w") as gt_file:
             for t in range(seq.n_frames):
-                for row in _gt_rows(seq, t):
+                for row in gt_rows(seq, t, gt_mode, visibility_threshold):
                     gt_file.write(row + "\n")
-                ok, data = cv2.imencode(
-                    ".png", cv2.cvtColor(np.asarray(seq.frames[t]), cv2.COLOR_RGB2BGR)
-                )
-                if not ok:
-                    raise ConfigError(f"{out}: could not encode frame {t}")
-                (tmp / "img1" / f"{t + 1:06d}.png").write_bytes(data.tobytes())
-        _replace_dir(tmp, out)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            shutil.rmtree(tmp)
-        raise
+                data = encode_frame(seq.frames[t], image_format, out)
+                (tmp / "img1" / f"{t + 1:06d}.{image_format}").write_bytes(data)
+                if progress is not None:
+                    progress(t + 1)
+
+    write_folder(out, fill)

@@ -14,10 +14,10 @@ parameters), ``results.json`` (leaderboard, per-axis curves and every score),
 the metric's mean per axis value, one line per tracker) and ``index.html``.
 
 Metrics (per sequence, from :func:`scenegen.evaluation.evaluate`): OTB ``auc`` and
-``precision_20`` over every tracked target and frame, ``success`` and ``recovery`` (% of
+``precision_20`` (the mean over the sequence's targets), ``success`` and ``recovery`` (% of
 targets tracked in every frame / tracked again at the end, DPS §3), ``tracked`` (% of
 frames), ``mean_iou``; on sequences with several targets also the multi-target metrics
-``mota``, ``idf1`` (and ``hota`` when the evaluation provides it).
+``mota``, ``idf1`` and ``hota`` (TrackEval's definitions, :mod:`scenegen.evaluation.mot`).
 """
 
 from __future__ import annotations
@@ -126,10 +126,11 @@ def run_pair(task: BenchTask) -> dict[str, Any]:
     seq = read(Path(task.root) / task.file, task.name)
     done = run(seq, task.tracker, dict(task.params), task.tracker_seed(), single_thread=True)
     res = done.result
-    rep = evaluate(
+    report = evaluate(
         seq, res.boxes, res.target_ids, tracker=task.tracker,
         order_prob=res.order_prob, orderings=res.orderings,
     )  # fmt: skip
+    rep = report if isinstance(report, dict) else report.to_dict()
     targets = rep["targets"]
     multi = len(targets) > 1
 

@@ -1,13 +1,13 @@
 """Batched kernel-weighted colour histograms on a bin-index image (numba).
 
 Every particle tracker spends its time building the colour histograms of candidate
-regions (ALGORITHMS.md §2.2). The frame is quantised once into a bin-index image
+regions (docs/algorithms.md §2.2). The frame is quantised once into a bin-index image
 (``quantize_rgb`` or ``quantize_hsv``); then one compiled call builds the histograms of
 all candidate boxes of all objects (``region_histograms``), or directly their
 Bhattacharyya distances to reference histograms (``region_distances``, which never
 materialises the (P, B) histogram array).
 
-Conventions shared by every function here (CONTRACT.md "Coordinates"):
+Conventions shared by every function here (docs/algorithms.md, "Notation"):
 
 - A box is [x, y, w, h]. Pixel (row r, column c) belongs to a box if its centre
   (c + 0.5, r + 0.5) lies in [x, x + w) × [y, y + h). Pixels outside the frame are
@@ -17,6 +17,15 @@ Conventions shared by every function here (CONTRACT.md "Coordinates"):
   ``KERNEL_UNIFORM`` weight 1 on the whole box; ``KERNEL_EPANECHNIKOV`` 1 − r²;
   ``KERNEL_CONE`` 1 − r (the linear kernel of KAMS §2); both elliptic kernels are 0 outside
   the ellipse inscribed in the box.
+- ``KERNEL_BOX`` with L levels (``box_levels``): a step ("pyramid") approximation of the
+  Epanechnikov profile made of L nested rectangles, rectangle l (l = 1 … L) being the box
+  scaled by l / L about its centre (rectangle L is the box itself, with the same pixel
+  rule). With the Chebyshev radius r∞ = max(|px − cx| / (w / 2), |py − cy| / (h / 2)), a
+  pixel in the shell (l − 1) / L < r∞ ≤ l / L has weight 1 − ((l − ½) / L)², the
+  Epanechnikov profile at the shell's mid-radius; as a sum of rectangles, rectangle l
+  carries a_l = k_l − k_(l+1) (k_(L+1) = 0). A box's histogram is then a weighted sum of L
+  rectangle histograms, which an integral histogram gives exactly in O(L · bins) per box
+  whatever its size (``region_distances``' integral path). L = 1 is the uniform kernel.
 - ``n_parts`` splits the box into that many horizontal bands of equal height (the
   "spatial components" of Pérez et al. 2002, DPS §3.2); the kernel is still the one of the
   whole box. Each band's histogram is normalised to sum 1, the bands are concatenated and
@@ -37,11 +46,14 @@ from __future__ import annotations
 
 from typing import NamedTuple
 
+import numba
 import numpy as np
-from numba import njit
+from numba import njit, prange
 from numpy.typing import NDArray
 
 __all__ = [
+    "DEFAULT_BOX_LEVELS",
+    "KERNEL_BOX",
     "KERNEL_CONE",
     "KERNEL_EPANECHNIKOV",
     "KERNEL_UNIFORM",
@@ -50,6 +62,7 @@ __all__ = [
     "PreparedReferences",
     "bhattacharyya_coefficient",
     "bhattacharyya_distance",
+    "box_kernel_levels",
     "hsv_n_bins",
     "prepare_references",
     "prepared_distances",
@@ -62,13 +75,56 @@ __all__ = [
 KERNEL_UNIFORM = 0
 KERNEL_EPANECHNIKOV = 1
 KERNEL_CONE = 2
+KERNEL_BOX = 3
+#: Levels of the nested-rectangle kernel when none is given (see the module docstring).
+DEFAULT_BOX_LEVELS = 3
+_MAX_BOX_LEVELS = 16
 
 #: Kernel profile names, as accepted by the observation models, mapped to their codes.
 KERNELS: dict[str, int] = {
     "uniform": KERNEL_UNIFORM,
     "epanechnikov": KERNEL_EPANECHNIKOV,
     "cone": KERNEL_CONE,
+    "box": KERNEL_BOX,
 }
+
+
+_NO_LEVELS = np.zeros(0, dtype=np.int64)
+_NO_FRACTIONS = np.zeros(0, dtype=np.float64)
+
+
+def box_kernel_levels(levels: int = DEFAULT_BOX_LEVELS) -> tuple[NDArray[np.float64],
+                                                                 NDArray[np.float64]]:
+    """Scales and weights of the nested-rectangle kernel with ``levels`` levels.
+
+    Returns
+    -------
+    fractions : ndarray of shape (L,)
+        Rectangle l's size as a fraction l / L of the box's (innermost first).
+    weights : ndarray of shape (L,)
+        a_l: the weight rectangle l adds to each of its pixels, so that a pixel of shell l
+        has Σ_(m ≥ l) a_m = 1 − ((l − ½) / L)².
+
+    Raises
+    ------
+    ValueError
+        If ``levels`` is not an integer in [1, 16].
+    """
+    if isinstance(levels, bool) or int(levels) != levels or not 1 <= levels <= _MAX_BOX_LEVELS:
+        raise ValueError(f"box_levels must be an integer in [1, {_MAX_BOX_LEVELS}], got "
+                         f"{levels!r}")
+    n = int(levels)
+    shell = 1.0 - ((np.arange(1, n + 1) - 0.5) / n) ** 2
+    weights = shell - np.append(shell[1:], 0.0)
+    return np.arange(1, n + 1) / n, weights
+
+
+def _level_args(kernel: int, levels: int) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+    """(fractions, fixed-point weights) passed to the compiled code; empty unless box."""
+    if kernel != KERNEL_BOX:
+        return _NO_FRACTIONS, _NO_LEVELS
+    fractions, weights = box_kernel_levels(levels)
+    return fractions, np.round(weights * _ONE).astype(np.int64)
 
 
 def _check_frame(frame: NDArray[np.uint8]) -> NDArray[np.uint8]:
@@ -334,14 +390,41 @@ def _scatter_unit(hist, row, c0, c1, base, unit):
 
 
 @njit(cache=True)
+def _level_rects(x, y, w, h, fracs, rows, cols, rects):
+    """rects[l] = (r0, r1, c0, c1): the pixels of rectangle l of the box kernel (the box
+    scaled by fracs[l] about its centre; fracs[-1] = 1 gives the box itself)."""
+    for lv in range(fracs.shape[0]):
+        f = fracs[lv]
+        r0, r1 = _pixel_range(y + 0.5 * h * (1.0 - f), h * f, rows)
+        c0, c1 = _pixel_range(x + 0.5 * w * (1.0 - f), w * f, cols)
+        rects[lv, 0] = r0
+        rects[lv, 1] = r1
+        rects[lv, 2] = c0
+        rects[lv, 3] = c1
+
+
+@njit(cache=True)
+def _box_row_weights(kbuf, n, c0, r, rects, a_fixed):
+    """Fixed-point box-kernel weights of row r, columns c0 … c0 + n − 1."""
+    for i in range(n):
+        kbuf[i] = 0
+    for lv in range(a_fixed.shape[0]):
+        if rects[lv, 0] <= r < rects[lv, 1]:
+            a = a_fixed[lv]
+            for c in range(rects[lv, 2], rects[lv, 3]):
+                kbuf[c - c0] += a
+
+
+@njit(cache=True)
 def _accumulate(bin_img, x, y, w, h, n_bins, kernel, n_parts, hist, lanes, totals, tbuf,
-                kbuf):
+                kbuf, fracs, a_fixed, rects):
     """Add the fixed-point weighted pixels of box [x, y, w, h] into ``hist``.
 
     ``hist`` (lanes * n_parts * n_bins, int64) receives the weights in ``lanes`` copies,
     ``totals`` (n_parts, int64) each band's total; ``tbuf`` and ``kbuf`` (W + 2,) are
     scratch. Every pixel of the box's rows is visited; those outside the kernel's ellipse
-    get weight 0 (finding each row's chord costs more than the pixels it skips).
+    get weight 0 (finding each row's chord costs more than the pixels it skips). For the
+    box kernel, ``fracs`` and ``a_fixed`` (L,) are its levels and ``rects`` (L, 4) scratch.
     """
     rows, cols = bin_img.shape
     r0, r1 = _pixel_range(y, h, rows)
@@ -367,12 +450,16 @@ def _accumulate(bin_img, x, y, w, h, n_bins, kernel, n_parts, hist, lanes, total
         for c in range(c0, c1):
             dx = (c + 0.5 - cx) * inv_hw
             tbuf[c - c0] = np.int64(dx * dx * _ONE + 0.5)
+    elif kernel == KERNEL_BOX:
+        _level_rects(x, y, w, h, fracs, rows, cols, rects)
     for r in range(r0, r1):
         py = r + 0.5
         part = int((py - y) / band)
         if part >= n_parts:
             part = n_parts - 1
-        if kernel != KERNEL_UNIFORM:
+        if kernel == KERNEL_BOX:
+            _box_row_weights(kbuf, n, c0, r, rects, a_fixed)
+        elif kernel != KERNEL_UNIFORM:
             dy = (py - cy) * inv_hh
             dy2 = dy * dy
             if dy2 >= 1.0:
@@ -390,7 +477,7 @@ def _accumulate(bin_img, x, y, w, h, n_bins, kernel, n_parts, hist, lanes, total
 
 
 @njit(cache=True)
-def _region_histograms(bin_img, boxes, n_bins, kernel, n_parts, lanes):
+def _region_histograms(bin_img, boxes, n_bins, kernel, n_parts, lanes, fracs, a_fixed):
     n_boxes = boxes.shape[0]
     dim = n_parts * n_bins
     out = np.empty((n_boxes, dim))
@@ -398,9 +485,10 @@ def _region_histograms(bin_img, boxes, n_bins, kernel, n_parts, lanes):
     totals = np.empty(n_parts, dtype=np.int64)
     tbuf = np.empty(bin_img.shape[1] + 2, dtype=np.int64)
     kbuf = np.empty(bin_img.shape[1] + 2, dtype=np.int64)
+    rects = np.empty((max(fracs.shape[0], 1), 4), dtype=np.int64)
     for p in range(n_boxes):
         _accumulate(bin_img, boxes[p, 0], boxes[p, 1], boxes[p, 2], boxes[p, 3], n_bins,
-                    kernel, n_parts, hist, lanes, totals, tbuf, kbuf)
+                    kernel, n_parts, hist, lanes, totals, tbuf, kbuf, fracs, a_fixed, rects)
         for j in range(n_parts):
             lo = j * n_bins
             if totals[j] > 0:
@@ -433,11 +521,11 @@ def _band_rho(hist, dim, lanes, sqrt_q, nz, i0, i1, scale):
 
 @njit(cache=True)
 def _direct_distance(bin_img, box, sqrt_q, nz, nz_start, empty_rho, n_bins, kernel,
-                     n_parts, hist, lanes, totals, tbuf, kbuf):
+                     n_parts, hist, lanes, totals, tbuf, kbuf, fracs, a_fixed, rects):
     """Bhattacharyya distance of one box to one reference by accumulating its pixels."""
     dim = n_parts * n_bins
     _accumulate(bin_img, box[0], box[1], box[2], box[3], n_bins, kernel, n_parts, hist,
-                lanes, totals, tbuf, kbuf)
+                lanes, totals, tbuf, kbuf, fracs, a_fixed, rects)
     rho = 0.0
     for j in range(n_parts):
         if totals[j] > 0:
@@ -477,9 +565,48 @@ def _corner_rho(i11, i01, i10, i00, sq, scale):
 
 
 @njit(cache=True)
+def _box_band_rho(integ, rects, a_fixed, ra, rb, R0, C0, ta, tb, sq, sums, scale_parts):
+    """ρ of one band (rows [ra, rb)) of a box-kernel box from the integral histogram.
+
+    Band histogram h_t = Σ_l a_l · (pixels of colour t in rectangle l ∩ the band), total
+    Σ_l a_l · (pixels of rectangle l ∩ the band); both in fixed point, so they equal what
+    the direct path accumulates pixel by pixel, and ρ is summed in the same order. Returns
+    −1 for a band without pixels.
+    """
+    n = tb - ta
+    for t in range(n):
+        sums[t] = 0
+    total = 0
+    for lv in range(a_fixed.shape[0]):
+        ya = max(ra, rects[lv, 0]) - R0
+        yb = min(rb, rects[lv, 1]) - R0
+        xa = rects[lv, 2] - C0
+        xb = rects[lv, 3] - C0
+        if yb <= ya or xb <= xa:
+            continue
+        a = a_fixed[lv]
+        total += a * (yb - ya) * (xb - xa)
+        i11 = integ[yb, xb]
+        i01 = integ[ya, xb]
+        i10 = integ[yb, xa]
+        i00 = integ[ya, xa]
+        for t in range(n):
+            k = ta + t
+            sums[t] += a * (np.int64(i11[k]) - i01[k] - i10[k] + i00[k])
+    if total <= 0:
+        return -1.0
+    scale = 1.0 / (total * scale_parts)
+    acc = 0.0
+    for t in range(n):
+        acc += np.sqrt(sums[t] * scale) * sq[ta + t]
+    return acc
+
+
+@njit(cache=True)
 def _integral_distances(bin_img, boxes, members, sqrt_q, nz, nz_start, empty_rho, n_bins,
-                        n_parts, roi, out):
-    """Uniform-kernel distances of the boxes ``members`` to one reference (integral path).
+                        n_parts, roi, out, kernel, fracs, a_fixed):
+    """Uniform- or box-kernel distances of the boxes ``members`` to one reference (integral
+    path).
 
     Builds, over ``roi`` (r0, r1, c0, c1: the union of the boxes' pixels), the integral
     histogram of the reference's support only: channel t counts the pixels of colour
@@ -518,6 +645,8 @@ def _integral_distances(bin_img, boxes, members, sqrt_q, nz, nz_start, empty_rho
             for t in range(n_chan):
                 here[t] = above[t] + racc[t]
     bounds = np.empty(n_parts + 1, dtype=np.int64)
+    rects = np.empty((max(fracs.shape[0], 1), 4), dtype=np.int64)
+    sums = np.empty(max(n_chan, 1), dtype=np.int64)
     for m in members:
         x, y, w, h = boxes[m, 0], boxes[m, 1], boxes[m, 2], boxes[m, 3]
         r0, r1 = _pixel_range(y, h, rows)
@@ -530,6 +659,8 @@ def _integral_distances(bin_img, boxes, members, sqrt_q, nz, nz_start, empty_rho
             _band_rows(y, h, n_parts, r0, r1, bounds)
             xa = c0 - C0
             xb = c1 - C0
+            if kernel == KERNEL_BOX:
+                _level_rects(x, y, w, h, fracs, rows, cols, rects)
             for j in range(n_parts):
                 ra = bounds[j]
                 rb = bounds[j + 1]
@@ -538,6 +669,11 @@ def _integral_distances(bin_img, boxes, members, sqrt_q, nz, nz_start, empty_rho
                     continue
                 ta = nz_start[j] - t0
                 tb = nz_start[j + 1] - t0
+                if kernel == KERNEL_BOX:
+                    band_rho = _box_band_rho(integ, rects, a_fixed, ra, rb, R0, C0, ta, tb,
+                                             sq, sums, n_parts)
+                    rho += empty_rho[j] if band_rho < 0.0 else band_rho
+                    continue
                 ya = ra - R0
                 yb = rb - R0
                 scale = 1.0 / ((rb - ra) * (c1 - c0) * n_parts)
@@ -566,58 +702,90 @@ METHODS: dict[str, int] = {"auto": METHOD_AUTO, "direct": METHOD_DIRECT,
 
 
 @njit(cache=True)
-def _region_distances(bin_img, boxes, sqrt_refs, ref_index, nz, nz_start, empty_rho,
-                      n_bins, kernel, n_parts, lanes, method):
-    n_boxes = boxes.shape[0]
+def _reference_groups(ref_index):
+    """Boxes sorted by reference (stable) and where each reference's run starts."""
+    n_boxes = ref_index.shape[0]
+    order = np.argsort(ref_index, kind="mergesort")
+    starts = np.empty(n_boxes + 1, dtype=np.int64)
+    n_groups = 0
+    for i in range(n_boxes):
+        if i == 0 or ref_index[order[i]] != ref_index[order[i - 1]]:
+            starts[n_groups] = i
+            n_groups += 1
+    starts[n_groups] = n_boxes
+    return order, starts[:n_groups + 1]
+
+
+@njit(cache=True)
+def _integral_group(bin_img, boxes, members, sqrt_refs, nz, nz_start, empty_rho, n_bins,
+                    n_parts, method, kernel, fracs, a_fixed, n_levels, out):
+    """Score one reference's boxes by the integral path if it is the cheaper (or asked
+    for); returns whether it did."""
     rows, cols = bin_img.shape
+    roi = np.empty(4, dtype=np.int64)
+    # The union of the members' pixels, and what each path would cost.
+    roi[0], roi[1], roi[2], roi[3] = rows, 0, cols, 0
+    area = 0.0
+    for m in members:
+        r0, r1 = _pixel_range(boxes[m, 1], boxes[m, 3], rows)
+        c0, c1 = _pixel_range(boxes[m, 0], boxes[m, 2], cols)
+        if r0 < r1 and c0 < c1:
+            area += (r1 - r0) * (c1 - c0)
+            roi[0] = min(roi[0], r0)
+            roi[1] = max(roi[1], r1)
+            roi[2] = min(roi[2], c0)
+            roi[3] = max(roi[3], c1)
+    n_sup = nz_start[n_parts] - nz_start[0]
+    cells = max(roi[1] - roi[0], 0) * max(roi[3] - roi[2], 0) * float(n_sup)
+    k = members.shape[0]
+    cost_direct = area * _COST_PIXEL + k * n_sup * _COST_SWEEP
+    cost_integral = cells * _COST_CELL + k * n_sup * n_levels * _COST_CORNER
+    if roi[1] > roi[0] and cells <= _MAX_CELLS and (
+            method == METHOD_INTEGRAL or cost_integral < cost_direct):
+        _integral_distances(bin_img, boxes, members, sqrt_refs, nz, nz_start, empty_rho,
+                            n_bins, n_parts, roi, out, kernel, fracs, a_fixed)
+        return True
+    return False
+
+
+@njit(cache=True, parallel=True)
+def _region_distances(bin_img, boxes, sqrt_refs, ref_index, nz, nz_start, empty_rho,
+                      n_bins, kernel, n_parts, lanes, method, fracs, a_fixed, n_chunks):
+    """Distances of every box to its reference, in parallel over references (integral
+    path) and over chunks of boxes (direct path). Every box is computed alone from zeroed
+    scratch, with sums in a fixed order, so the result does not depend on the number of
+    threads or on how the boxes are chunked."""
+    n_boxes = boxes.shape[0]
+    cols = bin_img.shape[1]
     out = np.empty(n_boxes)
     direct = np.ones(n_boxes, dtype=np.bool_)
-    if kernel == KERNEL_UNIFORM and method != METHOD_DIRECT and n_boxes > 0:
-        order = np.argsort(ref_index, kind="mergesort")
-        roi = np.empty(4, dtype=np.int64)
-        start = 0
-        while start < n_boxes:
-            ref = ref_index[order[start]]
-            end = start
-            while end < n_boxes and ref_index[order[end]] == ref:
-                end += 1
-            members = order[start:end]
-            # The union of the members' pixels, and what each path would cost.
-            roi[0], roi[1], roi[2], roi[3] = rows, 0, cols, 0
-            area = 0.0
-            for m in members:
-                r0, r1 = _pixel_range(boxes[m, 1], boxes[m, 3], rows)
-                c0, c1 = _pixel_range(boxes[m, 0], boxes[m, 2], cols)
-                if r0 < r1 and c0 < c1:
-                    area += (r1 - r0) * (c1 - c0)
-                    roi[0] = min(roi[0], r0)
-                    roi[1] = max(roi[1], r1)
-                    roi[2] = min(roi[2], c0)
-                    roi[3] = max(roi[3], c1)
-            n_sup = nz_start[ref, n_parts] - nz_start[ref, 0]
-            cells = max(roi[1] - roi[0], 0) * max(roi[3] - roi[2], 0) * float(n_sup)
-            k = end - start
-            cost_direct = area * _COST_PIXEL + k * n_sup * _COST_SWEEP
-            cost_integral = cells * _COST_CELL + k * n_sup * _COST_CORNER
-            if roi[1] > roi[0] and cells <= _MAX_CELLS and (
-                    method == METHOD_INTEGRAL or cost_integral < cost_direct):
-                _integral_distances(bin_img, boxes, members, sqrt_refs[ref], nz[ref],
-                                    nz_start[ref], empty_rho[ref], n_bins, n_parts, roi,
-                                    out)
+    integral_ok = kernel == KERNEL_UNIFORM or kernel == KERNEL_BOX
+    n_levels = max(a_fixed.shape[0], 1)
+    if integral_ok and method != METHOD_DIRECT and n_boxes > 0:
+        order, starts = _reference_groups(ref_index)
+        for g in prange(starts.shape[0] - 1):
+            members = order[starts[g]:starts[g + 1]]
+            ref = ref_index[members[0]]
+            if _integral_group(bin_img, boxes, members, sqrt_refs[ref], nz[ref],
+                               nz_start[ref], empty_rho[ref], n_bins, n_parts, method,
+                               kernel, fracs, a_fixed, n_levels, out):
                 for m in members:
                     direct[m] = False
-            start = end
     dim = n_parts * n_bins
-    hist = np.zeros(lanes * dim, dtype=np.int64)
-    totals = np.empty(n_parts, dtype=np.int64)
-    tbuf = np.empty(cols + 2, dtype=np.int64)
-    kbuf = np.empty(cols + 2, dtype=np.int64)
-    for p in range(n_boxes):
-        if direct[p]:
-            ref = ref_index[p]
-            out[p] = _direct_distance(bin_img, boxes[p], sqrt_refs[ref], nz[ref],
-                                      nz_start[ref], empty_rho[ref], n_bins, kernel,
-                                      n_parts, hist, lanes, totals, tbuf, kbuf)
+    n_chunks = max(min(n_chunks, n_boxes), 1)
+    for ch in prange(n_chunks):
+        hist = np.zeros(lanes * dim, dtype=np.int64)
+        totals = np.empty(n_parts, dtype=np.int64)
+        tbuf = np.empty(cols + 2, dtype=np.int64)
+        kbuf = np.empty(cols + 2, dtype=np.int64)
+        rects = np.empty((n_levels, 4), dtype=np.int64)
+        for p in range(ch * n_boxes // n_chunks, (ch + 1) * n_boxes // n_chunks):
+            if direct[p]:
+                ref = ref_index[p]
+                out[p] = _direct_distance(bin_img, boxes[p], sqrt_refs[ref], nz[ref],
+                                          nz_start[ref], empty_rho[ref], n_bins, kernel,
+                                          n_parts, hist, lanes, totals, tbuf, kbuf, fracs,
+                                          a_fixed, rects)
     return out
 
 
@@ -676,6 +844,8 @@ def region_histograms(
     n_bins: int,
     kernel: int,
     n_parts: int = 1,
+    *,
+    box_levels: int = DEFAULT_BOX_LEVELS,
 ) -> NDArray[np.float64]:
     """Kernel-weighted histograms of many boxes of one bin-index image, in one call.
 
@@ -688,9 +858,11 @@ def region_histograms(
     n_bins : int
         Number of colour bins B.
     kernel : int
-        ``KERNEL_UNIFORM``, ``KERNEL_EPANECHNIKOV`` or ``KERNEL_CONE``.
+        ``KERNEL_UNIFORM``, ``KERNEL_EPANECHNIKOV``, ``KERNEL_CONE`` or ``KERNEL_BOX``.
     n_parts : int, optional
         Horizontal bands (spatial components), concatenated top to bottom.
+    box_levels : int, optional
+        Levels L of ``KERNEL_BOX`` (ignored by the other kernels).
 
     Returns
     -------
@@ -712,7 +884,9 @@ def region_histograms(
     """
     img, bx, n_bins, kernel, n_parts = _check_region_args(bin_img, boxes, n_bins, kernel,
                                                           n_parts)
-    return _region_histograms(img, bx, n_bins, kernel, n_parts, _lanes(n_bins * n_parts))
+    fracs, a_fixed = _level_args(kernel, box_levels)
+    return _region_histograms(img, bx, n_bins, kernel, n_parts, _lanes(n_bins * n_parts),
+                              fracs, a_fixed)
 
 
 def region_distances(
@@ -725,6 +899,7 @@ def region_distances(
     *,
     check_bins: bool = True,
     method: str = "auto",
+    box_levels: int = DEFAULT_BOX_LEVELS,
 ) -> NDArray[np.float64]:
     """Bhattacharyya distance of every box's histogram to its reference, in one call.
 
@@ -734,10 +909,12 @@ def region_distances(
     - *direct*: each box's pixels are accumulated into one reused scratch histogram, and
       only the bins where the reference is positive are read back (the others add
       nothing to Σ sqrt(p q)); cost ∝ the boxes' total area.
-    - *integral* (uniform kernel only): per reference, the integral histogram (Porikli
-      2005) of the reference's support bins over the union of its boxes; each box then
-      costs four reads per support bin whatever its size. Particle clouds (hundreds of
-      overlapping boxes of one object) are where this pays.
+    - *integral* (uniform and box kernels): per reference, the integral histogram
+      (Porikli 2005) of the reference's support bins over the union of its boxes; each
+      box then costs four reads per support bin (per level, for the box kernel) whatever
+      its size. Particle clouds (hundreds of overlapping boxes of one object) are where
+      this pays. For the box kernel both paths give bit-identical results (the same
+      fixed-point histogram, summed in the same order).
 
     ``method="auto"`` picks, per reference, the path with the lower estimated cost; both
     give the same ρ to rounding (about 1e-15; d = sqrt(1 − ρ) magnifies that to about
@@ -763,9 +940,11 @@ def region_distances(
         object) check it once and pass False; an index out of range would then read
         out of bounds.
     method : {"auto", "direct", "integral"}, optional
-        Evaluation path (see above); "integral" applies to the uniform kernel only (the
-        others always take the direct path), and falls back to "direct" for a reference
-        whose integral histogram would exceed 2**24 cells.
+        Evaluation path (see above); "integral" applies to the uniform and box kernels
+        (the others always take the direct path), and falls back to "direct" for a
+        reference whose integral histogram would exceed 2**24 cells.
+    box_levels : int, optional
+        Levels L of ``KERNEL_BOX`` (ignored by the other kernels).
 
     Returns
     -------
@@ -788,7 +967,8 @@ def region_distances(
     prepared = prepare_references(refs, n_parts)
     img, bx, _, _, _ = _check_region_args(bin_img, boxes, prepared.n_bins, kernel,
                                           prepared.n_parts, check_bins)
-    return prepared_distances(img, bx, prepared, ref_index, kernel, method=method)
+    return prepared_distances(img, bx, prepared, ref_index, kernel, method=method,
+                              box_levels=box_levels)
 
 
 class PreparedReferences(NamedTuple):
@@ -847,6 +1027,7 @@ def prepared_distances(
     kernel: int,
     *,
     method: str = "auto",
+    box_levels: int = DEFAULT_BOX_LEVELS,
 ) -> NDArray[np.float64]:
     """``region_distances`` against prepared references, with the per-call checks cut to
     what keeps the kernel in bounds.
@@ -885,10 +1066,11 @@ def prepared_distances(
     if idx.size and (idx.min() < 0 or idx.max() >= n_refs):
         raise ValueError(f"ref_index must lie in [0, {n_refs}), got "
                          f"[{idx.min()}, {idx.max()}]")
+    fracs, a_fixed = _level_args(int(kernel), box_levels)
     return _region_distances(bin_img, bx, prepared.sqrt_refs, idx, prepared.nz,
                              prepared.nz_start, prepared.empty_rho, prepared.n_bins,
                              int(kernel), prepared.n_parts, _lanes(prepared.refs.shape[1]),
-                             METHODS[method])
+                             METHODS[method], fracs, a_fixed, numba.get_num_threads())
 
 
 
@@ -896,7 +1078,7 @@ def prepared_distances(
 def bhattacharyya_coefficient(
     hists: NDArray[np.floating], refs: NDArray[np.floating]
 ) -> NDArray[np.float64]:
-    """ρ = Σ_u sqrt(p_u q_u) per row (ALGORITHMS.md §2.1).
+    """ρ = Σ_u sqrt(p_u q_u) per row (docs/algorithms.md §2.2).
 
     Parameters
     ----------

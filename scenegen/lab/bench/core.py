@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 
 __all__ = ["BenchRow", "median_time"]
 
@@ -37,6 +37,9 @@ class BenchRow:
         The goal in words ("" if none), e.g. ``">= 10x baseline"``.
     met : bool | None
         Whether the goal is met (None if no goal).
+    params : dict
+        What the row was measured at, for rows that sweep a parameter (e.g.
+        ``{"axis": "n", "x": 300, "kernel": "box"}``).
     """
 
     group: str
@@ -48,6 +51,7 @@ class BenchRow:
     ratio: float = 1.0
     goal: str = ""
     met: bool | None = None
+    params: dict[str, object] = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, object]:
         return asdict(self)

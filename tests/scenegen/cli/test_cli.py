@@ -46,7 +46,8 @@ def test_generate_inspect_validate_preview_export(tmp_path, capsys):
     rows = np.loadtxt(tmp_path / "mot" / "gt" / "gt.txt", delimiter=",", ndmin=2)
     assert rows.shape == (6, 9)
     assert rows[:, 0].tolist() == [1, 2, 3, 4, 5, 6] and set(rows[:, 1]) == {1}
-    np.testing.assert_allclose(rows[:, 2:6], seq.gt.box[:, 0])
+    np.testing.assert_allclose(rows[:, 2:4] - 1, seq.gt.box[:, 0, :2])  # MOT pixels are 1-based
+    np.testing.assert_allclose(rows[:, 4:6], seq.gt.box[:, 0, 2:])
     np.testing.assert_allclose(rows[:, 8], seq.gt.visibility[:, 0], atol=1e-6)
     ini = (tmp_path / "mot" / "seqinfo.ini").read_text()
     assert "seqLength=6" in ini and "imWidth=320" in ini

@@ -44,16 +44,22 @@ def seq():
 def test_perfect_result_scores_perfectly(seq):
     gt = np.asarray(seq.gt.box[:, seq.target_indices()], dtype=np.float64)
     rep = evaluate(seq, gt, seq.target_ids(), tracker="oracle")
-    assert rep["n_frames"] == 12 and rep["tracker"] == "oracle"
-    for t in rep["targets"]:
-        assert t["tracked"] == 100.0 and t["success"] and t["recovered"]
-        assert t["precision"] == pytest.approx(100.0) and t["mean_centre_error"] == 0.0
-        assert t["failure_frame"] == -1
-    o = rep["overall"]
-    assert o["mota"] == 1.0 and o["idf1"] == 1.0 and o["auc"] == pytest.approx(20 / 21)
+    assert rep.n_frames == 12 and rep.tracker == "oracle"
+    for t in rep.targets:
+        assert t.tracked == 100.0 and t.success and t.recovered
+        assert t.precision == pytest.approx(100.0) and t.mean_centre_error == 0.0
+        assert t.failure_frame == -1
+        assert t.mot.mota == 1.0 and t.mot.hota == pytest.approx(1.0) and t.track_id == t.id
+    o = rep.overall
+    assert o.mot.mota == 1.0 and o.mot.idf1 == 1.0 and o.auc == pytest.approx(20 / 21)
+    assert (o.mot.fp, o.mot.fn, o.mot.idsw, o.mot.mt, o.mot.ml) == (0, 0, 0, 2, 0)
     text = format_table(rep)
-    assert "oracle" in text and "MOTA 1.000" in text
-    assert json.loads(to_json(rep)) == rep
+    assert "oracle" in text and "MOTA 1.000" in text and "HOTA 1.000" in text
+    doc = json.loads(to_json(rep))
+    assert doc == rep.to_dict()
+    keys = {"mota", "motp", "idf1", "idp", "idr", "fp", "fn", "idsw", "hota", "deta", "assa",
+            "auc", "precision_20"}  # fmt: skip
+    assert keys <= set(doc["overall"]) and all(keys <= set(t) for t in doc["targets"])
 
 
 def test_lost_target_is_reported(seq):
@@ -61,11 +67,12 @@ def test_lost_target_is_reported(seq):
     est[4:, 1, :2] = [0.0, 0.0]  # target b jumps to the corner and stays there
     est[4:, 1, 2:] = [5.0, 5.0]
     rep = evaluate(seq, est, seq.target_ids(), persist=3)
-    b = rep["targets"][1]
-    assert b["success"] is False and b["recovered"] is False
-    assert b["tracked"] == pytest.approx(100 * 4 / 12)
-    assert b["failure_frame"] == 4
-    assert rep["overall"]["mota"] < 1.0
+    b = rep.targets[1]
+    assert b.success is False and b.recovered is False
+    assert b.tracked == pytest.approx(100 * 4 / 12)
+    assert b.failure_frame == 4
+    assert rep.overall.mot.mota < 1.0
+    assert (b.mot.fp, b.mot.fn) == (8, 8) and rep.overall.mot.fn == 8
 
 
 def test_depth_order_accuracy_of_true_ordering(seq):
@@ -76,9 +83,10 @@ def test_depth_order_accuracy_of_true_ordering(seq):
     prob = np.eye(2)[truth]
     est = seq.gt.box[:, idx]
     rep = evaluate(seq, est, seq.target_ids(), order_prob=prob, orderings=orderings)
-    assert rep["overall"]["depth_order_accuracy"] == 100.0
+    assert rep.overall.depth_order_accuracy == 100.0
+    assert "depth_order_accuracy" in rep.to_dict()["overall"]
     rep = evaluate(seq, est, seq.target_ids(), order_prob=prob[:, ::-1], orderings=orderings)
-    assert rep["overall"]["depth_order_accuracy"] == 0.0
+    assert rep.overall.depth_order_accuracy == 0.0
 
 
 def test_mismatches_raise_data_error_naming_them(seq):
@@ -133,3 +141,25 @@ def test_cli_exit_codes(seq, tmp_path, capsys):
     write_result(res, TrackerResult("kalman", {}, 0, seq.name, seq.target_ids(), boxes))
     assert main(["evaluate", str(data), str(res), "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["overall"]["idf1"] == 1.0
+
+
+def test_tracks_with_foreign_ids_pair_by_identity_and_otb_average(seq):
+    from scenegen.evaluation import evaluate_tracks
+
+    gt = np.asarray(seq.gt.box[:, seq.target_indices()], dtype=np.float64)
+    est = gt[:, ::-1].copy()  # column 0 follows target b, column 1 target a
+    est[6:, 0] = np.nan  # track 70 (on b) stops half way
+    rep = evaluate_tracks(seq, est, [70, 80], tracker="other")
+    assert [(t.id, t.track_id) for t in rep.targets] == [(1, 80), (2, 70)]
+    assert rep.targets[0].mot.mota == 1.0 and rep.targets[1].mot.fn == 6
+    assert rep.targets[1].auc == pytest.approx(0.5 * 20 / 21)
+    assert rep.overall.auc == pytest.approx(np.mean([t.auc for t in rep.targets]))
+    pooled = evaluate_tracks(seq, est, [70, 80], otb_average="frames").overall
+    from scenegen.evaluation.metrics import otb_curves
+
+    assert pooled.otb_average == "frames"
+    assert pooled.auc == otb_curves(est[:, ::-1], gt).auc
+    with pytest.raises(scenegen.errors.ConfigError, match="otb_average"):
+        evaluate_tracks(seq, est, [70, 80], otb_average="mean")
+    with pytest.raises(DataError, match="tracks span 5 frames"):
+        evaluate_tracks(seq, est[:5], [70, 80])

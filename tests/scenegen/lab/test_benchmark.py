@@ -60,12 +60,12 @@ def test_report(reference):
     assert res["params"] == {"sok": {}, "annealed": PARAMS}
     assert len(res["scores"]) == 8
     row = res["scores"][0]
-    assert row["targets"] == 2 and row["mota"] is not None and row["idf1"] is not None
+    assert row["targets"] == 2 and None not in (row["mota"], row["idf1"], row["hota"])
     assert set(row["params"]) == {"clutter[0].count", "entities[a].position_noise"}
     axes = {(c["axis"], c["metric"]) for c in res["curves"]}
     assert ("clutter[0].count", "success") in axes and ("entities[a].position_noise", "auc") in axes
     page = (reference / "index.html").read_text()
-    assert "Leaderboard" in page and "MOTA" in page
+    assert "Leaderboard" in page and "MOTA" in page and "HOTA" in page
     pngs = sorted(p.name for p in reference.glob("curve-*.png"))
     assert pngs and all(f'src="{p}"' in page for p in pngs)
     csv = (reference / "scores.csv").read_text().splitlines()

@@ -1,0 +1,197 @@
+"""Export to single-object benchmark layouts: OTB, GOT-10k and VOT.
+
+Single-object toolkits know one target per sequence, so every target becomes its own
+sequence folder ``DIR/<sequence>_<target name>/`` holding all frames and that target's
+annotation (frames are hard links to one copy where the file system allows). DIR also
+gets ``list.txt`` naming the sequence folders, one a line (as GOT-10k and VOT have).
+Boxes are amodal ``x, y, w, h``, one comma-separated line per frame. Conventions:
+
+OTB (Wu et al. 2015, the MATLAB toolkit)
+    ``img/0001.jpg …`` and ``groundtruth_rect.txt``. Pixel coordinates are 1-based
+    (MATLAB): ``x + 1, y + 1, w, h``. OTB has no absence label: a frame where the target
+    is out of the scene is written ``0,0,0,0``, which the toolkit's
+    ``calcSeqErrRobust`` treats as unlabelled (any value <= 0: overlap and centre error
+    -1, still counted in the frame total). Occluded frames keep their amodal box, as OTB
+    annotates occluded targets.
+GOT-10k (Huang et al. 2019, the ``got10k`` Python toolkit)
+    ``00000001.jpg …``, ``groundtruth.txt`` (0-based pixels, the toolkit reads them as
+    they are), ``absence.label`` (1 where the target is out of the scene, box
+    ``0,0,0,0``), ``cover.label`` (visible ratio in GOT-10k's levels 0–8: 0 fully
+    occluded or absent, 1 (0, 15 %), 2 [15, 30 %), … 7 [90, 100 %), 8 fully visible),
+    ``cut_by_image.label`` (1 where the amodal box reaches past the image border) and
+    ``meta_info.ini``. The toolkit scores only frames with cover > 0, so fully occluded
+    and absent frames do not count there. It opens ``ROOT/<subset>/list.txt``: export
+    into ``ROOT/val`` for ``got10k.datasets.GOT10k(ROOT, subset="val")``.
+VOT (Kristan et al., the ``vot`` toolkit; short-term rectangle format)
+    ``color/00000001.jpg …``, ``groundtruth.txt`` (0-based pixels, as the Python toolkit
+    reads regions), absent frames ``nan,nan,nan,nan`` (VOT long-term's "target not
+    visible"), per-frame tags ``occlusion.tag`` (1 where less than the whole target is
+    visible, absent frames included) and ``sequence`` metadata (``channels.color``,
+    ``fps``, ``format``, ``name``).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from scenegen.errors import ConfigError
+from scenegen.io.export import encode_frame, write_folder
+from scenegen.sequence import Sequence
+
+__all__ = ["BENCHMARKS", "cover_level", "export_benchmark"]
+
+BENCHMARKS = ("otb", "got10k", "vot")
+_DEFAULT_IMAGE = {"otb": "jpg", "got10k": "jpg", "vot": "png"}
+
+
+def cover_level(visibility: float, present: bool) -> int:
+    """GOT-10k's cover level 0–8 of a visible fraction (0 when absent or fully occluded)."""
+    if not present or visibility <= 0.0:
+        return 0
+    if visibility >= 1.0:
+        return 8
+    if visibility >= 0.9:
+        return 7
+    return 1 + int(math.floor(visibility / 0.15 + 1e-9))
+
+
+def _num(v: float) -> str:
+    r = repr(float(v))
+    return r[:-2] if r.endswith(".0") else r
+
+
+def _frame_name(kind: str, t: int, ext: str) -> str:
+    if kind == "otb":
+        return f"img/{t + 1:04d}.{ext}"
+    if kind == "vot":
+        return f"color/{t + 1:08d}.{ext}"
+    return f"{t + 1:08d}.{ext}"
+
+
+def _annotations(kind: str, seq: Sequence, k: int, fps: int, ext: str) -> dict[str, str]:
+    """File name -> content of target ``k``'s annotation files."""
+    box = np.asarray(seq.gt.box[:, k], dtype=np.float64)
+    present = np.asarray(seq.gt.present[:, k], dtype=bool)
+    vis = np.asarray(seq.gt.visibility[:, k], dtype=np.float64)
+    lines = []
+    for t in range(seq.n_frames):
+        x, y, w, h = box[t]
+        if not present[t]:
+            lines.append("nan,nan,nan,nan" if kind == "vot" else "0,0,0,0")
+        elif kind == "otb":
+            lines.append(f"{_num(x + 1)},{_num(y + 1)},{_num(w)},{_num(h)}")
+        else:
+            lines.append(f"{_num(x)},{_num(y)},{_num(w)},{_num(h)}")
+    name = "groundtruth_rect.txt" if kind == "otb" else "groundtruth.txt"
+    files = {name: "\n".join(lines) + "\n"}
+    if kind == "got10k":
+        files["absence.label"] = "".join(f"{int(not p)}\n" for p in present)
+        files["cover.label"] = "".join(
+            f"{cover_level(float(v), bool(p))}\n" for v, p in zip(vis, present, strict=True)
+        )
+        right, bottom = box[:, 0] + box[:, 2], box[:, 1] + box[:, 3]
+        with np.errstate(invalid="ignore"):
+            cut = present & (
+                (box[:, 0] < 0) | (box[:, 1] < 0) | (right > seq.width) | (bottom > seq.height)
+            )
+        files["cut_by_image.label"] = "".join(f"{int(c)}\n" for c in cut)
+        files["meta_info.ini"] = (
+            "[METAINFO]\n"
+            f"object_class: {seq.entities.name[k]}\n"
+            f"resolution: ({seq.width}, {seq.height})\n"
+            "source: scenegen\n"
+        )
+    if kind == "vot":
+        files["occlusion.tag"] = "".join(
+            f"{int(not p or v < 1.0)}\n" for v, p in zip(vis, present, strict=True)
+        )
+        files["sequence"] = (
+            f"channels.color=color/%08d.{ext}\nformat=default\nfps={fps}\n"
+            f"name={seq.name}_{seq.entities.name[k]}\n"
+        )
+    return files
+
+
+def _folder_name(seq: Sequence, k: int) -> str:
+    raw = f"{seq.name}_{seq.entities.name[k]}"
+    return re.sub(r"[^A-Za-z0-9._-]+", "-", raw)
+
+
+def export_benchmark(
+    seq: Sequence,
+    out_dir: str | Path,
+    kind: str,
+    *,
+    image_format: str | None = None,
+    fps: int = 25,
+    progress: Callable[[int], None] | None = None,
+) -> list[str]:
+    """Write ``seq`` in the OTB, GOT-10k or VOT layout, one sequence folder per target.
+
+    Parameters
+    ----------
+    seq : Sequence
+        In memory or lazily read (frames are read one at a time).
+    out_dir : str or Path
+        Output folder, replaced atomically; its parent must exist.
+    kind : {"otb", "got10k", "vot"}
+    image_format : {"png", "jpg"}, optional
+        Frame files; default jpg for OTB and GOT-10k (their loaders list ``*.jpg``), png
+        (lossless) for VOT.
+    fps : int
+        VOT's ``sequence`` file.
+    progress : callable, optional
+        Called with the number of frames written so far.
+
+    Returns
+    -------
+    list of str
+        The sequence folders written (one per target in the scene at some frame).
+
+    Raises
+    ------
+    ConfigError
+        For an unknown ``kind`` or image format, or an output that cannot be written.
+    """
+    if kind not in BENCHMARKS:
+        raise ConfigError(f"benchmark must be one of {', '.join(BENCHMARKS)}; got {kind!r}")
+    ext = image_format or _DEFAULT_IMAGE[kind]
+    out = Path(out_dir)
+    encode_frame(np.zeros((1, 1, 3), np.uint8), ext, out)
+    idx = np.asarray(seq.target_indices())
+    idx = [int(k) for k in idx if np.asarray(seq.gt.present[:, k]).any()]
+    names = [_folder_name(seq, k) for k in idx]
+
+    def fill(tmp: Path) -> None:
+        for k, name in zip(idx, names, strict=True):
+            folder = tmp / name
+            (folder / ("img" if kind == "otb" else "color" if kind == "vot" else "")).mkdir(
+                parents=True, exist_ok=True
+            )
+            for fname, text in _annotations(kind, seq, k, fps, ext).items():
+                (folder / fname).write_text(text)
+        (tmp / "list.txt").write_text("".join(n + "\n" for n in names))
+        for t in range(seq.n_frames):
+            data = encode_frame(seq.frames[t], ext, out)
+            first: Path | None = None
+            for name in names:
+                path = tmp / name / _frame_name(kind, t, ext)
+                if first is None:
+                    path.write_bytes(data)
+                    first = path
+                    continue
+                try:
+                    os.link(first, path)
+                except OSError:
+                    path.write_bytes(data)
+            if progress is not None:
+                progress(t + 1)
+
+    write_folder(out, fill)
+    return names

@@ -1,0 +1,228 @@
+"""MOTChallenge text files: ground-truth rows and tracker files, written and read.
+
+MOTChallenge conventions (Milan et al., "MOT16", §3.3 and the devkit): one row per box,
+``frame, id, bb_left, bb_top, bb_width, bb_height, conf, ...``, frames and ids counted
+from 1, and pixel coordinates counted from 1 (the devkit is MATLAB: the top-left pixel
+is (1, 1)). scenegen counts pixels from 0, so ``bb_left = x + 1`` and ``bb_top = y + 1``;
+reading subtracts 1 again. Numbers are written with Python's shortest round-trip repr,
+so a file read back gives the boxes written (up to the float64 rounding of ``± 1``).
+
+Tracker files have 10 columns: ``frame, id, bb_left, bb_top, bb_width, bb_height, conf,
+-1, -1, -1`` (``conf`` 1; the last three are MOTChallenge's unused world coordinates).
+
+Ground-truth modes (``gt_mode``) say which ground-truth boxes count:
+
+``amodal`` (scenegen's default)
+    Every frame where a target is in the scene counts, with its amodal box, occluded or
+    not. Tracker boxes are all scored. The ground-truth file holds the target rows only,
+    all with ``conf`` 1.
+``visible`` (MOTChallenge's convention)
+    A target counts only in frames where its visible fraction is above
+    ``visibility_threshold`` (default 0: fully occluded frames are ignored); other rows
+    get ``conf`` 0, which MOTChallenge and TrackEval ignore. Distractors are written as
+    class 8 and occluders as class 9; a tracker box matched to a distractor is dropped
+    (neither a true nor a false positive), as TrackEval's MOTChallenge preprocessing does.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from scenegen.errors import ConfigError, DataError
+from scenegen.io.atomic import atomic_path
+from scenegen.sequence import Sequence
+
+__all__ = [
+    "GT_MODES",
+    "MOT_CLASS",
+    "gt_keep",
+    "gt_rows",
+    "read_mot_tracker",
+    "write_mot_tracker",
+]
+
+GT_MODES = ("amodal", "visible")
+"""Ground-truth conventions of the MOT export and of ``evaluate`` (see the module doc)."""
+
+MOT_CLASS = {"target": 1, "distractor": 8, "occluder": 9}
+"""MOT17 classes: pedestrian, distractor, occluder."""
+
+MAX_TRACKER_FILE_BYTES = 512 * 1024 * 1024
+
+
+def _num(v: float) -> str:
+    r = repr(float(v))
+    return r[:-2] if r.endswith(".0") else r
+
+
+def check_gt_mode(gt_mode: str, visibility_threshold: float) -> None:
+    """Raise ConfigError for an unknown mode or a threshold outside [0, 1)."""
+    if gt_mode not in GT_MODES:
+        raise ConfigError(f"gt_mode must be one of {', '.join(GT_MODES)}; got {gt_mode!r}")
+    if not 0.0 <= visibility_threshold < 1.0:
+        raise ConfigError(f"visibility threshold must be in [0, 1), got {visibility_threshold}")
+
+
+def gt_keep(
+    seq: Sequence, gt_mode: str = "amodal", visibility_threshold: float = 0.0
+) -> NDArray[np.bool_]:
+    """Ground-truth boxes that count, (T, K) bool: present, and visible enough if ``visible``."""
+    check_gt_mode(gt_mode, visibility_threshold)
+    present = np.asarray(seq.gt.present, dtype=bool)
+    if gt_mode == "amodal":
+        return present
+    return present & (np.asarray(seq.gt.visibility, dtype=np.float64) > visibility_threshold)
+
+
+def gt_rows(
+    seq: Sequence, t: int, gt_mode: str = "amodal", visibility_threshold: float = 0.0
+) -> list[str]:
+    """The MOTChallenge ``gt.txt`` rows of frame ``t`` (0-based), entities in file order.
+
+    Columns: ``frame, id, bb_left, bb_top, bb_width, bb_height, conf, class, visibility``.
+    """
+    check_gt_mode(gt_mode, visibility_threshold)
+    gt = seq.gt
+    roles = seq.entities.role
+    rows = []
+    for k in range(len(seq.entities)):
+        role = str(roles[k])
+        if role not in MOT_CLASS or not gt.present[t, k]:
+            continue
+        if gt_mode == "amodal" and role != "target":
+            continue
+        x, y, w, h = (float(v) for v in gt.box[t, k])
+        vis = float(gt.visibility[t, k])
+        conf = int(role == "target" and (gt_mode == "amodal" or vis > visibility_threshold))
+        eid = int(seq.entities.id[k])
+        rows.append(
+            f"{t + 1},{eid},{_num(x + 1)},{_num(y + 1)},{_num(w)},{_num(h)},{conf},"
+            f"{MOT_CLASS[role]},{vis:.6f}"
+        )
+    return rows
+
+
+def write_mot_tracker(path: str | Path, boxes: ArrayLike, track_ids: ArrayLike) -> int:
+    """Write tracker boxes as a MOTChallenge tracker file (atomically).
+
+    Parameters
+    ----------
+    path : str or Path
+        The ``.txt`` file; its folder must exist.
+    boxes : array_like of shape (T, M, 4)
+        Boxes ``[x, y, w, h]`` (0-based pixels), NaN where the track has no box.
+    track_ids : array_like of int, shape (M,)
+        Track ids (≥ 1), e.g. the entity ids of a :class:`scenegen.io.TrackerResult`.
+
+    Returns
+    -------
+    int
+        Rows written.
+
+    Raises
+    ------
+    ConfigError
+        If the file cannot be written (naming ``path``) or an id is < 1.
+    """
+    b = np.asarray(boxes, dtype=np.float64)
+    ids = np.asarray(track_ids).astype(np.int64).reshape(-1)
+    if b.ndim != 3 or b.shape[1:] != (ids.shape[0], 4):
+        raise ConfigError(f"boxes {b.shape} do not fit {ids.shape[0]} track ids")
+    if ids.size and ids.min() < 1:
+        raise ConfigError(f"MOTChallenge track ids start at 1, got {int(ids.min())}")
+    lines = []
+    for t in range(b.shape[0]):
+        for m in range(b.shape[1]):
+            x, y, w, h = b[t, m]
+            if not all(math.isfinite(v) for v in (x, y, w, h)):
+                continue
+            box = f"{_num(x + 1)},{_num(y + 1)},{_num(w)},{_num(h)}"
+            lines.append(f"{t + 1},{int(ids[m])},{box},1,-1,-1,-1\n")
+    target = Path(path)
+    with writable(target), atomic_path(target) as tmp:
+        tmp.write_text("".join(lines))
+    return len(lines)
+
+
+def read_mot_tracker(
+    path: str | Path, n_frames: int
+) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
+    """Read a MOTChallenge tracker file.
+
+    Parameters
+    ----------
+    path : str or Path
+    n_frames : int
+        Frames of the sequence it was made on; frame numbers must be in 1..n_frames.
+
+    Returns
+    -------
+    track_ids : ndarray of int, shape (M,)
+        The ids in the file, sorted.
+    boxes : ndarray of shape (n_frames, M, 4)
+        Boxes in scenegen's 0-based pixels (``bb_left - 1``, ``bb_top - 1``), NaN where a
+        track has no row.
+
+    Raises
+    ------
+    DataError
+        Naming the file and line of a malformed row, a frame out of range, or a track id
+        that appears twice in a frame.
+    """
+    p = Path(path)
+    try:
+        if p.stat().st_size > MAX_TRACKER_FILE_BYTES:
+            raise DataError(f"{p}: larger than {MAX_TRACKER_FILE_BYTES} bytes; not a tracker file")
+        text = p.read_text()
+    except (OSError, UnicodeDecodeError) as err:
+        raise DataError(f"{p}: cannot read as a MOTChallenge tracker file: {err}") from None
+    rows: list[tuple[int, int, float, float, float, float]] = []
+    for n, line in enumerate(text.splitlines(), 1):
+        if not line.strip():
+            continue
+        cells = line.replace(" ", "").split(",")
+        try:
+            if len(cells) < 6:
+                raise ValueError("fewer than 6 columns")
+            frame, ident = float(cells[0]), float(cells[1])
+            if frame != int(frame) or ident != int(ident):
+                raise ValueError("frame and id must be integers")
+            vals = [float(c) for c in cells[2:6]]
+        except ValueError as err:
+            raise DataError(f"{p}:{n}: not a MOTChallenge row ({err}): {line[:80]!r}") from None
+        if not 1 <= frame <= n_frames:
+            raise DataError(f"{p}:{n}: frame {int(frame)} is outside 1..{n_frames}")
+        rows.append((int(frame), int(ident), *vals))  # type: ignore[arg-type]
+    ids = np.array(sorted({r[1] for r in rows}), dtype=np.int64)
+    col = {int(i): c for c, i in enumerate(ids)}
+    boxes = np.full((n_frames, ids.shape[0], 4), np.nan)
+    for frame, ident, x, y, w, h in rows:
+        t, c = frame - 1, col[ident]
+        if not np.isnan(boxes[t, c, 0]):
+            raise DataError(f"{p}: track id {ident} appears twice in frame {frame}")
+        boxes[t, c] = (x - 1.0, y - 1.0, w, h)
+    return ids, boxes
+
+
+class writable:
+    """Context manager: turn an operating-system error while writing into one ConfigError.
+
+    ``with writable(target): ...`` reports ``TARGET: cannot write: REASON`` (exit 2 in the
+    CLI: the user must pick another output) instead of an internal error naming a
+    temporary file beside the target.
+    """
+
+    def __init__(self, target: str | Path) -> None:
+        self.target = Path(target)
+
+    def __enter__(self) -> None:
+        return None
+
+    def __exit__(self, kind: type | None, err: BaseException | None, tb: object) -> bool:
+        if isinstance(err, OSError) and err.errno is not None:
+            raise ConfigError(f"{self.target}: cannot write: {err.strerror or err}") from None
+        return False

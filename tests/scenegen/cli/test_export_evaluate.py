@@ -1,0 +1,169 @@
+"""MOT round trip (export a result, evaluate the tracker file), benchmark layouts, rough edges."""
+
+from __future__ import annotations
+
+import json
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from scenegen.cli import _parser, main
+from scenegen.io import TrackerResult, read, write_result
+from scenegen.io.benchmarks import cover_level, export_benchmark
+from scenegen.io.mot import read_mot_tracker, write_mot_tracker
+
+FIXTURES = Path(__file__).resolve().parents[3] / "fixtures"
+
+
+def run(capsys, *argv):
+    code = main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+@pytest.fixture(scope="module")
+def occluded():
+    return read(FIXTURES / "full-occlusion.h5")
+
+
+def test_result_round_trip_through_a_mot_file(tmp_path, capsys, occluded):
+    seq = occluded
+    boxes = np.load(FIXTURES / "expected" / "full-occlusion" / "kalman.npy").astype(np.float32)
+    boxes[3, 0] = np.nan  # a frame without a box: no row
+    b64 = boxes.astype(np.float64)
+    ids = seq.entities.id[seq.initial_targets()]
+    res = tmp_path / "r.h5"
+    write_result(res, TrackerResult("kalman", {}, 0, seq.name, ids, boxes))
+    txt = tmp_path / "kalman.txt"
+    code, out, _ = run(capsys, "export", res, "--format", "mot", "-o", txt)
+    assert code == 0 and "MOTChallenge" in out
+    rows = np.loadtxt(txt, delimiter=",", ndmin=2)
+    assert rows.shape == (seq.n_frames - 1, 10) and 4 not in rows[:, 0]
+    np.testing.assert_array_equal(rows[:, 2:4], b64[rows[:, 0].astype(int) - 1, 0, :2] + 1.0)
+    got_ids, got = read_mot_tracker(txt, seq.n_frames)
+    assert got_ids.tolist() == ids.tolist()
+    np.testing.assert_array_equal(got, b64)  # exact round trip
+    for mode in ("amodal", "visible"):
+        a = json.loads(run(capsys, "evaluate", FIXTURES / "full-occlusion.h5", res, "--json",
+                           "--gt-mode", mode)[1])  # fmt: skip
+        b = json.loads(run(capsys, "evaluate", FIXTURES / "full-occlusion.h5", txt, "--json",
+                           "--gt-mode", mode)[1])  # fmt: skip
+        assert a["overall"] | {"otb_average": 0} == b["overall"] | {"otb_average": 0}
+        assert a["gt_mode"] == mode
+    # amodal counts the two fully occluded frames, visible ignores them
+    assert a["overall"]["tp"] + a["overall"]["fn"] == seq.n_frames - 2
+    code, out, _ = run(capsys, "evaluate", FIXTURES / "full-occlusion.h5", txt)
+    assert code == 0 and "HOTA" in out and "IDSW" in out and "Frag" in out
+
+
+def test_bad_tracker_files_name_file_and_line(tmp_path, capsys):
+    seq_file = FIXTURES / "full-occlusion.h5"
+    bad = tmp_path / "bad.txt"
+    bad.write_text("1,1,2,3,4,5,1,-1,-1,-1\n2,1,x,3,4,5\n")
+    code, _, err = run(capsys, "evaluate", seq_file, bad)
+    assert code == 1 and "bad.txt:2" in err and len(err.strip().splitlines()) == 1
+    bad.write_text("99,1,2,3,4,5\n")
+    code, _, err = run(capsys, "evaluate", seq_file, bad)
+    assert code == 1 and "frame 99 is outside 1..14" in err
+    code, _, err = run(capsys, "evaluate", seq_file, bad, "--gt-mode", "visible",
+                       "--visibility-threshold", "1.5")  # fmt: skip
+    assert code == 2
+
+
+def test_gt_export_modes(tmp_path, capsys):
+    src = FIXTURES / "distractor-on-target.h5"
+    seq = read(src)
+    for mode in ("amodal", "visible"):
+        out = tmp_path / mode
+        assert run(capsys, "export", src, "--format", "mot", "-o", out, "--gt-mode", mode)[0] == 0
+        rows = np.loadtxt(out / "gt" / "gt.txt", delimiter=",", ndmin=2)
+        if mode == "amodal":  # target rows only, all counted
+            assert set(rows[:, 7]) == {1} and set(rows[:, 6]) == {1}
+            assert len(rows) == int(seq.gt.present[:, seq.target_indices()].sum())
+        else:  # distractor rows (class 8); fully occluded target rows conf 0
+            assert 8 in rows[:, 7]
+            hidden = (rows[:, 7] == 1) & (rows[:, 8] == 0)
+            assert hidden.any() and set(rows[hidden, 6]) == {0}
+    out = tmp_path / "jpg"
+    assert run(capsys, "export", src, "--format", "mot", "-o", out, "--image-format", "jpg")[0] == 0
+    assert "imExt=.jpg" in (out / "seqinfo.ini").read_text()
+    assert len(list((out / "img1").glob("*.jpg"))) == seq.n_frames
+
+
+def test_benchmark_layouts(tmp_path, capsys):
+    src = FIXTURES / "enter-leave.h5"
+    seq = read(src)
+    names = []
+    for kind in ("otb", "got10k", "vot"):
+        out = tmp_path / kind
+        code, _, _ = run(capsys, "export", src, "--format", kind, "-o", out)
+        assert code == 0
+        names = (out / "list.txt").read_text().split()
+        assert len(names) == 2  # one sequence per target
+        k = int(seq.target_indices()[1])  # target b enters late
+        absent = ~np.asarray(seq.gt.present[:, k])
+        assert absent.any()
+        folder = out / names[1]
+        gt_name = "groundtruth_rect.txt" if kind == "otb" else "groundtruth.txt"
+        lines = (folder / gt_name).read_text().splitlines()
+        assert len(lines) == seq.n_frames
+        t = int(np.flatnonzero(~absent)[0])
+        vals = [float(v) for v in lines[t].split(",")]
+        offset = 1.0 if kind == "otb" else 0.0  # OTB is 1-based (MATLAB)
+        np.testing.assert_allclose(vals, seq.gt.box[t, k] + [offset, offset, 0, 0], rtol=0)
+        gone = lines[int(np.flatnonzero(absent)[0])]
+        assert gone == ("nan,nan,nan,nan" if kind == "vot" else "0,0,0,0")
+        frames = {"otb": "img/*.jpg", "got10k": "*.jpg", "vot": "color/*.png"}[kind]
+        assert len(list(folder.glob(frames))) == seq.n_frames
+    got = tmp_path / "got10k" / names[1]
+    absence = (got / "absence.label").read_text().split()
+    assert absence == [str(int(not p)) for p in seq.gt.present[:, seq.target_indices()[1]]]
+    cut = (got / "cut_by_image.label").read_text().split()
+    assert len(cut) == seq.n_frames and set(cut) <= {"0", "1"}
+    assert "sequence" in {p.name for p in (tmp_path / "vot" / names[1]).iterdir()}
+    code, _, _ = run(capsys, "export", src, "--format", "otb", "-o", tmp_path / "o2",
+                     "--image-format", "png")  # fmt: skip
+    assert code == 0 and len(list((tmp_path / "o2" / names[0] / "img").glob("*.png"))) == 12
+
+
+def test_cover_levels_and_occlusion_tags(tmp_path, occluded):
+    assert [cover_level(v, True) for v in (0, 0.1, 0.15, 0.3, 0.5, 0.89, 0.9, 1)] == [
+        0, 1, 2, 3, 4, 6, 7, 8]  # fmt: skip
+    assert cover_level(1.0, False) == 0
+    done = []
+    export_benchmark(occluded, tmp_path / "v", "vot", progress=done.append)
+    assert done == list(range(1, occluded.n_frames + 1))
+    (name,) = (tmp_path / "v" / "list.txt").read_text().split()
+    tags = (tmp_path / "v" / name / "occlusion.tag").read_text().split()
+    vis = occluded.gt.visibility[:, occluded.target_indices()[0]]
+    assert tags == [str(int(v < 1)) for v in vis] and "1" in tags
+
+
+def test_unwritable_output_names_the_target(tmp_path, capsys, monkeypatch):
+    src = FIXTURES / "full-occlusion.h5"
+
+    def denied(*args, **kwargs):
+        raise PermissionError(13, "Permission denied", str(tmp_path / ".x.tmp-1@h-abc"))
+
+    monkeypatch.setattr(tempfile, "mkdtemp", denied)
+    monkeypatch.setattr(tempfile, "mkstemp", denied)
+    for fmt, out in (("mot", tmp_path / "mot"), ("otb", tmp_path / "otb")):
+        code, _, err = run(capsys, "export", src, "--format", fmt, "-o", out)
+        assert (
+            code == 2 and err.strip() == f"scenegen: error: {out}: cannot write: Permission denied"
+        )
+    with pytest.raises(Exception, match="trk.txt: cannot write: Permission denied"):
+        write_mot_tracker(tmp_path / "trk.txt", np.zeros((2, 1, 4)), [1])
+
+
+def test_every_verb_help_has_a_description(capsys):
+    parser = _parser()
+    sub = next(a for a in parser._actions if a.dest == "verb")
+    assert {"export", "evaluate", "track"} <= set(sub.choices)
+    for name, verb in sub.choices.items():
+        assert verb.description and "\n" not in verb.description.strip(), name
+        code = main([name, "--help"])
+        out = capsys.readouterr().out
+        assert code == 0 and verb.description.split()[0] in out, name

@@ -1,0 +1,76 @@
+"""scenegen.evaluation.mot on hand-worked cases (TrackEval's numbers: test_trackeval_oracle)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from scenegen.evaluation import metrics
+from scenegen.evaluation.mot import (
+    HOTA_ALPHAS,
+    box_iou,
+    clear,
+    hota,
+    identity,
+    mot_frames,
+    remove_distractor_matches,
+)
+
+
+def test_hota_of_half_overlap_is_ten_of_nineteen_thresholds():
+    gt = np.array([[[0, 0, 10, 10.0]], [[0, 0, 10, 10.0]]])
+    est = np.array([[[0, 0, 10, 5.0]], [[0, 0, 10, 5.0]]])  # IoU 0.5 in both frames
+    h = hota(mot_frames(gt, est))
+    assert len(HOTA_ALPHAS) == 19 and HOTA_ALPHAS[0] == 0.05
+    assert h.hota == pytest.approx(10 / 19) and h.deta == pytest.approx(10 / 19)
+    assert h.assa == pytest.approx(10 / 19)
+    assert h.loca == pytest.approx((10 * 0.5 + 9 * 1.0) / 19)  # unmatched thresholds: LocA 1
+
+
+def test_hota_association_of_a_switch():
+    # one object, tracked by track 0 in frames 0-1 and track 1 in frames 2-3, IoU 1
+    gt = np.tile(np.array([0, 0, 10, 10.0]), (4, 1, 1))
+    est = np.full((4, 2, 4), np.nan)
+    est[:2, 0] = est[2:, 1] = [0, 0, 10, 10]
+    h = hota(mot_frames(gt, est))
+    # DetA 1; each match's association Jaccard is 2 / (4 + 2 - 2) = 0.5
+    assert h.deta == 1.0 and h.assa == pytest.approx(0.5) and h.hota == pytest.approx(0.5**0.5)
+    c = clear(mot_frames(gt, est))
+    assert (c.idsw, c.frag, c.mt, c.mota) == (1, 0, 1, 0.75)
+    i = identity(mot_frames(gt, est))
+    assert (i.idtp, i.idfn, i.idfp, i.idf1) == (2, 2, 2, 0.5)
+
+
+def test_clear_frag_mt_pt_ml():
+    gt = np.tile(np.array([0, 0, 10, 10.0]), (10, 2, 1))
+    gt[:, 1, 0] = 50
+    est = gt.copy()
+    est[[3, 6], 0] = np.nan  # object 0: two interruptions, 80 % tracked
+    est[2:, 1] = np.nan  # object 1: tracked 20 %
+    c = clear(mot_frames(gt, est))
+    # As in TrackEval, a frame without any tracker box does not end a track: no fragment.
+    assert (c.frag, c.mt, c.pt, c.ml, c.fn, c.fp, c.idsw) == (0, 0, 2, 0, 10, 0, 0)
+    far = np.tile(np.array([200, 200, 5, 5.0]), (10, 1, 1))  # a false positive every frame
+    c = clear(mot_frames(gt, np.concatenate([est, far], axis=1)))
+    assert (c.frag, c.mt, c.pt, c.ml, c.fn, c.fp, c.idsw) == (2, 0, 2, 0, 10, 10, 0)
+    assert metrics.clear_mot(gt, est).mota == pytest.approx(0.5)
+
+
+def test_empty_sides_follow_trackeval():
+    gt = np.tile(np.array([0, 0, 10, 10.0]), (3, 1, 1))
+    none = np.full((3, 1, 4), np.nan)
+    c = clear(mot_frames(gt, none))
+    assert (c.fn, c.ml, c.mota) == (3, 1, 0.0)
+    h = hota(mot_frames(gt, none))
+    assert (h.hota, h.loca) == (0.0, 1.0)
+    c = clear(mot_frames(none, gt))
+    assert (c.fp, c.mota) == (3, 0.0)
+
+
+def test_box_iou_guards_and_distractor_matches():
+    assert box_iou([[0, 0, 0, 5]], [[0, 0, 0, 5]])[0, 0] == 0.0  # zero area
+    assert box_iou([[0, 0, 10, 10]], [[5, 0, 10, 10]])[0, 0] == pytest.approx(1 / 3)
+    gt = np.array([[[0, 0, 10, 10], [40, 0, 10, 10]]], dtype=float)  # target, distractor
+    est = np.array([[[0, 0, 10, 10], [41, 0, 10, 10], [80, 0, 5, 5]]], dtype=float)
+    keep = remove_distractor_matches(gt, [False, True], est)
+    assert keep.tolist() == [[True, False, True]]
