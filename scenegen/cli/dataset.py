@@ -6,7 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
-__all__ = ["cmd_dataset", "register"]
+__all__ = ["cmd_dataset", "cmd_validate_dataset", "register"]
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -74,4 +74,28 @@ def cmd_dataset(args: argparse.Namespace) -> int:
         file=sys.stderr,
     )
     print(str(Path(args.output).resolve()))
+    return 0
+
+
+def cmd_validate_dataset(args: argparse.Namespace) -> int:
+    """``scenegen validate DIR`` on a dataset folder: 0 if valid, else 1 and one line each.
+
+    With ``--deep`` (when the verb has it) every sequence is also generated again from its
+    config and seed and compared with the manifest's digests.
+    """
+    from scenegen.cli.progress import bar
+    from scenegen.datasets import read_manifest, validate_dataset
+
+    try:
+        shards = int(read_manifest(args.file).get("shards", 0))
+    except Exception:  # reported by validate_dataset as a problem line
+        shards = 0
+    with bar(shards, f"validate {args.file}", unit="shard") as pb:
+        problems = validate_dataset(args.file, deep=bool(getattr(args, "deep", False)),
+                                    progress=lambda n: pb.update(n - pb.n))  # fmt: skip
+    if problems:
+        for line in problems:
+            print(line, file=sys.stderr)
+        return 1
+    print(f"{args.file}: valid dataset")
     return 0

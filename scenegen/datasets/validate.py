@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 from scenegen.datasets.build import read_manifest, shard_name
 from scenegen.errors import DataError
@@ -12,7 +13,7 @@ __all__ = ["validate_dataset"]
 
 
 def validate_dataset(
-    root: str | Path, *, progress: Callable[[int], None] | None = None
+    root: str | Path, *, deep: bool = False, progress: Callable[[int], None] | None = None
 ) -> list[str]:
     """Problems of the dataset folder ``root``, one line each (empty if valid).
 
@@ -25,6 +26,9 @@ def validate_dataset(
     Parameters
     ----------
     root : str or Path
+    deep : bool
+        Also generate every sequence again from its stored config and seed and compare
+        with the manifest's digests (as long as making the dataset).
     progress : callable, optional
         Called with the number of shard files checked so far.
     """
@@ -91,8 +95,25 @@ def validate_dataset(
                     problems.append(
                         f"{path}: {e['name']}: contents differ from the manifest: {what}"
                     )
+                elif deep:
+                    again = digests(_regenerate(seq))
+                    off = sorted(k for k, v in e["digests"].items() if again.get(k) != v)
+                    if off:
+                        problems.append(
+                            f"{path}: {e['name']}: generating it again from its config and "
+                            f"seed gives other {', '.join(off)}"
+                        )
         except DataError as err:
             problems.append(str(err))
         if progress is not None:
             progress(n + 1)
     return problems
+
+
+def _regenerate(seq: Any) -> Any:
+    """The sequence generated again from its stored config, seed and preset."""
+    from scenegen.config import to_dict
+    from scenegen.datasets.build import _generate
+    from scenegen.datasets.family import Draw
+
+    return _generate(Draw(0, seq.name, seq.seed, seq.preset, {}, to_dict(seq.config)))

@@ -102,6 +102,7 @@ def test_interrupted_build_resumes_without_redoing_shards(reference, tmp_path):
     assert {p: (out / p).stat().st_mtime_ns for p in stamps} == stamps
     assert files(out) == files(reference)
     assert validate_dataset(out) == []
+    assert validate_dataset(out, deep=True) == []  # every sequence generated again
 
 
 def test_damaged_shard_is_made_again(reference, tmp_path):
