@@ -94,6 +94,7 @@ def test_leaderboard_means_skip_undefined():
     assert board[0]["mota"] is None and board[0]["rank"] == 1
 
 
+@pytest.mark.slow  # the Dask path of the shared executor is in the fast dataset tests
 def test_same_results_on_a_dask_cluster(dataset, reference, tmp_path):
     distributed = pytest.importorskip("distributed")
     with distributed.LocalCluster(
