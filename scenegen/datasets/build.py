@@ -30,7 +30,7 @@ from pathlib import Path
 from typing import Any
 
 from scenegen.datasets.builtin import resolve_family
-from scenegen.datasets.executor import check_executor, run_tasks
+from scenegen.datasets.executor import check_executor, probe, run_tasks
 from scenegen.datasets.family import Draw, Family
 from scenegen.errors import ConfigError, DataError
 
@@ -349,6 +349,8 @@ def build_dataset(
     if root.exists() and not root.is_dir():
         raise ConfigError(f"{root}: exists and is not a folder")
     draws = fam.draws(n, s)  # validates every sequence's config before any work
+    if scheduler is not None:
+        probe(scheduler)  # an unreachable scheduler fails before anything is written
     header = _header(fam, n, s, shard_size, compression)
     previous: dict[int, dict[str, Any]] = {}
     if (root / MANIFEST).exists():

@@ -18,7 +18,7 @@ from typing import Any
 
 from scenegen.errors import ConfigError
 
-__all__ = ["SCHEDULER_TIMEOUT", "check_executor", "connect", "run_tasks"]
+__all__ = ["SCHEDULER_TIMEOUT", "check_executor", "connect", "probe", "run_tasks"]
 
 SCHEDULER_TIMEOUT = 5.0
 """Seconds to wait for a Dask scheduler before giving up."""
@@ -43,7 +43,14 @@ async def _identity(address: str) -> dict[str, Any]:
         await comm.close()
 
 
-def _probe(address: str) -> None:
+def probe(address: str) -> None:
+    """Check within :data:`SCHEDULER_TIMEOUT` seconds that a Dask scheduler answers.
+
+    Raises
+    ------
+    ConfigError
+        One line naming the address and what went wrong.
+    """
     import asyncio
 
     try:
@@ -71,7 +78,7 @@ def connect(address: str) -> Any:
     """
     from distributed import Client
 
-    _probe(address)
+    probe(address)
     try:
         return Client(address, timeout=SCHEDULER_TIMEOUT, set_as_default=False)
     except Exception as err:

@@ -456,11 +456,13 @@ def run_benchmark(
     """
     from tqdm import tqdm
 
-    from scenegen.datasets.executor import check_executor, run_tasks
+    from scenegen.datasets.executor import check_executor, probe, run_tasks
 
     check_executor(jobs, scheduler)
     root = Path(dataset)
     man, tasks = plan_benchmark(root, list(trackers), params)
+    if scheduler is not None:
+        probe(scheduler)  # fail before writing anything
     outp = Path(out)
     outp.mkdir(parents=True, exist_ok=True)
     records: dict[tuple[str, int], dict[str, Any]] = {}

@@ -71,3 +71,12 @@ def test_benchmark_errors(tmp_path, capsys):
     args = ["benchmark", str(out), "--tracker", "sok", "--param", "n_layers=3", "-o", "b"]
     assert main(args) == 2
     assert "--param n_layers: no tracker of sok takes this parameter" in capsys.readouterr().err
+
+
+def test_unreachable_scheduler_exits_2_and_writes_nothing(tmp_path, capsys):
+    out = tmp_path / "ds"
+    assert main(["dataset", "kams", "--count", "2", "-o", str(out),
+                 "--scheduler", "tcp://127.0.0.1:9"]) == 2  # fmt: skip
+    err = capsys.readouterr().err
+    assert "cannot reach the Dask scheduler at 'tcp://127.0.0.1:9'" in err and err.count("\n") == 1
+    assert not out.exists()
