@@ -10,6 +10,7 @@ __version__ = "0.1.0"
 
 from scenegen import presets
 from scenegen.config import SceneConfig, from_dict, load_config
+from scenegen.datasets import open_dataset
 from scenegen.errors import ConfigError, DataError
 from scenegen.io import read, write
 from scenegen.render.plan import generate, plan
@@ -26,6 +27,7 @@ __all__ = [
     "from_dict",
     "generate",
     "load_config",
+    "open_dataset",
     "plan",
     "presets",
     "read",

@@ -19,6 +19,8 @@ __all__ = ["main"]
 def _parser() -> argparse.ArgumentParser:
     from scenegen import __version__
     from scenegen.cli import bench, data, demo, evaluate, experiment, fixtures, track
+    from scenegen.cli import benchmark as benchmark_verb
+    from scenegen.cli import dataset as dataset_verb
 
     parser = argparse.ArgumentParser(
         prog="scenegen",
@@ -30,6 +32,8 @@ def _parser() -> argparse.ArgumentParser:
     sub.required = True
     for module in (data, track, evaluate, experiment, bench, demo, fixtures):
         module.register(sub)
+    dataset_verb.register(sub)
+    benchmark_verb.register(sub)
     for action in sub._choices_actions:  # each verb's --help opens with its one-line summary
         verb = sub.choices[action.dest]
         if verb.description is None and action.help:

@@ -191,6 +191,10 @@ def cmd_inspect(args: argparse.Namespace) -> int:
 def cmd_validate(args: argparse.Namespace) -> int:
     import sys
 
+    if args.file.is_dir():  # a dataset folder (scenegen dataset): every shard and digest
+        from scenegen.cli.dataset import cmd_validate_dataset
+
+        return cmd_validate_dataset(args)
     from scenegen.io.validate import check_file
 
     problems = check_file(args.file, isolate=True)

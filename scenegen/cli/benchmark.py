@@ -1,0 +1,65 @@
+"""The ``benchmark`` verb: run trackers over a dataset; leaderboard and difficulty curves."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+__all__ = ["cmd_benchmark", "register"]
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "benchmark",
+        help="run trackers over a dataset: per-sequence scores, leaderboard, curves",
+        description="Runs every --tracker on every sequence of the dataset DIR (made by "
+        "`scenegen dataset`) and writes OUT/index.html (leaderboard and metric-vs-difficulty "
+        "figures), OUT/results.json and OUT/scores.csv. Finished runs are kept under "
+        "OUT/runs/; running the same command again resumes.",
+    )
+    p.add_argument("dataset", type=Path, help="dataset folder DIR")
+    p.add_argument("--tracker", action="append", required=True, metavar="NAME",
+                   help="tracker name (repeatable; see trackers in the README)")  # fmt: skip
+    p.add_argument(
+        "--param", action="append", default=[], metavar="KEY=VALUE",
+        help="tracker parameter given to every tracker that takes it (e.g. n_particles=100); "
+        "VALUE is read as JSON when it parses",
+    )  # fmt: skip
+    where = p.add_mutually_exclusive_group()
+    where.add_argument("--jobs", type=int, default=None, help="local processes (default: all)")
+    where.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                       help="dask.distributed scheduler, e.g. tcp://host:8786 (its workers "
+                       "read DIR; this process writes OUT)")  # fmt: skip
+    p.add_argument("-o", "--output", type=Path, required=True, help="output folder OUT")
+    p.set_defaults(func=cmd_benchmark)
+
+
+def cmd_benchmark(args: argparse.Namespace) -> int:
+    """Run the benchmark and print the report page's path; 0 on success.
+
+    Raises
+    ------
+    ConfigError
+        Unknown tracker or parameter, bad --jobs, unreachable scheduler, incomplete dataset.
+    DataError
+        DIR is not a dataset folder, or a shard is damaged.
+    """
+    from scenegen.cli.track import parse_params
+    from scenegen.lab.benchmark import run_benchmark
+
+    res = run_benchmark(
+        args.dataset,
+        args.tracker,
+        args.output,
+        params=parse_params(args.param),
+        jobs=args.jobs,
+        scheduler=args.scheduler,
+        progress=sys.stderr.isatty(),
+    )
+    best = res["leaderboard"][0] if res["leaderboard"] else None
+    if best is not None:
+        print(f"benchmark: {len(res['scores'])} runs; best AUC {best['tracker']} "
+              f"({best['auc']})", file=sys.stderr)  # fmt: skip
+    print(str((args.output / "index.html").resolve()))
+    return 0

@@ -1,0 +1,418 @@
+"""Building a dataset: sequences drawn from a family, written in shards, with a manifest.
+
+Layout of a dataset folder ``DIR``::
+
+    DIR/manifest.json        one entry per sequence: index, name, seed, file, params, digests
+    DIR/shard-00000.h5       sequences 0 .. S-1 (schema scenegen/1), S = shard size
+    DIR/shard-00001.h5       ...
+
+Reproducible to the byte: sequence ``i``'s config and seed come from (family, seed, i)
+only (:meth:`Family.draw`), shard ``j`` holds sequences ``j*S .. j*S+S-1`` in index
+order, files are written by :func:`scenegen.io.write` (deterministic bytes) and the
+manifest is sorted; so the folder is the same whether it is made by one process, a local
+pool or a Dask cluster, in any completion order.
+
+Resumable: a shard is written atomically (a temporary file renamed into place), and the
+manifest is rewritten atomically as shards finish. Running the same command again keeps
+every shard file whose sequences have the expected names, seeds and configs and whose
+contents match their digests (the manifest's, when it lists them), and makes the rest.
+A larger ``--count`` extends a dataset the same way (the first sequences do not depend
+on the count), remaking only its last, partial shard.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from scenegen.datasets.builtin import resolve_family
+from scenegen.datasets.executor import check_executor, probe, run_tasks
+from scenegen.datasets.family import Draw, Family
+from scenegen.errors import ConfigError, DataError
+
+__all__ = [
+    "DEFAULT_SHARD_SIZE",
+    "MANIFEST",
+    "SCHEMA",
+    "ShardTask",
+    "build_dataset",
+    "make_shard",
+    "plan_shards",
+    "shard_name",
+    "write_manifest",
+]
+
+SCHEMA = "scenegen-dataset/1"
+MANIFEST = "manifest.json"
+DEFAULT_SHARD_SIZE = 4
+"""Sequences per shard file: small enough that many workers write in parallel and a lost
+shard costs little, large enough to keep the file count down (10,000 sequences: 2,500
+files). A worker holds one shard's sequences in memory while writing it."""
+
+_FLUSH_SECONDS = 2.0  # the manifest is rewritten at most this often while shards finish
+
+
+def shard_name(j: int) -> str:
+    """File name of shard ``j``: ``shard-NNNNN.h5``."""
+    return f"shard-{j:05d}.h5"
+
+
+@dataclass(frozen=True)
+class ShardTask:
+    """One shard to make (or to verify and keep).
+
+    Attributes
+    ----------
+    shard : int
+    root : str
+        The dataset folder.
+    draws : tuple of Draw
+        Its sequences, in index order.
+    compression : str
+    expected : tuple of (dict or None)
+        Per sequence, the digests an earlier run recorded in the manifest (None if not).
+    """
+
+    shard: int
+    root: str
+    draws: tuple[Draw, ...]
+    compression: str
+    expected: tuple[dict[str, str] | None, ...]
+
+    @property
+    def file(self) -> str:
+        return shard_name(self.shard)
+
+
+def _entry(d: Draw, file: str, seq: Any, digests: dict[str, str]) -> dict[str, Any]:
+    roles = [str(r) for r in seq.entities.role]
+    return {
+        "index": d.index,
+        "name": d.name,
+        "seed": d.seed,
+        "preset": d.preset,
+        "file": file,
+        "params": d.params,
+        "n_frames": int(d.config["n_frames"]),
+        "width": int(d.config["width"]),
+        "height": int(d.config["height"]),
+        "targets": roles.count("target"),
+        "digests": digests,
+    }
+
+
+def _verify(task: ShardTask) -> list[dict[str, Any]] | None:
+    """Entries of an existing complete shard file that matches the task, else None."""
+    import scenegen
+    from scenegen.config import to_dict
+    from scenegen.io import sequence_names
+    from scenegen.testing.fixtures import digests
+
+    path = Path(task.root) / task.file
+    if not path.is_file():
+        return None
+    try:
+        if sequence_names(path) != [d.name for d in task.draws]:
+            return None
+        out = []
+        for d, want in zip(task.draws, task.expected, strict=True):
+            seq = scenegen.read(path, d.name)
+            if seq.seed != d.seed or seq.preset != d.preset or to_dict(seq.config) != d.config:
+                return None
+            got = digests(seq)
+            if want is not None and got != want:
+                return None
+            out.append(_entry(d, task.file, seq, got))
+        return out
+    except (DataError, ConfigError, OSError):
+        return None  # damaged or foreign: make it again
+
+
+def _generate(d: Draw) -> Any:
+    from scenegen.config import from_dict
+    from scenegen.render.plan import plan
+    from scenegen.sequence import GroundTruth, Sequence
+
+    cfg = from_dict(d.config)
+    scn = plan(cfg, d.seed, preset=d.preset)
+    chunk = scn.render()
+    return Sequence(
+        name=cfg.name,
+        seed=scn.seed,
+        config=cfg,
+        preset=d.preset,
+        frames=chunk.frames,
+        labels=chunk.labels,
+        entities=scn.entities(),
+        gt=GroundTruth(**chunk.gt),
+        templates=scn.template_images(),
+    )
+
+
+def make_shard(task: ShardTask) -> dict[str, Any]:
+    """Make one shard file (atomically) unless a matching one exists; return its entries.
+
+    Runs in a worker process (or on a Dask worker, which must see the dataset folder).
+
+    Returns
+    -------
+    dict
+        ``shard``, ``reused`` (the file existed and verified), ``entries`` (manifest
+        entries, one per sequence, with digests), and the worker's ``pid``,
+        ``cpu_seconds`` (CPU time of this shard) and ``peak_rss_mb`` (peak resident memory
+        so far, MiB).
+    """
+    from scenegen.io import write
+    from scenegen.testing.fixtures import digests
+
+    cpu = time.process_time()
+    kept = _verify(task)
+    if kept is not None:
+        return {"shard": task.shard, "reused": True, "entries": kept, **_worker(cpu)}
+    seqs = [_generate(d) for d in task.draws]
+    Path(task.root).mkdir(parents=True, exist_ok=True)  # a worker without the shared folder
+    entries = [_entry(d, task.file, s, digests(s)) for d, s in zip(task.draws, seqs, strict=True)]
+    write(Path(task.root) / task.file, *seqs, compression=task.compression)
+    return {"shard": task.shard, "reused": False, "entries": entries, **_worker(cpu)}
+
+
+def _worker(cpu_start: float) -> dict[str, Any]:
+    """Which process made a shard, the CPU time it took and the peak memory so far."""
+    import os
+
+    try:
+        import resource
+
+        rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0  # Linux: KiB
+    except (ImportError, OSError):
+        rss = float("nan")
+    return {"pid": os.getpid(), "peak_rss_mb": rss, "cpu_seconds": time.process_time() - cpu_start}
+
+
+def plan_shards(
+    draws: list[Draw],
+    root: Path,
+    shard_size: int,
+    compression: str,
+    previous: dict[int, dict[str, Any]] | None = None,
+) -> list[ShardTask]:
+    """Group draws into shard tasks (``previous``: manifest entries by index)."""
+    if shard_size < 1:
+        raise ConfigError(f"--shard-size must be >= 1, got {shard_size}")
+    prev = previous or {}
+    tasks = []
+    for j, start in enumerate(range(0, len(draws), shard_size)):
+        group = tuple(draws[start : start + shard_size])
+        expected = []
+        for d in group:
+            e = prev.get(d.index)
+            ok = e is not None and e.get("file") == shard_name(j) and e.get("seed") == d.seed
+            expected.append(e.get("digests") if ok and e is not None else None)
+        tasks.append(ShardTask(j, str(root), group, compression, tuple(expected)))
+    return tasks
+
+
+def _header(fam: Family, count: int, seed: int, shard_size: int, compression: str) -> dict:
+    from scenegen import __version__
+
+    return {
+        "schema": SCHEMA,
+        "family": fam.name,
+        "description": fam.description,
+        "family_digest": fam.digest(),
+        "family_spec": fam.spec,
+        "seed": seed,
+        "count": count,
+        "shard_size": shard_size,
+        "shards": -(-count // shard_size),
+        "compression": compression,
+        "generator_version": __version__,
+        "params": fam.param_names,
+        "axes": [
+            {"name": a.name, "paths": list(a.paths), "values": [list(v) for v in a.values]}
+            for a in fam.axes
+        ],
+        "vary": [{"path": d.path, "kind": d.kind, "args": list(d.args)} for d in fam.distributions],
+    }
+
+
+_IDENTITY = ("schema", "family_digest", "seed", "shard_size", "compression")
+
+
+def write_manifest(root: Path, manifest: dict[str, Any]) -> None:
+    """Write ``manifest.json`` atomically (sorted keys, entries in index order)."""
+    from scenegen.io import atomic_path
+
+    text = json.dumps(manifest, sort_keys=True, indent=1, allow_nan=False)
+    with atomic_path(root / MANIFEST, ".json") as tmp:
+        tmp.write_text(text + "\n", encoding="utf-8")
+
+
+def read_manifest(root: Path) -> dict[str, Any]:
+    """The manifest of the dataset folder ``root``.
+
+    Raises
+    ------
+    DataError
+        If it is missing, unreadable or not a scenegen dataset manifest.
+    """
+    p = Path(root) / MANIFEST
+    try:
+        data = json.loads(p.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise DataError(f"{root}: not a dataset folder (no {MANIFEST})") from None
+    except (OSError, ValueError) as err:
+        raise DataError(f"{p}: unreadable: {err}") from None
+    if not isinstance(data, dict) or data.get("schema") != SCHEMA:
+        raise DataError(f"{p}: not a scenegen dataset manifest (schema {SCHEMA} expected)")
+    if not isinstance(data.get("sequences"), list):
+        raise DataError(f"{p}: no 'sequences' list")
+    return data
+
+
+def build_dataset(
+    family: str | Path | Family | dict[str, Any],
+    out: str | Path,
+    *,
+    count: int | None = None,
+    seed: int | None = None,
+    frames: int | None = None,
+    jobs: int | None = None,
+    scheduler: str | None = None,
+    shard_size: int = DEFAULT_SHARD_SIZE,
+    compression: str = "gzip",
+    progress: bool = False,
+    on_shard: Callable[[dict[str, Any]], None] | None = None,
+) -> dict[str, Any]:
+    """Generate (or finish) the dataset of ``family`` in the folder ``out``.
+
+    Parameters
+    ----------
+    family : str, Path, Family or dict
+        A family file, a built-in family or preset name, or a parsed family.
+    out : str or Path
+        The dataset folder (created if missing).
+    count : int, optional
+        Sequences (default: the family's ``count``).
+    seed : int, optional
+        Base seed (default: the family's ``seed``).
+    frames : int, optional
+        Override every sequence's frame count (a ``set: {n_frames: ...}`` entry, so it
+        makes a different dataset).
+    jobs : int or None
+        Local worker processes (None: all cores; 1: this process).
+    scheduler : str or None
+        A ``dask.distributed`` scheduler address; its workers must see ``out``.
+    shard_size : int
+        Sequences per shard file.
+    compression : {'gzip', 'lzf', 'none'}
+    progress : bool
+        Show a tqdm bar on stderr.
+    on_shard : callable, optional
+        Called in this process with each shard's result (``shard``, ``reused``, ``entries``).
+
+    Returns
+    -------
+    dict
+        The manifest, as written to ``out/manifest.json``.
+
+    Raises
+    ------
+    ConfigError
+        For a bad family, count, seed, executor or compression, or an ``out`` that holds
+        another dataset.
+    """
+    from tqdm import tqdm
+
+    from scenegen.io import filter_options
+
+    fam = resolve_family(family)
+    if frames is not None:
+        if isinstance(frames, bool) or not isinstance(frames, int) or frames < 1:
+            raise ConfigError(f"--frames must be >= 1, got {frames}")
+        fam = fam.with_overrides({"n_frames": frames})
+    check_executor(jobs, scheduler)
+    filter_options(compression)
+    n = fam.count if count is None else count
+    s = fam.seed if seed is None else seed
+    if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+        raise ConfigError(f"--count must be >= 1, got {n}")
+    if isinstance(s, bool) or not isinstance(s, int) or s < 0:
+        raise ConfigError(f"--seed must be a non-negative integer, got {s}")
+    if shard_size < 1:
+        raise ConfigError(f"--shard-size must be >= 1, got {shard_size}")
+    root = Path(out)
+    if root.exists() and not root.is_dir():
+        raise ConfigError(f"{root}: exists and is not a folder")
+    draws = fam.draws(n, s)  # validates every sequence's config before any work
+    if scheduler is not None:
+        probe(scheduler)  # an unreachable scheduler fails before anything is written
+    header = _header(fam, n, s, shard_size, compression)
+    previous: dict[int, dict[str, Any]] = {}
+    if (root / MANIFEST).exists():
+        try:
+            old = read_manifest(root)
+        except DataError as err:
+            raise ConfigError(f"{err}; remove it or choose another output folder") from None
+        diff = [k for k in _IDENTITY if old.get(k) != header[k]]
+        if diff:
+            was = ", ".join(f"{k}={old.get(k)!r}" for k in diff if k != "family_digest")
+            what = "another family" if "family_digest" in diff else was
+            raise ConfigError(
+                f"{root}: holds a different dataset ({old.get('family')!r}: {what}); "
+                "choose another output folder or remove it"
+            )
+        if isinstance(old.get("count"), int) and old["count"] > n:
+            raise ConfigError(
+                f"{root}: holds {old['count']} sequences of {old.get('family')!r}; a rerun "
+                f"may extend it (--count >= {old['count']}) but not shrink it"
+            )
+        previous = {int(e["index"]): e for e in old["sequences"] if isinstance(e, dict)}
+    else:
+        root.mkdir(parents=True, exist_ok=True)
+        if any(root.glob("shard-*.h5")):
+            raise ConfigError(f"{root}: holds shard files but no {MANIFEST}; choose another folder")
+    tasks = plan_shards(draws, root, shard_size, compression, previous)
+    done: dict[int, list[dict[str, Any]]] = {}
+    manifest = dict(header)
+
+    def flush(complete: bool) -> None:
+        entries = [e for j in sorted(done) for e in done[j]]
+        keep = {e["index"] for e in entries}
+        # Entries of shards not redone yet stay listed (their files are checked on resume).
+        entries += [e for i, e in sorted(previous.items()) if i not in keep and i < n]
+        entries.sort(key=lambda e: e["index"])
+        manifest["sequences"] = entries
+        manifest["complete"] = complete
+        write_manifest(root, manifest)
+
+    flush(False)
+    bar = tqdm(total=n, disable=not progress, unit="seq", desc=f"dataset {fam.name}",
+               leave=False)  # fmt: skip
+    last, wait = [time.monotonic()], [_FLUSH_SECONDS]
+
+    def store(task: ShardTask, res: dict[str, Any]) -> None:
+        done[task.shard] = res["entries"]
+        bar.update(len(res["entries"]))
+        if on_shard is not None:
+            on_shard(res)
+        if time.monotonic() - last[0] >= wait[0]:
+            t0 = time.monotonic()
+            flush(False)
+            last[0] = time.monotonic()
+            # A 10,000-sequence manifest is ~13 MB: rewrite it at most 5% of the time.
+            wait[0] = max(_FLUSH_SECONDS, 20.0 * (last[0] - t0))
+
+    try:
+        run_tasks(
+            make_shard, tasks, store, jobs=jobs, scheduler=scheduler,
+            key=lambda t: t.file, name="scenegen-dataset",
+        )  # fmt: skip
+    finally:
+        bar.close()
+        flush(len(done) == len(tasks))
+    return manifest

@@ -1,0 +1,545 @@
+"""Benchmarking trackers over a dataset: per-sequence scores, a leaderboard, difficulty curves.
+
+Every (tracker, sequence) pair is one task. The worker reads the sequence lazily from its
+shard, runs the tracker through :func:`scenegen.lab.run.run` (the one bridge, compiled
+kernels on one thread) with a seed derived from (tracker, parameters, sequence seed), and
+scores it with :func:`scenegen.evaluation.evaluate`. Scores are rounded to fixed decimals
+and stored as one JSON file per pair under ``OUT/runs/TRACKER/NNNNN.json`` (atomically),
+so a rerun skips finished pairs, and the results are the same whichever executor ran
+them.
+
+``OUT`` then holds ``scores.csv`` (one row per tracker and sequence, with the sequence's
+parameters), ``results.json`` (leaderboard, per-axis curves and every score),
+``leaderboard.md``, one PNG per metric and difficulty axis (``curve-METRIC-AXIS.png``:
+the metric's mean per axis value, one line per tracker) and ``index.html``.
+
+Metrics (per sequence, from :func:`scenegen.evaluation.evaluate`): OTB ``auc`` and
+``precision_20`` (the mean over the sequence's targets), ``success`` and ``recovery`` (% of
+targets tracked in every frame / tracked again at the end, DPS §3), ``tracked`` (% of
+frames), ``mean_iou``; on sequences with several targets also the multi-target metrics
+``mota``, ``idf1`` and ``hota`` (TrackEval's definitions, :mod:`scenegen.evaluation.mot`).
+"""
+
+from __future__ import annotations
+
+import csv
+import html
+import io
+import json
+import math
+import re
+from collections.abc import Callable
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from scenegen.errors import ConfigError
+from scenegen.lab.experiments.runner import _round, derive_seed, write_json_atomic
+
+__all__ = [
+    "METRICS",
+    "BenchTask",
+    "leaderboard",
+    "plan_benchmark",
+    "run_benchmark",
+    "run_pair",
+]
+
+METRICS: dict[str, str] = {
+    "auc": "OTB success AUC",
+    "precision_20": "precision @ 20 px",
+    "success": "success (% targets)",
+    "recovery": "recovery (% targets)",
+    "tracked": "tracked (% frames)",
+    "mean_iou": "mean IoU",
+    "mota": "MOTA",
+    "idf1": "IDF1",
+    "hota": "HOTA",
+}
+"""Leaderboard columns and their labels, in order (absent metrics are left out)."""
+
+MULTI_TARGET = ("mota", "idf1", "hota")
+"""Metrics reported only on sequences with several targets."""
+
+_CURVE_METRICS = ("auc", "precision_20", "success", "recovery", "mota", "idf1", "hota")
+_MAX_LEVELS = 8  # a numeric axis with more distinct values is binned into quantiles
+_BINS = 6
+
+
+@dataclass(frozen=True)
+class BenchTask:
+    """One tracker on one sequence of a dataset.
+
+    Attributes
+    ----------
+    root : str
+        The dataset folder.
+    index : int
+    name : str
+        Sequence name in its shard.
+    file : str
+        Shard file name.
+    seed : int
+        The sequence's seed.
+    frames_digest : str
+        The manifest's digest of its frames (a changed dataset invalidates stored runs).
+    tracker : str
+    params : tuple of (str, value)
+        Tracker parameters (without ``rng``), sorted.
+    """
+
+    root: str
+    index: int
+    name: str
+    file: str
+    seed: int
+    frames_digest: str
+    tracker: str
+    params: tuple[tuple[str, Any], ...]
+
+    def tracker_seed(self) -> int:
+        return derive_seed("benchmark", self.tracker, json.dumps(dict(self.params),
+                           sort_keys=True), self.seed)  # fmt: skip
+
+    def filename(self) -> str:
+        return f"runs/{_slug(self.tracker)}/{self.index:05d}.json"
+
+    def key(self) -> dict[str, Any]:
+        d = asdict(self)
+        del d["root"]
+        d["params"] = dict(self.params)
+        return _round(d)
+
+
+def _slug(name: str) -> str:
+    return re.sub(r"[^A-Za-z0-9._-]+", "_", name)
+
+
+def run_pair(task: BenchTask) -> dict[str, Any]:
+    """Run one tracker on one sequence and score it (a JSON-ready record, floats rounded)."""
+    from scenegen.evaluation import evaluate
+    from scenegen.io import read
+    from scenegen.lab.run import run
+
+    seq = read(Path(task.root) / task.file, task.name)
+    done = run(seq, task.tracker, dict(task.params), task.tracker_seed(), single_thread=True)
+    res = done.result
+    report = evaluate(
+        seq, res.boxes, res.target_ids, tracker=task.tracker,
+        order_prob=res.order_prob, orderings=res.orderings,
+    )  # fmt: skip
+    rep = report if isinstance(report, dict) else report.to_dict()
+    targets = rep["targets"]
+    multi = len(targets) > 1
+
+    def pct(key: str) -> float | None:
+        vals = [t[key] for t in targets if t[key] is not None]
+        return 100.0 * float(np.mean(vals)) if vals else None
+
+    tracked = [t["tracked"] for t in targets if t["tracked"] is not None]
+    scores: dict[str, Any] = {
+        "auc": rep["overall"].get("auc"),
+        "precision_20": rep["overall"].get("precision_20"),
+        "success": pct("success"),
+        "recovery": pct("recovered"),
+        "tracked": float(np.mean(tracked)) if tracked else None,
+        "mean_iou": rep["overall"].get("mean_iou"),
+    }
+    for m in MULTI_TARGET:
+        if m in rep["overall"]:
+            scores[m] = rep["overall"][m] if multi else None
+    return _round(
+        {
+            "key": task.key(),
+            "tracker_seed": task.tracker_seed(),
+            "targets": len(targets),
+            "n_frames": int(rep["n_frames"]),
+            "scores": scores,
+        }
+    )
+
+
+def _load(path: Path, task: BenchTask) -> dict[str, Any] | None:
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    if not isinstance(data, dict) or data.get("key") != task.key():
+        return None
+    return data
+
+
+def _check_params(trackers: list[str], params: dict[str, Any]) -> dict[str, dict[str, Any]]:
+    """Per tracker, the ``params`` it accepts; each key must be accepted by one at least."""
+    from trackers.registry import parameters
+
+    out: dict[str, dict[str, Any]] = {}
+    used: set[str] = set()
+    for t in trackers:
+        try:
+            valid = set(parameters(t)) - {"rng"}
+        except ValueError as err:
+            raise ConfigError(str(err)) from None
+        out[t] = {k: v for k, v in params.items() if k in valid}
+        used |= set(out[t])
+    unused = sorted(set(params) - used)
+    if unused:
+        raise ConfigError(
+            f"--param {unused[0]}: no tracker of {', '.join(trackers)} takes this parameter"
+        )
+    return out
+
+
+def plan_benchmark(
+    root: Path, trackers: list[str], params: dict[str, Any] | None = None
+) -> tuple[dict[str, Any], list[BenchTask]]:
+    """(dataset manifest, every task in a fixed order: trackers x sequences).
+
+    Raises
+    ------
+    ConfigError
+        No tracker, a duplicate or unknown tracker, or a parameter no tracker takes.
+    DataError
+        If ``root`` is not a dataset folder.
+    """
+    from scenegen.datasets import read_manifest
+
+    if not trackers:
+        raise ConfigError("give at least one --tracker")
+    if len(set(trackers)) != len(trackers):
+        raise ConfigError(f"a tracker is listed twice: {', '.join(trackers)}")
+    per = _check_params(trackers, dict(params or {}))
+    man = read_manifest(root)
+    if not man.get("complete"):
+        raise ConfigError(f"{root}: the dataset is incomplete; finish it with scenegen dataset")
+    tasks = []
+    for t in trackers:
+        p = tuple(sorted(per[t].items()))
+        for e in sorted(man["sequences"], key=lambda e: e["index"]):
+            fd = str((e.get("digests") or {}).get("frames", ""))
+            tasks.append(
+                BenchTask(str(root), int(e["index"]), e["name"], e["file"], int(e["seed"]),
+                          fd, t, p)
+            )  # fmt: skip
+    return man, tasks
+
+
+# --------------------------------------------------------------------------------------
+# Aggregation
+
+
+def _mean(vals: list[Any]) -> float | None:
+    v = [float(x) for x in vals if x is not None]
+    return float(np.mean(v)) if v else None
+
+
+def leaderboard(rows: list[dict[str, Any]], trackers: list[str]) -> list[dict[str, Any]]:
+    """Mean of each metric per tracker over the sequences where it is defined, ranked by AUC.
+
+    Parameters
+    ----------
+    rows : list of dict
+        One per (tracker, sequence): ``tracker`` and the metric keys.
+    trackers : list of str
+
+    Returns
+    -------
+    list of dict
+        ``rank``, ``tracker``, ``sequences`` and one mean per metric (None if undefined).
+    """
+    board = []
+    for t in trackers:
+        mine = [r for r in rows if r["tracker"] == t]
+        entry: dict[str, Any] = {"tracker": t, "sequences": len(mine)}
+        for m in METRICS:
+            entry[m] = _mean([r.get(m) for r in mine])
+        board.append(entry)
+    board.sort(key=lambda e: (-(e["auc"] if e["auc"] is not None else -1.0), e["tracker"]))
+    for i, e in enumerate(board):
+        e["rank"] = i + 1
+    return _round(board)
+
+
+def _axis_levels(values: list[Any]) -> tuple[list[Any], list[str], list[int]]:
+    """(level keys, labels, level index per value) of an axis: as is, or quantile bins."""
+    numeric = all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values)
+    distinct = sorted({json.dumps(v, sort_keys=True) for v in values})
+    if numeric and len(distinct) > _MAX_LEVELS:
+        arr = np.asarray(values, dtype=float)
+        edges = np.unique(np.quantile(arr, np.linspace(0, 1, _BINS + 1)))
+        idx = np.clip(np.searchsorted(edges, arr, side="right") - 1, 0, len(edges) - 2)
+        centres = [float(arr[idx == b].mean()) if np.any(idx == b) else math.nan
+                   for b in range(len(edges) - 1)]  # fmt: skip
+        labels = [f"{edges[b]:.3g}-{edges[b + 1]:.3g}" for b in range(len(edges) - 1)]
+        return centres, labels, idx.tolist()
+    if numeric:
+        keys = sorted({float(v) for v in values})
+        return keys, [f"{k:g}" for k in keys], [keys.index(float(v)) for v in values]
+    # Categorical (preset names, lists): in order of first appearance in the index order.
+    order: list[str] = []
+    for v in values:
+        s = json.dumps(v, sort_keys=True)
+        if s not in order:
+            order.append(s)
+    labels = [json.loads(s) if isinstance(json.loads(s), str) else s for s in order]
+    return list(range(len(order))), [str(x) for x in labels], [
+        order.index(json.dumps(v, sort_keys=True)) for v in values
+    ]
+
+
+def _axes(man: dict[str, Any]) -> list[str]:
+    """Difficulty axes to plot: sweep axis names (a named axis by its name), drawn paths."""
+    out = [a["name"] for a in man.get("axes", []) if len(a["values"]) > 1]
+    out += [d["path"] for d in man.get("vary", [])]
+    return out
+
+
+def curves(
+    rows: list[dict[str, Any]], man: dict[str, Any], trackers: list[str]
+) -> list[dict[str, Any]]:
+    """Per difficulty axis and metric: the metric's mean per axis level, per tracker."""
+    out = []
+    for axis in _axes(man):
+        mine = [r for r in rows if axis in r["params"]]
+        if not mine:
+            continue
+        per_seq: dict[int, Any] = {}
+        for r in mine:
+            per_seq.setdefault(r["index"], r["params"][axis])
+        order = sorted(per_seq)
+        keys, labels, idx = _axis_levels([per_seq[i] for i in order])
+        level_of = dict(zip(order, idx, strict=True))
+        for metric in _CURVE_METRICS:
+            series = {}
+            for t in trackers:
+                vals = []
+                for lv in range(len(keys)):
+                    vals.append(_mean([r.get(metric) for r in mine
+                                       if r["tracker"] == t and level_of[r["index"]] == lv]))
+                series[t] = vals  # fmt: skip
+            if all(v is None for s in series.values() for v in s):
+                continue
+            out.append({"axis": axis, "metric": metric, "x": keys, "labels": labels,
+                        "series": series})  # fmt: skip
+    return _round(out)
+
+
+def _figure(curve: dict[str, Any], path: Path) -> str:
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    from scenegen.io import atomic_path
+
+    fig = Figure(figsize=(5.2, 3.4))
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot(1, 1, 1)
+    x = np.arange(len(curve["labels"]))
+    for t, vals in curve["series"].items():
+        v = np.array([np.nan if a is None else a for a in vals], dtype=float)
+        ax.plot(x, v, marker="o", label=t)
+    ax.set_xticks(x, curve["labels"], rotation=30 if len(x) > 4 else 0, fontsize=8)
+    ax.set_xlabel(curve["axis"])
+    ax.set_ylabel(METRICS.get(curve["metric"], curve["metric"]))
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    with atomic_path(path, ".png") as tmp:
+        fig.savefig(tmp, dpi=100, format="png", metadata={"Software": None})
+    return path.name
+
+
+def _fmt(v: Any) -> str:
+    if v is None:
+        return "—"
+    if isinstance(v, float):
+        return f"{v:.3f}" if abs(v) <= 1.0 else f"{v:.1f}"
+    return str(v)
+
+
+def _columns(board: list[dict[str, Any]]) -> list[str]:
+    return [m for m in METRICS if any(e.get(m) is not None for e in board)]
+
+
+def _markdown(board: list[dict[str, Any]]) -> str:
+    cols = _columns(board)
+    lines = ["| rank | tracker | sequences | " + " | ".join(METRICS[c] for c in cols) + " |",
+             "|---:|---|---:|" + "---:|" * len(cols)]  # fmt: skip
+    for e in board:
+        cells = [_fmt(e[c]) for c in cols]
+        lines.append(f"| {e['rank']} | {e['tracker']} | {e['sequences']} | " + " | ".join(cells)
+                     + " |")  # fmt: skip
+    return "\n".join(lines) + "\n"
+
+
+def _html(man: dict[str, Any], board: list[dict[str, Any]], figures: list[tuple[str, str]],
+          params: dict[str, dict[str, Any]]) -> str:  # fmt: skip
+    e = html.escape
+    cols = _columns(board)
+    head = "".join(f"<th>{e(METRICS[c])}</th>" for c in cols)
+    body = ""
+    for r in board:
+        cells = "".join(f"<td>{_fmt(r[c])}</td>" for c in cols)
+        body += f"<tr><td>{r['rank']}</td><td>{e(r['tracker'])}</td><td>{r['sequences']}</td>"
+        body += cells + "</tr>\n"
+    figs = "\n".join(
+        f'<figure><img src="{e(f)}" alt="{e(cap)}"><figcaption>{e(cap)}</figcaption></figure>'
+        for f, cap in figures
+    )
+    tp = "".join(f"<li>{e(t)}: {e(json.dumps(p, sort_keys=True))}</li>" for t, p in params.items())
+    axes = ", ".join(e(a) for a in _axes(man)) or "none"
+    multi = [m for m in MULTI_TARGET if m in cols]
+    note = (
+        f"<p>{', '.join(METRICS[m] for m in multi)}: means over the sequences with several "
+        "targets only.</p>" if multi else
+        "<p>No multi-target metric: every sequence has one target (or none was computed).</p>"
+    )  # fmt: skip
+    return f"""<!doctype html>
+<html><head><meta charset="utf-8"><title>Benchmark: {e(str(man.get("family")))}</title>
+<style>body{{font-family:sans-serif;max-width:1100px;margin:2em auto}}
+table{{border-collapse:collapse}}td,th{{border:1px solid #ccc;padding:4px 8px;text-align:right}}
+td:nth-child(2){{text-align:left}}figure{{display:inline-block;margin:8px}}
+img{{max-width:520px}}</style></head><body>
+<h1>Benchmark on dataset {e(str(man.get("family")))}</h1>
+<p>{e(str(man.get("description", "")))} — {man.get("count")} sequences, seed {man.get("seed")},
+difficulty axes: {axes}.</p>
+<h2>Leaderboard</h2>
+<table><tr><th>rank</th><th>tracker</th><th>sequences</th>{head}</tr>
+{body}</table>
+{note}
+<p>Tracker parameters (besides defaults): <ul>{tp}</ul></p>
+<p>Per-sequence scores: <a href="scores.csv">scores.csv</a>; everything:
+<a href="results.json">results.json</a>.</p>
+<h2>Metrics against the difficulty axes</h2>
+{figs or "<p>No swept or drawn axis with more than one value.</p>"}
+</body></html>
+"""
+
+
+def run_benchmark(
+    dataset: str | Path,
+    trackers: list[str],
+    out: str | Path,
+    *,
+    params: dict[str, Any] | None = None,
+    jobs: int | None = None,
+    scheduler: str | None = None,
+    progress: bool = False,
+    on_done: Callable[[BenchTask], None] | None = None,
+) -> dict[str, Any]:
+    """Run every tracker on every sequence of ``dataset`` (resumably) and write the report.
+
+    Parameters
+    ----------
+    dataset : str or Path
+        A dataset folder (``scenegen dataset``).
+    trackers : list of str
+        Tracker names.
+    out : str or Path
+        Output folder.
+    params : dict, optional
+        Tracker parameters, given to every tracker that takes them.
+    jobs, scheduler
+        Local processes, or a Dask scheduler address (its workers read ``dataset``; results
+        come back to this process, which writes ``out``).
+    progress : bool
+        Show a tqdm bar on stderr.
+    on_done : callable, optional
+        Called with each task whose record was just stored.
+
+    Returns
+    -------
+    dict
+        What ``results.json`` holds: ``dataset``, ``trackers``, ``params``,
+        ``leaderboard``, ``curves``, ``scores``.
+    """
+    from tqdm import tqdm
+
+    from scenegen.datasets.executor import check_executor, probe, run_tasks
+
+    check_executor(jobs, scheduler)
+    root = Path(dataset)
+    man, tasks = plan_benchmark(root, list(trackers), params)
+    if scheduler is not None:
+        probe(scheduler)  # fail before writing anything
+    outp = Path(out)
+    outp.mkdir(parents=True, exist_ok=True)
+    records: dict[tuple[str, int], dict[str, Any]] = {}
+    todo = []
+    for t in tasks:
+        rec = _load(outp / t.filename(), t)
+        if rec is None:
+            todo.append(t)
+        else:
+            records[(t.tracker, t.index)] = rec
+    bar = tqdm(total=len(tasks), initial=len(records), disable=not progress, unit="run",
+               desc="benchmark", leave=False)  # fmt: skip
+
+    def store(t: BenchTask, rec: dict[str, Any]) -> None:
+        write_json_atomic(outp / t.filename(), rec)
+        records[(t.tracker, t.index)] = json.loads(json.dumps(rec, sort_keys=True))
+        bar.update(1)
+        if on_done is not None:
+            on_done(t)
+
+    try:
+        run_tasks(run_pair, todo, store, jobs=jobs, scheduler=scheduler,
+                  key=lambda t: f"{_slug(t.tracker)}-{t.index}", name="scenegen-benchmark")
+    finally:  # fmt: skip
+        bar.close()
+    return write_report(man, tasks, records, outp, list(trackers))
+
+
+def write_report(
+    man: dict[str, Any],
+    tasks: list[BenchTask],
+    records: dict[tuple[str, int], dict[str, Any]],
+    out: Path,
+    trackers: list[str],
+) -> dict[str, Any]:
+    """Write scores.csv, results.json, leaderboard.md, the figures and index.html."""
+    from scenegen.io import atomic_path
+
+    entries = {int(e["index"]): e for e in man["sequences"]}
+    rows = []
+    for t in tasks:
+        rec = records[(t.tracker, t.index)]
+        e = entries[t.index]
+        rows.append({"tracker": t.tracker, "index": t.index, "name": t.name,
+                     "targets": rec["targets"], "params": e.get("params", {}),
+                     **rec["scores"]})  # fmt: skip
+    board = leaderboard(rows, trackers)
+    cur = curves(rows, man, trackers)
+    figures = []
+    for i, c in enumerate(cur):
+        name = f"curve-{c['metric']}-{i:02d}-{_slug(c['axis'])[:40]}.png"
+        _figure(c, out / name)
+        figures.append((name, f"{METRICS.get(c['metric'], c['metric'])} vs {c['axis']}"))
+    per_tracker = {t.tracker: dict(t.params) for t in tasks}
+    results = _round({
+        "dataset": {"family": man.get("family"),
+                    "family_digest": man.get("family_digest"), "seed": man.get("seed"),
+                    "count": man.get("count")},
+        "trackers": trackers,
+        "params": per_tracker,
+        "leaderboard": board,
+        "curves": cur,
+        "scores": rows,
+    })  # fmt: skip
+    write_json_atomic(out / "results.json", results, indent=1)
+    metric_cols = [m for m in METRICS if any(m in r for r in rows)]
+    pnames = list(man.get("params", []))
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(["tracker", "index", "name", "targets", *pnames, *metric_cols])
+    for r in rows:
+        w.writerow([r["tracker"], r["index"], r["name"], r["targets"],
+                    *[json.dumps(r["params"].get(p)) if isinstance(r["params"].get(p), list)
+                      else r["params"].get(p) for p in pnames],
+                    *["" if r.get(m) is None else r[m] for m in metric_cols]])  # fmt: skip
+    for name, text in (("scores.csv", buf.getvalue()), ("leaderboard.md", _markdown(board)),
+                       ("index.html", _html(man, board, figures, per_tracker))):  # fmt: skip
+        with atomic_path(out / name, Path(name).suffix) as tmp:
+            tmp.write_text(text, encoding="utf-8")
+    return results

@@ -1,0 +1,216 @@
+"""Building datasets: the same bytes on any executor, resuming after a kill, validation."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import h5py
+import pytest
+
+import scenegen
+from scenegen.datasets import build_dataset, open_dataset, validate_dataset
+from scenegen.errors import ConfigError
+from scenegen.testing.fixtures import digests
+
+TINY = {
+    "name": "tiny",
+    "base": "kams-a",
+    "set": {"n_frames": 3, "width": 48, "height": 40, "entities[0].position": [24, 20],
+            "entities[0].appearance.size": [10, 10],
+            "entities[0].motion.x.margin": 1, "entities[0].motion.y.margin": 1},
+    "sweep": {"clutter[0].count": [0, 6]},
+    "vary": {"entities[0].position_noise": {"uniform": [0.0, 2.0]}},
+    "count": 7,
+}  # fmt: skip
+SHARD = 2  # 7 sequences: shards of 2, 2, 2, 1
+
+
+def files(folder: Path) -> dict[str, bytes]:
+    """Every file of a dataset folder, by name (temporary files would show up too)."""
+    return {p.name: p.read_bytes() for p in sorted(folder.iterdir())}
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory):
+    out = tmp_path_factory.mktemp("ref") / "ds"
+    build_dataset(TINY, out, jobs=1, shard_size=SHARD)
+    return out
+
+
+def test_layout_and_manifest(reference):
+    names = sorted(files(reference))
+    assert names == ["manifest.json"] + [f"shard-{j:05d}.h5" for j in range(4)]
+    man = json.loads((reference / "manifest.json").read_text())
+    assert man["complete"] and man["count"] == 7 and man["shards"] == 4
+    entries = man["sequences"]
+    assert [e["index"] for e in entries] == list(range(7))
+    assert [e["file"] for e in entries] == ["shard-00000.h5"] * 2 + ["shard-00001.h5"] * 2 + [
+        "shard-00002.h5"] * 2 + ["shard-00003.h5"]  # fmt: skip
+    with h5py.File(reference / "shard-00001.h5") as f:
+        assert sorted(f["sequences"]) == ["tiny-00002", "tiny-00003"]
+    # The manifest's digests are those of the sequence generated from its config and seed.
+    e = entries[3]
+    seq = scenegen.read(reference / e["file"], e["name"])
+    again = scenegen.generate(scenegen.config.to_dict(seq.config), seed=e["seed"])
+    assert digests(again) == e["digests"] == digests(seq)
+    assert e["params"]["clutter[0].count"] == 6
+
+
+def test_same_bytes_with_two_local_processes(reference, tmp_path):
+    build_dataset(TINY, tmp_path / "ds", jobs=2, shard_size=SHARD)
+    assert files(tmp_path / "ds") == files(reference)
+
+
+def test_same_bytes_on_a_dask_cluster(reference, tmp_path):
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(
+        n_workers=2, processes=True, threads_per_worker=1, dashboard_address=None
+    ) as cluster:
+        build_dataset(TINY, tmp_path / "ds", scheduler=cluster.scheduler_address,
+                      shard_size=SHARD)  # fmt: skip
+    assert files(tmp_path / "ds") == files(reference)
+
+
+class Interrupt(Exception):
+    pass
+
+
+def test_interrupted_build_resumes_without_redoing_shards(reference, tmp_path):
+    out = tmp_path / "ds"
+    seen = []
+
+    def stop_after_two(res):
+        seen.append(res)
+        if len(seen) == 2:
+            raise Interrupt
+
+    with pytest.raises(Interrupt):
+        build_dataset(TINY, out, jobs=1, shard_size=SHARD, on_shard=stop_after_two)
+    man = json.loads((out / "manifest.json").read_text())
+    assert not man["complete"] and len(man["sequences"]) == 4
+    assert validate_dataset(out)[0].endswith("incomplete dataset (the build was interrupted); "
+                                             "rerun it")  # fmt: skip
+    stamps = {p.name: p.stat().st_mtime_ns for p in out.glob("shard-*.h5")}
+    again = []
+    build_dataset(TINY, out, jobs=1, shard_size=SHARD, on_shard=again.append)
+    assert [r["reused"] for r in sorted(again, key=lambda r: r["shard"])] == [True, True,
+                                                                               False, False]
+    assert {p: (out / p).stat().st_mtime_ns for p in stamps} == stamps
+    assert files(out) == files(reference)
+    assert validate_dataset(out) == []
+    assert validate_dataset(out, deep=True) == []  # every sequence generated again
+
+
+def test_damaged_shard_is_made_again(reference, tmp_path):
+    out = tmp_path / "ds"
+    build_dataset(TINY, out, jobs=1, shard_size=SHARD)
+    target = out / "shard-00002.h5"
+    data = bytearray(target.read_bytes())
+    with h5py.File(target) as f:  # flip a byte inside the first frame's stored chunk
+        offset = f["sequences/tiny-00004/frames"].id.get_chunk_info(0).byte_offset
+    data[offset + 5] ^= 0xFF
+    target.write_bytes(bytes(data))
+    assert any("shard-00002.h5" in line for line in validate_dataset(out))
+    again = []
+    build_dataset(TINY, out, jobs=1, shard_size=SHARD, on_shard=again.append)
+    assert [r["shard"] for r in again if not r["reused"]] == [2]
+    assert files(out) == files(reference)
+
+
+def test_validate_reports_missing_and_foreign_files(reference, tmp_path):
+    out = tmp_path / "ds"
+    build_dataset(TINY, out, jobs=1, shard_size=SHARD)
+    (out / "shard-00001.h5").unlink()
+    (out / "shard-00009.h5").write_bytes(b"x")
+    problems = validate_dataset(out)
+    assert any("shard-00001.h5: missing shard file" in p for p in problems)
+    assert any("shard-00009.h5: shard file not listed" in p for p in problems)
+    assert validate_dataset(tmp_path) == [f"{tmp_path}: not a dataset folder (no manifest.json)"]
+
+
+def test_folder_of_another_dataset_is_refused(reference, tmp_path):
+    out = tmp_path / "ds"
+    build_dataset(TINY, out, jobs=1, shard_size=SHARD)
+    with pytest.raises(ConfigError, match="holds a different dataset"):
+        build_dataset(TINY, out, jobs=1, shard_size=SHARD, seed=5)
+    with pytest.raises(ConfigError, match="holds a different dataset"):
+        build_dataset({**TINY, "sweep": {"clutter[0].count": [1]}}, out, shard_size=SHARD)
+
+
+def test_a_larger_count_extends_the_dataset(reference, tmp_path):
+    out = tmp_path / "ds"
+    build_dataset(TINY, out, jobs=1, shard_size=SHARD, count=5)
+    again = []
+    build_dataset(TINY, out, jobs=1, shard_size=SHARD, on_shard=again.append)  # 7
+    assert sorted((r["shard"], r["reused"]) for r in again) == [
+        (0, True), (1, True), (2, False), (3, False)]  # fmt: skip
+    assert files(out) == files(reference)
+    with pytest.raises(ConfigError, match="may extend it .--count >= 7. but not shrink it"):
+        build_dataset(TINY, out, jobs=1, shard_size=SHARD, count=3)
+
+
+def test_open_dataset(reference):
+    ds = open_dataset(reference)
+    assert len(ds) == 7 and ds.params == ["clutter[0].count", "entities[0].position_noise"]
+    seq = ds[4]
+    assert seq.name == "tiny-00004" and seq.frames.shape == (3, 40, 48, 3)
+    assert digests(seq) == ds.manifest["sequences"][4]["digests"]
+    assert [e["index"] for e in ds.select(count=6).entries] == [1, 3, 5]
+    noisy = ds.select(position_noise=(1.0, None))
+    assert all(e["params"]["entities[0].position_noise"] >= 1.0 for e in noisy.entries)
+    both = ds.select({"clutter[0].count": 0}, position_noise=lambda v: v < 1.0)
+    assert all(e["params"]["clutter[0].count"] == 0 for e in both.entries)
+    assert ds.select(count={0, 6}).entries == ds.entries
+    with pytest.raises(ConfigError, match="no parameter 'speed'"):
+        ds.select(speed=1)
+    with pytest.raises(IndexError):
+        ds[7]
+
+
+def test_samples_read_frames_and_boxes_lazily(reference):
+    import pickle
+
+    ds = open_dataset(reference)
+    whole = ds.samples()
+    frames, boxes = whole[2]
+    assert frames.shape == (3, 40, 48, 3) and frames.dtype.name == "uint8"
+    assert boxes.shape == (3, 1, 4) and boxes.dtype.name == "float32"
+    clips = pickle.loads(pickle.dumps(ds.samples(clip=2, stride=1)))
+    assert len(clips) == 7 * 2
+    f, b = clips[1]  # sequence 0, frames 1..2
+    assert (f == whole[0][0][1:3]).all() and (b == whole[0][1][1:3]).all()
+    assert sum(1 for _ in clips) == len(clips)
+
+
+def _kill_test_command(out: Path, family: Path) -> list[str]:
+    return [sys.executable, "-m", "scenegen.cli", "dataset", str(family), "-o", str(out),
+            "--jobs", "1", "--shard-size", "1"]  # fmt: skip
+
+
+def test_killed_dataset_command_resumes_identical(reference, tmp_path):
+    family = tmp_path / "tiny.json"
+    bigger = {**TINY["set"], "n_frames": 40, "width": 160, "height": 120}
+    family.write_text(json.dumps({**TINY, "set": bigger, "count": 12}))
+    full = tmp_path / "full"
+    subprocess.run(_kill_test_command(full, family), check=True, capture_output=True)
+    out = tmp_path / "killed"
+    proc = subprocess.Popen(_kill_test_command(out, family), stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL)  # fmt: skip
+    deadline = time.monotonic() + 120
+    while not (out / "shard-00002.h5").exists() and proc.poll() is None:
+        assert time.monotonic() < deadline
+        time.sleep(0.01)
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait()
+    assert proc.returncode == -signal.SIGKILL  # killed mid-run, not finished
+    assert not json.loads((out / "manifest.json").read_text())["complete"]
+    made = sorted(p.name for p in out.glob("shard-*.h5"))
+    assert 3 <= len(made) < 12
+    stamps = {name: (out / name).stat().st_mtime_ns for name in made}
+    subprocess.run(_kill_test_command(out, family), check=True, capture_output=True)
+    assert {n: (out / n).stat().st_mtime_ns for n in stamps} == stamps  # not made again
+    assert files(out) == files(full)

@@ -1,0 +1,131 @@
+"""Scenario families: parsing, field paths, draws, and one-line errors for bad families."""
+
+import json
+
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from scenegen import presets
+from scenegen.config import to_dict
+from scenegen.datasets import builtin_names, family_from_dict, load_family, resolve_family
+from scenegen.datasets.paths import get_path, leaf_type, set_path
+from scenegen.errors import ConfigError
+
+FAMILY = {
+    "name": "t",
+    "base": "kams-a",
+    "set": {"n_frames": 4, "width": 64, "height": 48, "entities[0].position": [30, 24],
+            "entities[target].motion.x.margin": 2, "entities[target].motion.y.margin": 2},
+    "sweep": {"clutter[0].count": [0, 4, 8]},
+    "vary": {"entities[0].position_noise": {"uniform": [0.0, 3.0]},
+             "clutter[clutter].min_size": {"randint": [2, 8]},
+             "background.kind": {"choice": ["uniform", "noise"]}},
+    "count": 7,
+}  # fmt: skip
+
+
+def test_paths_name_fields_by_index_or_name():
+    data = to_dict(presets.get("dps-occlusion"))
+    assert leaf_type(data, "entities[walker].appearance.size[0]") is int
+    assert leaf_type(data, "entities[1].position_noise") is float
+    set_path(data, "entities[standing2].appearance.size[0]", 50)
+    assert get_path(data, "entities[2].appearance.size") == [50, 50]
+
+
+def test_every_builtin_family_draws_valid_sequences():
+    for name in builtin_names():
+        fam = resolve_family(name)
+        draws = fam.draws(min(fam.count, 5))
+        assert len({d.seed for d in draws}) == len(draws), name
+        assert all(d.name == f"{name}-{d.index:05d}" for d in draws)
+
+
+def test_kams_family_sweeps_the_four_levels():
+    fam = resolve_family("kams")
+    assert [d.params["preset"] for d in fam.draws(8)] == ["kams-a", "kams-b", "kams-c",
+                                                           "kams-d"] * 2  # fmt: skip
+    d = fam.draw(3)
+    assert d.preset == "kams-d" and d.config["clutter"][0]["count"] == 600
+
+
+def test_a_preset_name_is_a_family_of_seeds():
+    fam = resolve_family("kams-c")
+    assert fam.grid_size == 1
+    a, b = fam.draws(2)
+    assert a.params == {} and a.seed != b.seed and a.preset == "kams-c"
+
+
+def test_grid_and_draws():
+    fam = family_from_dict(FAMILY)
+    draws = fam.draws()
+    assert [d.params["clutter[0].count"] for d in draws] == [0, 4, 8, 0, 4, 8, 0]
+    for d in draws:
+        assert 0.0 <= d.params["entities[0].position_noise"] <= 3.0
+        assert d.config["entities"][0]["position_noise"] == d.params["entities[0].position_noise"]
+        assert d.config["clutter"][0]["min_size"] == d.params["clutter[clutter].min_size"]
+        assert d.config["n_frames"] == 4
+    assert fam.param_names == ["clutter[0].count", "entities[0].position_noise",
+                               "clutter[clutter].min_size", "background.kind"]  # fmt: skip
+
+
+@given(seed=st.integers(0, 2**32), index=st.integers(0, 50))
+def test_a_draw_depends_on_family_seed_and_index_only(seed, index):
+    fam = family_from_dict(FAMILY)
+    alone = fam.draw(index, seed)
+    assert fam.draws(index + 1, seed)[index] == alone
+    bigger = family_from_dict({**FAMILY, "count": 500})  # the count is not part of it
+    assert bigger.draw(index, seed) == alone
+    assert fam.draw(index, seed + 1).seed != alone.seed
+
+
+def test_family_file(tmp_path):
+    p = tmp_path / "f.json"
+    p.write_text(json.dumps(FAMILY))
+    y = tmp_path / "f.yaml"
+    y.write_text("name: t\nbase: kams-a\nsweep:\n  clutter[0].count: [1, 2]\n")
+    assert load_family(p).draws() == family_from_dict(FAMILY, source=str(p)).draws()
+    assert load_family(y).grid_size == 2
+
+
+BAD = [
+    ({"sweep": {"clutter[0].cnt": [1]}}, "sweep.clutter[0].cnt: unknown field 'cnt'"),
+    ({"vary": {"entities[0].motion.z": {"uniform": [0, 1]}}},
+     "vary.entities[0].motion.z: unknown field 'z'"),
+    ({"vary": {"entities[5].position_noise": {"uniform": [0, 1]}}}, "index 5 out of range"),
+    ({"vary": {"entities[nobody].position_noise": {"uniform": [0, 1]}}}, "no item named"),
+    ({"sweep": {"clutter[0].count": []}}, "sweep.clutter[0].count: empty sweep"),
+    ({"vary": {"entities[0].position_noise": {"uniform": [3, 1]}}},
+     "vary.entities[0].position_noise: empty range [3, 1]"),
+    ({"vary": {"clutter[0].count": {"randint": [9, 2]}}}, "clutter[0].count: empty range"),
+    ({"vary": {"background.kind": {"choice": []}}}, "background.kind: empty choice"),
+    ({"vary": {"clutter[0].count": {"uniform": [1, 5]}}},
+     "vary.clutter[0].count: uniform draws real numbers but clutter[0].count is an integer"),
+    ({"vary": {"background.kind": {"normal": [1, 5]}}},
+     "vary.background.kind: normal draws numbers but background.kind is one of"),
+    ({"vary": {"sensor_noise": {"gauss": [1, 5]}}}, "vary.sensor_noise: unknown distribution"),
+    ({"vary": {"sensor_noise": {"loguniform": [0, 5]}}}, "loguniform needs low > 0"),
+    ({"vary": {"sensor_noise": {"uniform": ["a", 5]}}}, "bounds must be finite numbers"),
+    ({"sweep": {"entities[0].position_noise": [-1]}}, "entities[0].position_noise: must be >= 0"),
+    ({"vary": {"entities[0].position_noise": {"normal": [0, 5]}}, "count": 20},
+     "entities[0].position_noise: must be >= 0"),
+    ({"colour": 1}, "colour: unknown key"),
+    ({"count": 0}, "count: must be an integer >= 1"),
+    ({"base": "kams-z"}, "base: unknown preset 'kams-z'"),
+    ({"name": "a/b"}, "name: is required"),
+]  # fmt: skip
+
+
+@pytest.mark.parametrize(("change", "message"), BAD)
+def test_bad_family_is_one_line_naming_the_field(change, message):
+    data = {"name": "t", "base": "kams-a", **change}
+    with pytest.raises(ConfigError) as info:
+        family_from_dict(data, source="f.yaml").draws()
+    text = str(info.value)
+    assert message in text
+    assert text.startswith("f.yaml: ") and "\n" not in text
+
+
+def test_unknown_family_name_lists_the_valid_ones():
+    with pytest.raises(ConfigError, match="built-in families: kams"):
+        resolve_family("nope")
