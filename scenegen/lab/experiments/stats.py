@@ -11,7 +11,8 @@ interval for the effect into "reproduced", "not reproduced" or "inconclusive":
 - **not reproduced**: not significant, and our interval for the effect excludes the effect
   of interest ``delta`` (the paper's own effect where it prints one): an effect that large
   is ruled out by our runs — or the effect is significant the other way;
-- **inconclusive**: neither: the runs are too few to tell.
+- **inconclusive**: neither, or fewer than :data:`MIN_RUNS` runs (cases) per compared
+  arm: the runs are too few to tell.
 
 Every function takes counts or arrays and returns plain floats, so results stay JSON-ready.
 """
@@ -28,6 +29,7 @@ from numpy.typing import ArrayLike
 __all__ = [
     "ALPHA",
     "LEVEL",
+    "MIN_RUNS",
     "Test",
     "binomial_greater",
     "bootstrap_mean",
@@ -49,6 +51,8 @@ LEVEL = 0.95
 """Coverage of every interval."""
 N_BOOT = 2000
 """Bootstrap resamples."""
+MIN_RUNS = 10
+"""Fewest runs (or paired cases) per compared arm for a "not reproduced" verdict."""
 
 
 @dataclass(frozen=True)
@@ -226,7 +230,7 @@ def bootstrap_paired_diff(a: ArrayLike, b: ArrayLike, rng: int | np.random.Gener
             Test("paired bootstrap of the mean difference (one-sided)", float(d.mean()), p))
 
 
-def verdict(p_value: float, interval: tuple[float, float], delta: float,
+def verdict(p_value: float, interval: tuple[float, float], delta: float, n: int,
             alpha: float = ALPHA) -> str:
     """Judge a claim "effect > 0" from its one-sided p-value and an interval for the effect.
 
@@ -239,18 +243,20 @@ def verdict(p_value: float, interval: tuple[float, float], delta: float,
     delta : float
         Effect of interest (> 0): the paper's effect, or a stated smallest effect that
         matters where the paper prints none.
+    n : int
+        Runs (or paired cases) of the smaller compared arm.
     alpha : float
 
     Returns
     -------
     str
-        ``"reproduced"`` (p < alpha), ``"not reproduced"`` (the interval lies below delta,
-        i.e. an effect that large is ruled out, or lies wholly below 0), else
-        ``"inconclusive"`` (too few runs to tell).
+        ``"reproduced"`` (p < alpha), ``"not reproduced"`` (n >= :data:`MIN_RUNS` and the
+        interval lies below delta, i.e. an effect that large is ruled out, or wholly below
+        0), else ``"inconclusive"`` (too few runs to tell).
     """
     lo, hi = interval
     if p_value < alpha:
         return "reproduced"
-    if math.isfinite(hi) and (hi < delta or hi < 0):
+    if n >= MIN_RUNS and math.isfinite(hi) and (hi < delta or hi < 0):
         return "not reproduced"
     return "inconclusive"

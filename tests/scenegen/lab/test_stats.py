@@ -85,7 +85,8 @@ def test_bootstrap_is_seeded_and_sensible():
 
 
 def test_verdicts():
-    assert stats.verdict(0.01, (0.1, 0.5), 0.3) == "reproduced"
-    assert stats.verdict(0.4, (-0.1, 0.1), 0.3) == "not reproduced"  # 0.3 ruled out
-    assert stats.verdict(0.4, (-0.5, -0.2), 0.1) == "not reproduced"  # the other way
-    assert stats.verdict(0.2, (-0.1, 0.6), 0.3) == "inconclusive"
+    assert stats.verdict(0.01, (0.1, 0.5), 0.3, 3) == "reproduced"
+    assert stats.verdict(0.4, (-0.1, 0.1), 0.3, 20) == "not reproduced"  # 0.3 ruled out
+    assert stats.verdict(0.4, (-0.1, 0.1), 0.3, 9) == "inconclusive"  # too few runs
+    assert stats.verdict(0.4, (-0.5, -0.2), 0.1, 20) == "not reproduced"  # the other way
+    assert stats.verdict(0.2, (-0.1, 0.6), 0.3, 50) == "inconclusive"
