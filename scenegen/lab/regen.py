@@ -160,14 +160,6 @@ def verify(
     return problems
 
 
-def _write_npy(path: Path, arr: NDArray[Any]) -> None:
-    from scenegen.io import atomic_path
-
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_path(path) as tmp, open(tmp, "wb") as fh:
-        np.save(fh, arr)
-
-
 def regen(
     folder: str | Path | None = None,
     *,
@@ -199,7 +191,8 @@ def regen(
     """
     import trackers
     from scenegen import __version__
-    from scenegen.io import atomic_path, write
+    from scenegen.io import write
+    from scenegen.io.atomic import write_npy, write_text
     from scenegen.render.plan import generate
 
     root = default_dir() if folder is None else Path(folder)
@@ -257,7 +250,7 @@ def regen(
             exp_path = root / rel
             previous = np.load(exp_path) if exp_path.exists() else None
             if previous is None or not np.array_equal(previous, boxes, equal_nan=True):
-                _write_npy(exp_path, boxes)
+                write_npy(exp_path, boxes, parents=True)
                 if previous is None:
                     changes.append(f"fixture {name}, tracker {tname}: new expected output")
                 else:
@@ -287,6 +280,5 @@ def regen(
     text = json.dumps(out, indent=1, sort_keys=False) + "\n"
     reg_path = root / "registry.json"
     if not reg_path.exists() or reg_path.read_text(encoding="utf-8") != text:
-        with atomic_path(reg_path) as tmp:
-            tmp.write_text(text, encoding="utf-8")
+        write_text(reg_path, text)
     return changes, errors

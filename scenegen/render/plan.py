@@ -95,6 +95,8 @@ class Scenario:
         Base template of each entity.
     cx, cy : ndarray of shape (T, K)
         Drawn centre (motion plus position noise) before rounding to pixels.
+    path_x, path_y : ndarray of shape (T, K)
+        Centre of the noise-free motion path (``cx``, ``cy`` before the position noise).
     scale, angle, shade : ndarray of shape (T, K)
         Per-frame appearance transform.
     alive : ndarray of shape (T, K), bool
@@ -114,6 +116,8 @@ class Scenario:
     templates: list[NDArray[np.uint8]]
     cx: NDArray[np.float64]
     cy: NDArray[np.float64]
+    path_x: NDArray[np.float64]
+    path_y: NDArray[np.float64]
     scale: NDArray[np.float64]
     angle: NDArray[np.float64]
     shade: NDArray[np.float64]
@@ -237,6 +241,9 @@ class Scenario:
 
         gt = _ground_truth(tidx, x0, y0, th, tw, toff, tbuf, out_box, out_count)
         gt["depth"] = self.depth_rank[start:stop].copy()
+        path = np.stack([self.path_x[start:stop], self.path_y[start:stop]], axis=-1)
+        path[~gt["present"]] = np.nan
+        gt["path_center"] = path.astype(np.float32)
         return Chunk(start=start, frames=out_rgb, labels=out_lab, gt=gt)
 
     def chunks(self, size: int = 64) -> Iterator[Chunk]:
@@ -313,7 +320,8 @@ def _ground_truth(tidx, x0, y0, th, tw, toff, tbuf, vbox, vcount) -> dict[str, N
 def _entity_plan(
     e: EntitySpec, cfg: SceneConfig, seed: int, tpl: NDArray[np.uint8], start: tuple[float, float]
 ) -> tuple[NDArray[np.float64], ...]:
-    """Trajectory (T,) x, y, scale, angle, shade of one entity from its own stream."""
+    """Trajectory (T,) x, y, scale, angle, shade, path x, path y of one entity from its own
+    stream; x, y include the position noise, path x, path y do not."""
     t_n = cfg.n_frames
     rng = entity_rng(seed, e.name, 1)
     th, tw = tpl.shape[:2]
@@ -336,6 +344,7 @@ def _entity_plan(
             s = ar2_path(m.scale, 0.0, 0.0, t_n, rng=rng, lo=-lim, hi=lim)
         else:
             s = np.zeros(t_n)
+    path_x, path_y = x, y
     if e.position_noise > 0:
         noise = rng.standard_normal((t_n, 2)) * e.position_noise
         x = x + noise[:, 0]
@@ -350,7 +359,7 @@ def _entity_plan(
         angle = np.zeros(t_n)
         shade = np.ones(t_n)
     scale = np.clip(np.exp(s), *_SCALE_LIMITS)
-    return x, y, scale, angle, shade
+    return x, y, scale, angle, shade, path_x, path_y
 
 
 def _clutter(cfg: SceneConfig, seed: int) -> list[tuple[str, NDArray[np.uint8], float, float]]:
@@ -440,17 +449,23 @@ def plan(config: SceneConfig, seed: int | None = None, *, preset: str = "") -> S
 
     cx = np.empty((t_n, k_n))
     cy = np.empty((t_n, k_n))
+    path_x = np.empty((t_n, k_n))
+    path_y = np.empty((t_n, k_n))
     scale = np.ones((t_n, k_n))
     angle = np.zeros((t_n, k_n))
     shade = np.ones((t_n, k_n))
     alive = np.zeros((t_n, k_n), dtype=bool)
     for k, e in enumerate(cfg.entities):
-        cx[:, k], cy[:, k], scale[:, k], angle[:, k], shade[:, k] = paths[e.name]
+        cx[:, k], cy[:, k], scale[:, k], angle[:, k], shade[:, k], path_x[:, k], path_y[:, k] = (
+            paths[e.name]
+        )
         stop = t_n if e.disappear is None else min(e.disappear, t_n)
         alive[e.appear : stop, k] = True
     for j, c in enumerate(clutter):
         cx[:, k_user + j] = c[2]
         cy[:, k_user + j] = c[3]
+        path_x[:, k_user + j] = c[2]
+        path_y[:, k_user + j] = c[3]
         alive[:, k_user + j] = True
 
     depth_value = np.empty((t_n, k_n), dtype=np.int64)
@@ -487,6 +502,8 @@ def plan(config: SceneConfig, seed: int | None = None, *, preset: str = "") -> S
         templates=tpls,
         cx=cx,
         cy=cy,
+        path_x=path_x,
+        path_y=path_y,
         scale=scale,
         angle=angle,
         shade=shade,

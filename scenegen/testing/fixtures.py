@@ -42,6 +42,7 @@ from scenegen.config import (
     SceneConfig,
 )
 from scenegen.errors import ConfigError, DataError
+from scenegen.testing.compare import difference
 
 __all__ = [
     "EXPECTED_ATOL",
@@ -367,21 +368,10 @@ def digests(seq: Any) -> dict[str, str]:
 
 
 def compare_boxes(actual: NDArray[Any], expected: NDArray[Any]) -> str | None:
-    """None if equal within EXPECTED_ATOL (NaN matching NaN), else what differs."""
-    if actual.shape != expected.shape:
-        return f"shape {actual.shape}, expected {expected.shape}"
-    nan_a, nan_e = np.isnan(actual), np.isnan(expected)
-    if np.any(nan_a != nan_e):
-        t = int(np.argwhere(nan_a != nan_e)[0][0])
-        return f"NaN pattern differs from frame {t}"
-    diff = np.abs(np.where(nan_a, 0.0, actual.astype(np.float64) - expected))
-    if diff.max(initial=0.0) <= EXPECTED_ATOL:
-        return None
-    bad = np.argwhere(diff > EXPECTED_ATOL)
-    return (
-        f"{len(bad)} of {diff.size} values differ beyond {EXPECTED_ATOL} px "
-        f"(largest {float(diff.max()):.3g} px), first at frame {int(bad[0][0])}"
-    )
+    """None if equal within :data:`EXPECTED_ATOL` pixels (NaN matching NaN), else what
+    differs (:func:`scenegen.testing.compare.difference`; the index is (frame, target,
+    coordinate))."""
+    return difference(actual, expected, atol=EXPECTED_ATOL)
 
 
 # --------------------------------------------------------------------------------------
