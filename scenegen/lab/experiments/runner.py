@@ -2,8 +2,9 @@
 
 Every run is a :class:`Task`: (experiment, method, preset, swept value, scene index s, run
 index r) plus the base seed and the quick flag. An experiment runs S scenes (each its own
-scene seed, shared by every method, so that runs are paired) times R tracker runs per scene. Its seeds come from a SHA-256 hash of that key (never
-Python's ``hash``), so a run gives the same numbers whichever process or machine runs it.
+scene seed, shared by every method, so that runs are paired) times R tracker runs per
+scene. The seeds come from a SHA-256 hash of that key (never Python's ``hash``), so a
+run gives the same numbers whichever process or machine runs it.
 The worker generates the run's sequence itself (cached per process), runs the tracker and
 returns a small record of per-frame measures with floats rounded to fixed decimals. The
 parent stores each record as it arrives (one JSON file per run under ``DIR/runs/``,
@@ -143,8 +144,8 @@ def plan_tasks(
     """Every task of an experiment, in a fixed order.
 
     Every method runs on every preset, ``scenes`` scenes (default the experiment's S) and
-    ``runs`` tracker runs per scene. ``methods`` (slugs or labels) and ``values`` (of the swept parameter) restrict the
-    sweep; by default every method runs at every value.
+    ``runs`` tracker runs per scene. ``methods`` (slugs or labels) and ``values`` (of the
+    swept parameter) restrict the sweep; by default every method runs at every value.
 
     Raises
     ------
