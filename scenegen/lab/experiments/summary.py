@@ -544,8 +544,43 @@ def _dps_real(exp: Experiment, records: Records) -> dict[str, Any]:
                     claims, f"{preset}: occluded object's success of {a} above {b}'s",
                     recs[a], recs[b], lambda r: _success(r["targets"][hard]), abs(gap), a, b,
                     delta_source="paper's difference")
+            _pooled_ps_claims(claims, exp, preset, rows, paper)
     return {"summary": {"hard_target": exp.hard_target, "presets": by_preset},
             "comparisons": comparisons, "claims": claims}
+
+
+def _pooled_ps_claims(claims: list[dict[str, Any]], exp: Experiment, preset: str,
+                      rows: dict[str, Any], paper: dict[str, Any]) -> None:
+    """DPS against the pooled PS orderings, and whether the orderings differ (success)."""
+    ps = [m.label for m in exp.methods if m.group == "PS" and m.label in rows
+          and m.label in paper]
+    if not ps or "DPS" not in rows:
+        return
+    k = sum(rows[m]["hard"]["success"]["k"] for m in ps)
+    n = sum(rows[m]["hard"]["success"]["n"] for m in ps)
+    d = rows["DPS"]["hard"]["success"]
+    gap = paper["DPS"][0] - float(np.mean([paper[m][0] for m in ps]))
+    if gap >= 0:
+        _z_claim(claims, f"{preset}: occluded object's success of DPS above the PS orderings' "
+                 "(pooled)", d["k"], d["n"], k, n, gap, "DPS", "PS (all orderings)",
+                 delta_source="paper's DPS − PS mean")
+    else:
+        _z_claim(claims, f"{preset}: occluded object's success of the PS orderings (pooled) "
+                 "above DPS's (the paper's limitation of DPS)", k, n, d["k"], d["n"], -gap,
+                 "PS (all orderings)", "DPS", delta_source="paper's PS mean − DPS")
+    spread = max(paper[m][0] for m in ps) - min(paper[m][0] for m in ps)
+    if len(ps) > 1 and spread >= _CLAIM_GAP:
+        rs = [rows[m]["hard"]["success"] for m in ps]
+        best = max(ps, key=lambda m: rows[m]["hard"]["success"]["pct"])
+        worst = min(ps, key=lambda m: rows[m]["hard"]["success"]["pct"])
+        b, w = rows[best]["hard"]["success"], rows[worst]["hard"]["success"]
+        lo, hi = stats.newcombe_diff(b["k"], b["n"], w["k"], w["n"])
+        test = stats.chi2_homogeneity([r["k"] for r in rs], [r["n"] for r in rs])
+        _claim(claims, f"{preset}: the PS orderings differ in the occluded object's success "
+               "(the ordering matters)", test, b["pct"] - w["pct"], (100 * lo, 100 * hi),
+               spread, f"best {best} {b['pct']:.0f}%, worst {worst} {w['pct']:.0f}%, "
+               f"χ² = {test.statistic:.1f}", delta_source="paper's best − worst ordering",
+               n=min(r["n"] for r in rs))
 
 
 def _table_dps_real(res: dict[str, Any], exp_name: str) -> list[str]:
