@@ -267,6 +267,11 @@ def dps_occlusion_2() -> SceneConfig:
     then occludes object 3 while passing in front of it: the two share hair, face and
     trousers, so object 1's particles may stay on object 3 when the walker moves on.
 
+    Not tuned: on base seed 1 (6 scenes x 2 runs) this version gives Non-PS 33 %, PS
+    58–67 %, DPS 50 % success. Tried without a gain for DPS: the first person in the
+    half-red shirt of ``dps-occlusion`` (Non-PS 33 %, PS 42–67 %, DPS 42 %), both people in
+    it (67 / 67–92 / 58 %), the second only (92 / 100 / 100 %).
+
     Differs from the paper: as ``dps-occlusion``; the paper's occlusions last 6 and 10
     frames, ours about as long (walker 32 px wide, occluders 44 px, speed below).
     """

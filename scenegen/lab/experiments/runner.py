@@ -218,6 +218,17 @@ def tracker_params(exp: Experiment, task: Task) -> dict[str, Any]:
     return params
 
 
+@functools.lru_cache(maxsize=64)
+def scene_digest(preset: str) -> str:
+    """SHA-256 (16 hex digits) of the preset's resolved config: a changed preset makes
+    stored runs on it stale."""
+    from scenegen import presets
+    from scenegen.config import to_dict
+
+    text = json.dumps(to_dict(presets.get(preset)), sort_keys=True, default=str)
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()[:16]
+
+
 def run_task(task: Task) -> dict[str, Any]:
     """Run one task and return its record (JSON-ready, floats rounded).
 
@@ -270,6 +281,7 @@ def run_task(task: Task) -> dict[str, Any]:
         "tracker": method.tracker,
         "params": params,
         "scene_seed": task.scene_seed(),
+        "scene_digest": scene_digest(task.preset),
         "tracker_seed": task.tracker_seed(),
         "n_frames": int(gt.shape[0]),
         "failure_threshold": failure_threshold(gt),
@@ -314,8 +326,9 @@ def write_json_atomic(path: Path, data: Any, *, indent: int | None = None) -> No
 def load_record(path: Path, task: Task) -> dict[str, Any] | None:
     """The stored record of ``task`` at ``path``, or None if missing, unreadable or stale.
 
-    Stale means stored for another key (experiment, method, preset, value, run, seed,
-    quick) or with other tracker parameters.
+    Stale means stored for another key (experiment, method, preset, value, scene, run,
+    seed, quick), with other tracker parameters, or for another version of the preset's
+    config (:func:`scene_digest`).
     """
     try:
         data = json.loads(path.read_text(encoding="utf-8"))
@@ -325,6 +338,8 @@ def load_record(path: Path, task: Task) -> dict[str, Any] | None:
         return None
     # Parameters changed since the run was stored (a new version of the experiment).
     if data.get("params") != _round(tracker_params(get(task.experiment), task)):
+        return None
+    if data.get("scene_digest") != scene_digest(task.preset):
         return None
     return data
 

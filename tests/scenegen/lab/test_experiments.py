@@ -114,7 +114,11 @@ def test_stale_or_damaged_run_files_are_redone(reference, tmp_path):
     rec = json.loads(stored[2].read_text())
     rec["params"]["n_particles"] = 7  # stored by an older definition of the experiment
     stored[2].write_text(json.dumps(rec))
+    rec = json.loads(stored[3].read_text())
+    rec["scene_digest"] = "0" * 16  # stored for an older version of the preset
+    stored[3].write_text(json.dumps(rec))
     run_experiment(NAME, tmp_path, jobs=1, **KW)
+    assert json.loads(stored[3].read_text())["scene_digest"] != "0" * 16  # redone
     assert (tmp_path / "results.json").read_bytes() == (reference / "results.json").read_bytes()
 
 
