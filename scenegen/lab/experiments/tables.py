@@ -32,7 +32,7 @@ def _num(v: Any, digits: int = 1) -> str:
     if v is None:
         return "–"
     if isinstance(v, float):
-        return f"{v:.{digits}f}"
+        return f"{v:.3f}" if abs(v) < 1 and v != 0 else f"{v:.{digits}f}"
     return str(v)
 
 
