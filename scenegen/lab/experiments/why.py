@@ -21,7 +21,7 @@ WHY: dict[str, str] = {
         "+2 points). Our distractor is a recoloured copy that drifts away in 6 frames; "
         "the paper learned object 1's model from the distractor itself, which makes the "
         "distractor the better match and recovery much harder. Non-PS keeps objects 2–7 "
-        "in only 60–64 % of cases (paper 93–97 %): one 300-particle set for a 21-dimensional "
+        "in only 55–64 % of cases (paper 93–97 %): one 300-particle set for a 21-dimensional "
         "joint state cannot follow seven objects that each wander ~30 px, which is the "
         "paper's argument for partitioning, stronger on our scene than on theirs."
     ),
