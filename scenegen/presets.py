@@ -35,9 +35,15 @@ def _preset(name: str) -> Callable[[Callable[[], SceneConfig]], Callable[[], Sce
     return register
 
 
+_CONTRACT_ORDER = ("dps-synthetic", "dps-occlusion", "kams-a", "kams-b", "kams-c", "kams-d",
+                   "shm-crossing")
+
+
 def names() -> list[str]:
-    """The preset names, in the contract's order."""
-    return list(_PRESETS)
+    """The preset names: the original seven in the contract's order, then the newer ones
+    (``dps-occlusion-2``, ``dps-dancers``, ``shm-clutter``) in definition order."""
+    first = [n for n in _CONTRACT_ORDER if n in _PRESETS]
+    return first + [n for n in _PRESETS if n not in _CONTRACT_ORDER]
 
 
 def get(name: str) -> SceneConfig:
