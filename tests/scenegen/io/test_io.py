@@ -1,4 +1,4 @@
-"""HDF5 round trips, lazy reading and result files (CONTRACT layout)."""
+"""HDF5 round trips, lazy reading and result files (the layout of docs/format.md)."""
 
 from __future__ import annotations
 

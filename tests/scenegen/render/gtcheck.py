@@ -56,7 +56,7 @@ def reference_frame(scn: Scenario, t: int) -> tuple[np.ndarray, np.ndarray, dict
 
 
 def check_sequence(seq, scn: Scenario, *, pixels: bool = True) -> None:
-    """Assert every CONTRACT ground-truth invariant of ``seq`` against ``scn``."""
+    """Assert every ground-truth invariant (docs/format.md) of ``seq`` against ``scn``."""
     t_n, k_n = seq.gt.present.shape
     h, w = seq.height, seq.width
     for t in range(t_n):
