@@ -35,15 +35,15 @@ def _preset(name: str) -> Callable[[Callable[[], SceneConfig]], Callable[[], Sce
     return register
 
 
-_CONTRACT_ORDER = ("dps-synthetic", "dps-occlusion", "kams-a", "kams-b", "kams-c", "kams-d",
+_ORIGINAL_ORDER = ("dps-synthetic", "dps-occlusion", "kams-a", "kams-b", "kams-c", "kams-d",
                    "shm-crossing")
 
 
 def names() -> list[str]:
     """The preset names: the original seven in the contract's order, then the newer ones
     (``dps-occlusion-2``, ``dps-dancers``, ``shm-clutter``) in definition order."""
-    first = [n for n in _CONTRACT_ORDER if n in _PRESETS]
-    return first + [n for n in _PRESETS if n not in _CONTRACT_ORDER]
+    first = [n for n in _ORIGINAL_ORDER if n in _PRESETS]
+    return first + [n for n in _PRESETS if n not in _ORIGINAL_ORDER]
 
 
 def get(name: str) -> SceneConfig:

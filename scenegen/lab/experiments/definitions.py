@@ -1,4 +1,4 @@
-"""The five experiments of the contract, as declarative definitions.
+"""The six experiments (the contract's five and ``dps-dancers``), as declarative definitions.
 
 An :class:`Experiment` names the sequence preset(s), the methods (a tracker with fixed
 parameters), an optional parameter sweep, the default number of runs R and what to change

@@ -107,5 +107,7 @@ def render_table(exp: Experiment, results: dict[str, Any], why: str = "") -> str
         lines.append("The paper prints no numbers for this experiment; only its claims are "
                      "tested.")
     if why:
-        lines += ["", "## Where we differ and why", "", why]
+        lines += ["", "## Where we differ and why", "",
+                  "(Numbers of the full run, `scenegen experiment all`, base seed 0, default "
+                  "S x R.) " + why]
     return "\n".join(lines) + "\n"
