@@ -1,4 +1,5 @@
-"""The ``experiment`` verb: run one of the papers' experiments, locally or on Dask."""
+"""The ``experiment`` verb: run one of the papers' experiments (or ``all``), locally or on
+Dask."""
 
 from __future__ import annotations
 
@@ -14,41 +15,65 @@ def register(sub: argparse._SubParsersAction) -> None:
 
     p = sub.add_parser(
         "experiment",
-        help="run a paper's experiment: results.json, table.md and figures",
-        description="Experiments: " + ", ".join(names()) + ". Finished runs are kept under "
-        "DIR/runs/; running the same command again resumes.",
+        help="run a paper's experiment (or all): results.json, table.md and figures",
+        description="Experiments: " + ", ".join(names()) + "; `all` runs every one into "
+        "DIR/experiments/<name>/ and writes the report DIR/index.html. Finished runs are kept "
+        "under .../runs/; running the same command again resumes.",
     )
-    p.add_argument("name", help="experiment name")
-    p.add_argument("--runs", type=int, default=None, help="runs per method (default: paper's)")
+    p.add_argument("name", help="experiment name, or `all`")
+    p.add_argument("--runs", type=int, default=None,
+                   help="tracker runs R per scene (default: the experiment's)")
+    p.add_argument("--scenes", type=int, default=None,
+                   help="scenes S per preset (default: the experiment's)")
     where = p.add_mutually_exclusive_group()
     where.add_argument("--jobs", type=int, default=None, help="local processes (default: all)")
     where.add_argument("--scheduler", default=None, metavar="ADDRESS",
                        help="dask.distributed scheduler address, e.g. tcp://host:8786")
     p.add_argument("--seed", type=int, default=0, help="base seed (default 0)")
     p.add_argument("--method", action="append", default=None, metavar="NAME",
-                   help="run only this method (repeatable)")
+                   help="run only this method (repeatable; not with `all`)")
     p.add_argument("--quick", action="store_true",
                    help="scaled-down settings (fewer frames/particles), for smoke tests")
     p.add_argument("-o", "--output", required=True, type=Path, help="output folder DIR")
     p.set_defaults(func=cmd_experiment)
 
 
+def _say_verdicts(name: str, results: dict, where: Path) -> None:
+    from scenegen.lab.experiments import verdict_counts
+
+    c = verdict_counts(results)
+    print(f"{name}: {c['reproduced']} reproduced, {c['not reproduced']} not reproduced, "
+          f"{c['inconclusive']} inconclusive; table: {where}", file=sys.stderr)
+
+
 def cmd_experiment(args: argparse.Namespace) -> int:
-    """Run the experiment and print where its table is; 0 on success.
+    """Run the experiment (or all of them) and print where the results are; 0 on success.
 
     Raises
     ------
     ConfigError
-        Unknown experiment or method (listing the valid ones), bad --runs/--jobs/--seed,
-        or an unreachable scheduler (within 10 s, naming the address).
+        Unknown experiment or method (listing the valid ones), bad --runs/--scenes/--jobs/
+        --seed, or an unreachable scheduler (within 10 s, naming the address).
     """
+    from scenegen.errors import ConfigError
     from scenegen.lab.experiments import get, run_experiment
 
+    if args.name == "all":
+        from scenegen.lab.report import run_all
+
+        if args.method:
+            raise ConfigError("--method cannot be used with `experiment all`")
+        index = run_all(args.output, runs=args.runs, scenes=args.scenes, jobs=args.jobs,
+                        scheduler=args.scheduler, seed=args.seed, quick=args.quick,
+                        progress=sys.stderr.isatty(), say=_say_verdicts)
+        print(str(Path(index).resolve()))
+        return 0
     get(args.name)
     results = run_experiment(
         args.name,
         args.output,
         runs=args.runs,
+        scenes=args.scenes,
         jobs=args.jobs,
         scheduler=args.scheduler,
         seed=args.seed,
@@ -56,8 +81,6 @@ def cmd_experiment(args: argparse.Namespace) -> int:
         methods=args.method,
         progress=sys.stderr.isatty(),
     )
-    bad = [c["claim"] for c in results["fidelity"] if not c["holds"]]
-    print(f"{args.name}: {len(results['fidelity']) - len(bad)} of {len(results['fidelity'])} "
-          f"paper claims hold; table: {args.output / 'table.md'}", file=sys.stderr)
+    _say_verdicts(args.name, results, args.output / "table.md")
     print(str((args.output / "results.json").resolve()))
     return 0

@@ -1,6 +1,7 @@
 """The papers' experiments: seeded sweeps on local processes or Dask, with tables and figures.
 
-``run_experiment(name, out_dir)`` runs R seeded runs per method (and swept value), storing
+``run_experiment(name, out_dir)`` runs S scenes x R seeded tracker runs per method, preset
+(and swept value), storing
 each finished run under ``out_dir/runs/`` so that an interrupted sweep resumes where it
 stopped, then writes ``results.json`` (deterministic: sorted keys, no timestamps, floats
 rounded to fixed decimals), ``table.md`` (the paper's table with its figures beside ours)
@@ -41,7 +42,9 @@ from scenegen.lab.experiments.runner import (
     run_task,
     write_json_atomic,
 )
-from scenegen.lab.experiments.summary import render_table, summarize
+from scenegen.lab.experiments.summary import summarize
+from scenegen.lab.experiments.tables import render_table, verdict_counts
+from scenegen.lab.experiments.why import WHY
 
 __all__ = [
     "EXPERIMENTS",
@@ -55,6 +58,7 @@ __all__ = [
     "names",
     "run_experiment",
     "run_task",
+    "verdict_counts",
 ]
 
 RESULT_DECIMALS = 4
@@ -82,6 +86,7 @@ def run_experiment(
     out_dir: str | Path,
     *,
     runs: int | None = None,
+    scenes: int | None = None,
     jobs: int | None = None,
     scheduler: str | None = None,
     seed: int = 0,
@@ -97,11 +102,14 @@ def run_experiment(
     ----------
     name : str
         One of :func:`names` (``dps-synthetic``, ``dps-occlusion``, ``kams-accuracy``,
-        ``kams-robustness``, ``shm-depth``).
+        ``kams-robustness``, ``shm-depth``, ``dps-dancers``).
     out_dir : str or Path
         Output folder: ``results.json``, ``table.md``, ``*.png`` and ``runs/``.
     runs : int, optional
-        Runs R per method (and swept value); default the experiment's (the paper's).
+        Tracker runs R per scene; default the experiment's.
+    scenes : int, optional
+        Scenes S per preset; default the experiment's. Fewer than the defaults marks the
+        results "indicative".
     jobs : int, optional
         Local worker processes; default all cores. Ignored with ``scheduler``.
     scheduler : str, optional
@@ -127,14 +135,15 @@ def run_experiment(
     Raises
     ------
     ConfigError
-        Unknown experiment or method (listing the valid ones), bad runs/jobs/seed, or an
+        Unknown experiment or method (listing the valid ones), bad runs/scenes/jobs/seed, or an
         unreachable scheduler.
     """
     exp = get(name)
     if jobs is not None and jobs < 1:
         raise ConfigError(f"jobs must be >= 1, got {jobs}")
     r = exp.runs if runs is None else int(runs)
-    tasks = plan_tasks(exp, runs=r, seed=int(seed), quick=quick, methods=methods,
+    s = exp.scenes if scenes is None else int(scenes)
+    tasks = plan_tasks(exp, runs=r, scenes=s, seed=int(seed), quick=quick, methods=methods,
                        values=values)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -145,6 +154,8 @@ def run_experiment(
         "experiment": exp.name,
         "title": exp.title,
         "runs": r,
+        "scenes": s,
+        "indicative": bool(quick or r * s < exp.runs * exp.scenes),
         "seed": int(seed),
         "quick": bool(quick),
         "presets": list(exp.presets),
@@ -158,7 +169,7 @@ def run_experiment(
     }
     results = _round(json.loads(json.dumps(results)))
     write_json_atomic(out / "results.json", results, indent=1)
-    _write_text(out / "table.md", render_table(exp, results))
+    _write_text(out / "table.md", render_table(exp, results, WHY.get(exp.name, "")))
     if figures:
         from scenegen.lab.experiments.figures import write_figures
 

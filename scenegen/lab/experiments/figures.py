@@ -25,19 +25,44 @@ def _save(fig: Figure, path: Path) -> str:
     return path.name
 
 
-def _bars(ax: Any, groups: list[str], series: dict[str, list[float | None]], ylabel: str) -> None:
+def _v(x: Any) -> tuple[float, float, float]:
+    """(value, lo, hi) of a number or a rate/mean dict with ``ci``; NaN where missing."""
+    if x is None:
+        return (np.nan, np.nan, np.nan)
+    if isinstance(x, dict):
+        v = x.get("pct", x.get("mean"))
+        lo, hi = x.get("ci", (None, None))
+        f = [np.nan if a is None else float(a) for a in (v, lo, hi)]
+        return (f[0], f[1], f[2])
+    return (float(x), np.nan, np.nan)
+
+
+def _bars(ax: Any, groups: list[str], series: dict[str, list[Any]], ylabel: str,
+          paper: dict[str, list[float | None]] | None = None) -> None:
+    """Grouped bars with 95% intervals; the paper's values as black diamonds."""
     n = max(len(series), 1)
     width = 0.8 / n
     x = np.arange(len(groups))
+    marked = False
     for i, (label, vals) in enumerate(series.items()):
-        v = np.array([np.nan if a is None else a for a in vals], dtype=float)
-        ax.bar(x + (i - (n - 1) / 2) * width, v, width, label=label)
+        v = np.array([_v(a) for a in vals], dtype=float).reshape(-1, 3)
+        pos = x + (i - (n - 1) / 2) * width
+        err = np.vstack([v[:, 0] - v[:, 1], v[:, 2] - v[:, 0]])
+        ax.bar(pos, v[:, 0], width, label=label,
+               yerr=np.where(np.isfinite(err), err, 0.0), capsize=2, ecolor="0.3")
+        pv = (paper or {}).get(label)
+        if pv is not None:
+            pp = np.array([np.nan if a is None else a for a in pv], dtype=float)
+            ax.plot(pos, pp, "kD", ms=5, label=None if marked else "paper")
+            marked = True
     ax.set_xticks(x, groups)
     ax.set_ylabel(ylabel)
     ax.grid(axis="y", alpha=0.3)
 
 
 def _dps_synthetic(res: dict[str, Any], out: Path) -> list[str]:
+    from scenegen.lab.experiments.definitions import PAPER
+
     by = res["summary"]["by_value"]
     files = []
     v0 = next(iter(by))
@@ -64,15 +89,18 @@ def _dps_synthetic(res: dict[str, Any], out: Path) -> list[str]:
         axes[0].legend(fontsize=8, ncol=4, loc="upper center")
         fig.tight_layout()
         files.append(_save(fig, out / "fig4_uniqueness_effective_dynamics.png"))
-    fig = Figure(figsize=(10, 4))
+    fig = Figure(figsize=(11, 4.5))
     ax1, ax2 = fig.subplots(1, 2)
     lams = list(by)
-    labels = {"nonps": "Non-PS", "ps_mean": "PS mean", "ps_worst": "PS worst", "dps": "DPS"}
-    rec: dict[str, list[float | None]] = {lab: [] for lab in labels.values()}
-    succ: dict[str, list[float | None]] = {"Non-PS": [], "PS mean": [], "DPS": []}
+    t1, t2 = PAPER["dps-synthetic"]["table1"], PAPER["dps-synthetic"]["table2"]
+    rec: dict[str, list[Any]] = {k: [] for k in ("Non-PS", "PS mean", "PS worst", "DPS")}
+    succ: dict[str, list[Any]] = {"Non-PS": [], "PS mean": [], "DPS": []}
+    prec = {k: [] for k in rec}
+    psucc = {k: [] for k in succ}
     for v in lams:
         row = by[v]
         m = row["methods"]
+        p2, p1 = t2.get(float(v)), t1.get(float(v))
         rec["Non-PS"].append(m["nonps"]["hard"]["recovery"] if "nonps" in m else None)
         rec["PS mean"].append(row["ps_mean"]["hard"]["recovery"] if "ps_mean" in row else None)
         rec["PS worst"].append(row["ps_worst"]["recovery"] if "ps_worst" in row else None)
@@ -80,42 +108,57 @@ def _dps_synthetic(res: dict[str, Any], out: Path) -> list[str]:
         succ["Non-PS"].append(m["nonps"]["others"]["success"] if "nonps" in m else None)
         succ["PS mean"].append(row["ps_mean"]["others"]["success"] if "ps_mean" in row else None)
         succ["DPS"].append(m["dps"]["others"]["success"] if "dps" in m else None)
+        for i, k in enumerate(prec):
+            prec[k].append(p2["recovery"][i] if p2 else None)
+        for i, k in enumerate(psucc):
+            psucc[k].append(p1["success"][i] if p1 else None)
     groups = [f"λ={v}" for v in lams]
-    _bars(ax1, groups, rec, "recovery rate %")
+    _bars(ax1, groups, rec, "recovery rate %", prec)
     ax1.set_title("object 1 (distracted): recovery")
-    _bars(ax2, groups, succ, "success rate %")
+    _bars(ax2, groups, succ, "success rate %", psucc)
     ax2.set_title("objects 2–7: success")
     for ax in (ax1, ax2):
         ax.set_ylim(0, 122)
-        ax.legend(fontsize=8, ncol=4, loc="upper center")
+        ax.legend(fontsize=8, ncol=5, loc="upper center")
     fig.tight_layout()
     files.append(_save(fig, out / "success_recovery.png"))
     return files
 
 
-def _dps_occlusion(res: dict[str, Any], out: Path) -> list[str]:
-    rows = res["summary"]["methods"]
-    labels = list(rows)
-    fig = Figure(figsize=(9, 4))
-    ax = fig.subplots()
-    _bars(ax, labels, {
-        "success": [rows[m]["hard"]["success"] for m in labels],
-        "recovery": [rows[m]["hard"]["recovery"] for m in labels],
-    }, "% of runs")
-    ax.set_title(f"occluded object ({res['summary']['hard_target']}): success and recovery")
-    ax.set_ylim(0, 115)
-    ax.legend(fontsize=8, ncol=2, loc="upper center")
+def _dps_real(res: dict[str, Any], out: Path) -> list[str]:
+    from scenegen.lab.experiments.definitions import PAPER
+
+    presets = res["summary"]["presets"]
+    paper_all = PAPER[res["experiment"]]
+    fig = Figure(figsize=(11, 4 * len(presets)))
+    axes = fig.subplots(len(presets), 1, squeeze=False)[:, 0]
+    for ax, (preset, rows) in zip(axes, presets.items(), strict=True):
+        labels = list(rows)
+        paper = paper_all.get(preset, {})
+        _bars(ax, labels, {
+            "success": [rows[m]["hard"]["success"] for m in labels],
+            "recovery": [rows[m]["hard"]["recovery"] for m in labels],
+        }, "% of runs", {
+            "success": [paper[m][0] if m in paper else None for m in labels],
+            "recovery": [paper[m][1] if m in paper else None for m in labels],
+        })
+        ax.set_title(f"{preset}: occluded object ({res['summary']['hard_target']}) — success "
+                     "and recovery, 95% intervals; ◆ paper")
+        ax.set_ylim(0, 118)
+        ax.legend(fontsize=8, ncol=3, loc="upper center")
     fig.tight_layout()
     files = [_save(fig, out / "success_recovery.png")]
-    if labels and "uniqueness" in rows[labels[0]]:
-        fig = Figure(figsize=(9, 4))
+    first = next(iter(presets.values()), {})
+    labels = list(first)
+    if labels and "uniqueness" in first[labels[0]]:
+        fig = Figure(figsize=(10, 4))
         ax = fig.subplots()
-        k = len(rows[labels[0]]["uniqueness"])
+        k = len(first[labels[0]]["uniqueness"])
         _bars(ax, [str(i + 1) for i in range(k)],
-              {m: rows[m]["uniqueness"] for m in labels if "uniqueness" in rows[m]},
+              {m: first[m]["uniqueness"] for m in labels if "uniqueness" in first[m]},
               "uniqueness %")
         ax.set_xlabel("object")
-        ax.set_title("uniqueness per object (DPS Fig. 8)")
+        ax.set_title(f"{next(iter(presets))}: uniqueness per object (DPS Fig. 8)")
         ax.set_ylim(0, 122)
         ax.legend(fontsize=8, ncol=len(labels), loc="upper center")
         fig.tight_layout()
@@ -124,26 +167,32 @@ def _dps_occlusion(res: dict[str, Any], out: Path) -> list[str]:
 
 
 def _kams_accuracy(res: dict[str, Any], out: Path) -> list[str]:
+    from scenegen.lab.experiments.definitions import PAPER
+
     methods = res["summary"]["methods"]
     presets = sorted({p for v in methods.values() for p in v})
     if not presets:
         return []
-    fig = Figure(figsize=(11, 7))
+    fig = Figure(figsize=(12, 8))
     axes = fig.subplots(2, 2, squeeze=False).ravel()
     for ax, preset in zip(axes, presets, strict=False):
         threshold = None
         for label, per in methods.items():
             if preset in per:
                 e = np.array([np.nan if x is None else x for x in per[preset]["error_per_frame"]])
-                ax.plot(np.arange(e.size), e, label=label, lw=1.2)
+                line = ax.plot(np.arange(1, e.size + 1), e, label=label, lw=1.2)
                 threshold = per[preset]["failure_threshold"]
+                pv = PAPER["kams-accuracy"].get(label)
+                if pv is not None and pv[presets.index(preset)] is not None:
+                    ax.axhline(pv[presets.index(preset)], color=line[0].get_color(), ls="--",
+                               lw=0.8, label=f"{label} paper mean")
         if threshold is not None:
             ax.axhline(threshold, color="k", ls=":", lw=1, label="failure threshold")
         ax.set_title(preset)
         ax.set_xlabel("frame")
-        ax.set_ylabel("centre error px (mean over runs)")
+        ax.set_ylabel(f"error px vs {res['summary']['error_against']} (mean of runs)")
         ax.grid(alpha=0.3)
-    axes[0].legend(fontsize=8)
+    axes[0].legend(fontsize=7)
     fig.tight_layout()
     return [_save(fig, out / "centre_error.png")]
 
@@ -157,10 +206,8 @@ def _kams_robustness(res: dict[str, Any], out: Path) -> list[str]:
     labels = list(pairs)
     fig = Figure(figsize=(8, 4))
     ax = fig.subplots()
-    _bars(ax, labels, {
-        "ours": [pairs[m]["z"] for m in labels],
-        "paper": [PAPER["kams-robustness"].get(m) for m in labels],
-    }, "McNemar z (KAMS vs …)")
+    _bars(ax, labels, {"ours": [pairs[m]["z"] for m in labels]}, "McNemar z (KAMS vs …)",
+          {"ours": [PAPER["kams-robustness"].get(m) for m in labels]})
     ax.axhline(2.576, color="k", ls=":", lw=1, label="99.5%")
     ax.legend(fontsize=8)
     ax.set_title("robustness of KAMS against each tracker")
@@ -176,7 +223,8 @@ def _shm_depth(res: dict[str, Any], out: Path, records: list[dict[str, Any]]) ->
     fig = Figure(figsize=(10, 2.8 * len(slugs)))
     axes = fig.subplots(len(slugs), 1, squeeze=False)[:, 0]
     for ax, slug in zip(axes, slugs, strict=True):
-        rec = min((r for r in shm if r["key"]["method"] == slug), key=lambda r: r["key"]["run"])
+        rec = min((r for r in shm if r["key"]["method"] == slug),
+                  key=lambda r: (r["key"]["preset"] != "shm-clutter", r["key"]["scene"]))
         p = np.array([[np.nan if x is None else x for x in row] for row in rec["order_prob"]])
         t = np.arange(p.shape[0])
         for j in range(p.shape[1]):
@@ -190,7 +238,8 @@ def _shm_depth(res: dict[str, Any], out: Path, records: list[dict[str, Any]]) ->
                 label="true order 1 (top) / other (bottom)")
         ax.set_ylim(-0.05, 1.05)
         ax.set_ylabel("probability")
-        ax.set_title(f"{slug}: ordering probability over time (run {rec['key']['run']})")
+        ax.set_title(f"{slug} on {rec['key']['preset']}: ordering probability over time "
+                     f"(scene {rec['key']['scene']})")
         ax.legend(fontsize=7, loc="upper right")
     axes[-1].set_xlabel("frame")
     fig.tight_layout()
@@ -202,8 +251,8 @@ def write_figures(name: str, results: dict[str, Any], records: list[dict[str, An
     """Write the PNG figures of experiment ``name`` into ``out``; return their file names."""
     if name == "dps-synthetic":
         return _dps_synthetic(results, out)
-    if name == "dps-occlusion":
-        return _dps_occlusion(results, out)
+    if name in ("dps-occlusion", "dps-dancers"):
+        return _dps_real(results, out)
     if name == "kams-accuracy":
         return _kams_accuracy(results, out)
     if name == "kams-robustness":

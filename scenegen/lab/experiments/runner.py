@@ -1,8 +1,10 @@
 """Running an experiment's seeded runs on local processes or a Dask cluster, resumably.
 
-Every run is a :class:`Task`: (experiment, method, preset, swept value, run index) plus the
-base seed and the quick flag. Its seeds come from a SHA-256 hash of that key (never
-Python's ``hash``), so a run gives the same numbers whichever process or machine runs it.
+Every run is a :class:`Task`: (experiment, method, preset, swept value, scene index s, run
+index r) plus the base seed and the quick flag. An experiment runs S scenes (each its own
+scene seed, shared by every method, so that runs are paired) times R tracker runs per
+scene. The seeds come from a SHA-256 hash of that key (never Python's ``hash``), so a
+run gives the same numbers whichever process or machine runs it.
 The worker generates the run's sequence itself (cached per process), runs the tracker and
 returns a small record of per-frame measures with floats rounded to fixed decimals. The
 parent stores each record as it arrives (one JSON file per run under ``DIR/runs/``,
@@ -64,6 +66,11 @@ def derive_seed(*parts: Any) -> int:
     return int(np.random.SeedSequence(words).generate_state(1, dtype=np.uint64)[0] >> 1)
 
 
+def scene_seed(seed: int, experiment: str, preset: str, scene: int) -> int:
+    """Seed of scene ``scene`` of ``preset`` in ``experiment`` under base seed ``seed``."""
+    return derive_seed(seed, experiment, "scene", preset, scene)
+
+
 @dataclass(frozen=True)
 class Task:
     """One seeded run of one method on one sequence.
@@ -76,8 +83,10 @@ class Task:
         The swept parameter ("" without a sweep).
     value : float or None
         Its value.
+    scene : int
+        Scene index s = 0..S-1 (the scene seed derives from it).
     run : int
-        Run index r = 0..R-1.
+        Tracker run index r = 0..R-1 on that scene.
     seed : int
         The experiment's base seed (``--seed``).
     quick : bool
@@ -89,6 +98,7 @@ class Task:
     preset: str
     param: str
     value: float | None
+    scene: int
     run: int
     seed: int
     quick: bool
@@ -97,20 +107,25 @@ class Task:
     def sweep_label(self) -> str:
         return f"{self.param}={self.value:g}" if self.param else ""
 
-    def scene_seed(self, exp: Experiment) -> int:
-        """Seed of the run's sequence: shared by every method (runs are paired)."""
-        which = self.run if exp.scene_per_run else "all"
-        return derive_seed(self.seed, self.experiment, "scene", self.preset, which)
+    @property
+    def case(self) -> tuple[str, int, int]:
+        """(preset, scene, run): the key that pairs runs of different methods."""
+        return (self.preset, self.scene, self.run)
+
+    def scene_seed(self) -> int:
+        """Seed of the run's sequence: shared by every method and run on scene s."""
+        return scene_seed(self.seed, self.experiment, self.preset, self.scene)
 
     def tracker_seed(self) -> int:
         """Seed of the tracker's random stream for this run."""
         return derive_seed(
-            self.seed, self.experiment, self.method, self.preset, self.sweep_label, self.run
+            self.seed, self.experiment, self.method, self.preset, self.sweep_label,
+            self.scene, self.run,
         )
 
     def filename(self) -> str:
         sweep = f"__{self.param}{self.value:g}" if self.param else ""
-        return f"{self.method}__{self.preset}{sweep}__r{self.run:03d}.json"
+        return f"{self.method}__{self.preset}{sweep}__s{self.scene:03d}__r{self.run:03d}.json"
 
     def key(self) -> dict[str, Any]:
         return asdict(self)
@@ -120,6 +135,7 @@ def plan_tasks(
     exp: Experiment,
     *,
     runs: int,
+    scenes: int | None = None,
     seed: int,
     quick: bool,
     methods: Iterable[str] | None = None,
@@ -127,17 +143,21 @@ def plan_tasks(
 ) -> list[Task]:
     """Every task of an experiment, in a fixed order.
 
-    ``methods`` (slugs or labels) and ``values`` (of the swept parameter) restrict the
-    sweep; by default every method runs at every value.
+    Every method runs on every preset, ``scenes`` scenes (default the experiment's S) and
+    ``runs`` tracker runs per scene. ``methods`` (slugs or labels) and ``values`` (of the
+    swept parameter) restrict the sweep; by default every method runs at every value.
 
     Raises
     ------
     ConfigError
-        For runs < 1, a negative seed, an unknown method or a value outside the sweep
+        For runs or scenes < 1, a negative seed, an unknown method or a value outside the sweep
         (listing the valid ones).
     """
     if runs < 1:
         raise ConfigError(f"runs must be >= 1, got {runs}")
+    n_scenes = exp.scenes if scenes is None else int(scenes)
+    if n_scenes < 1:
+        raise ConfigError(f"scenes must be >= 1, got {n_scenes}")
     if seed < 0:
         raise ConfigError(f"seed must be a non-negative integer, got {seed}")
     chosen = [exp.method(m) for m in methods] if methods else list(exp.methods)
@@ -155,13 +175,11 @@ def plan_tasks(
     tasks = []
     for m in chosen:
         for param, value in sweep:
-            for r in range(runs):
-                presets = [exp.presets[r % len(exp.presets)]] if exp.scene_per_run else list(
-                    exp.presets
-                )
-                for preset in presets:
-                    v = None if value is None else float(value)
-                    tasks.append(Task(exp.name, m.slug, preset, param, v, r, seed, quick))
+            v = None if value is None else float(value)
+            for preset in exp.presets:
+                for s in range(n_scenes):
+                    for r in range(runs):
+                        tasks.append(Task(exp.name, m.slug, preset, param, v, s, r, seed, quick))
     return tasks
 
 
@@ -200,6 +218,17 @@ def tracker_params(exp: Experiment, task: Task) -> dict[str, Any]:
     return params
 
 
+@functools.lru_cache(maxsize=64)
+def scene_digest(preset: str) -> str:
+    """SHA-256 (16 hex digits) of the preset's resolved config: a changed preset makes
+    stored runs on it stale."""
+    from scenegen import presets
+    from scenegen.config import to_dict
+
+    text = json.dumps(to_dict(presets.get(preset)), sort_keys=True, default=str)
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()[:16]
+
+
 def run_task(task: Task) -> dict[str, Any]:
     """Run one task and return its record (JSON-ready, floats rounded).
 
@@ -215,7 +244,7 @@ def run_task(task: Task) -> dict[str, Any]:
 
     exp = get(task.experiment)
     frames = exp.quick_frames if task.quick else None
-    seq = _sequence(task.preset, task.scene_seed(exp), frames)
+    seq = _sequence(task.preset, task.scene_seed(), frames)
     params = tracker_params(exp, task)
     method = exp.method(task.method)
     done = run(seq, method.tracker, params, task.tracker_seed(), single_thread=True)
@@ -224,6 +253,12 @@ def run_task(task: Task) -> dict[str, Any]:
     fm = frame_measures(np.asarray(done.result.boxes, dtype=np.float64), gt)
     present = np.all(np.isfinite(gt), axis=-1)
     names = np.asarray(seq.entities.name)[idx]
+    path = getattr(seq.gt, "path_center", None)
+    path_err = None
+    if path is not None:
+        # KAMS §3.1: accuracy against the noise-free path, not the drawn (jittered) position.
+        est_c = metrics.centres(np.asarray(done.result.boxes, dtype=np.float64))
+        path_err = np.linalg.norm(est_c - np.asarray(path, dtype=np.float64)[:, idx], axis=-1)
     targets = []
     for m in range(len(idx)):
         state: list[int | None] = [
@@ -239,11 +274,14 @@ def run_task(task: Task) -> dict[str, Any]:
                 "centre_error": fm["centre_error"][:, m],
             }
         )
+        if path_err is not None:
+            targets[-1]["path_error"] = path_err[:, m]
     record: dict[str, Any] = {
         "key": task.key(),
         "tracker": method.tracker,
         "params": params,
-        "scene_seed": task.scene_seed(exp),
+        "scene_seed": task.scene_seed(),
+        "scene_digest": scene_digest(task.preset),
         "tracker_seed": task.tracker_seed(),
         "n_frames": int(gt.shape[0]),
         "failure_threshold": failure_threshold(gt),
@@ -263,8 +301,10 @@ def run_task(task: Task) -> dict[str, Any]:
         record["order_prob"] = extras["order_prob"]
         record["orderings"] = np.asarray(orderings).astype(int)
         record["true_order"] = metrics.ordering_index(depth, orderings)
+        # Frame 0 (the initial boxes, no estimate yet) is excluded from every measure.
         record["depth_order_accuracy"] = metrics.depth_order_accuracy(
-            extras["order_prob"], orderings, depth, gt, min_overlap=_MIN_OVERLAP
+            np.asarray(extras["order_prob"])[1:], orderings, depth[1:], gt[1:],
+            min_overlap=_MIN_OVERLAP,
         )
         over = metrics.overlap_fraction(gt[:, :, None, :], gt[:, None, :, :])
         off_diagonal = ~np.eye(len(idx), dtype=bool)
@@ -286,8 +326,9 @@ def write_json_atomic(path: Path, data: Any, *, indent: int | None = None) -> No
 def load_record(path: Path, task: Task) -> dict[str, Any] | None:
     """The stored record of ``task`` at ``path``, or None if missing, unreadable or stale.
 
-    Stale means stored for another key (experiment, method, preset, value, run, seed,
-    quick) or with other tracker parameters.
+    Stale means stored for another key (experiment, method, preset, value, scene, run,
+    seed, quick), with other tracker parameters, or for another version of the preset's
+    config (:func:`scene_digest`).
     """
     try:
         data = json.loads(path.read_text(encoding="utf-8"))
@@ -297,6 +338,8 @@ def load_record(path: Path, task: Task) -> dict[str, Any] | None:
         return None
     # Parameters changed since the run was stored (a new version of the experiment).
     if data.get("params") != _round(tracker_params(get(task.experiment), task)):
+        return None
+    if data.get("scene_digest") != scene_digest(task.preset):
         return None
     return data
 

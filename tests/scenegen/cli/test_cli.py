@@ -25,6 +25,7 @@ def test_presets_json(capsys):
     assert names[:7] == ["dps-synthetic", "dps-occlusion", "kams-a", "kams-b", "kams-c",
                          "kams-d", "shm-crossing"]  # fmt: skip
     assert names[-3:] == ["faces-crossing", "tiger-like", "dps-synthetic-real"]
+    assert set(names[7:-3]) >= {"dps-occlusion-2", "dps-dancers", "shm-clutter"}
 
 
 def test_generate_inspect_validate_preview_export(tmp_path, capsys):

@@ -1,0 +1,262 @@
+"""The statistics the experiments judge the papers' claims with (no scipy needed).
+
+Intervals: :func:`wilson` for rates, :func:`newcombe_diff` for the difference of two rates,
+:func:`bootstrap_mean` and :func:`bootstrap_paired_diff` (percentile bootstrap, seeded) for
+means. Tests (one-sided, in the paper's direction): :func:`two_proportion_z` (independent
+samples), :func:`mcnemar_exact` (paired cases), :func:`chi2_homogeneity` (k rates equal?),
+:func:`binomial_greater` (one rate above a level). :func:`verdict` turns a p-value and an
+interval for the effect into "reproduced", "not reproduced" or "inconclusive":
+
+- **reproduced**: p < ``alpha`` in the paper's direction;
+- **not reproduced**: not significant, and our interval for the effect excludes the effect
+  of interest ``delta`` (the paper's own effect where it prints one): an effect that large
+  is ruled out by our runs — or the effect is significant the other way;
+- **inconclusive**: neither, or fewer than :data:`MIN_RUNS` runs (cases) per compared
+  arm: the runs are too few to tell.
+
+Every function takes counts or arrays and returns plain floats, so results stay JSON-ready.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+__all__ = [
+    "ALPHA",
+    "LEVEL",
+    "MIN_RUNS",
+    "Test",
+    "binomial_greater",
+    "bootstrap_mean",
+    "bootstrap_paired_diff",
+    "chi2_homogeneity",
+    "chi2_sf",
+    "mcnemar_exact",
+    "newcombe_diff",
+    "norm_ppf",
+    "norm_sf",
+    "two_proportion_z",
+    "verdict",
+    "wilson",
+]
+
+ALPHA = 0.05
+"""Significance level of every claim (one-sided, no correction for the number of claims)."""
+LEVEL = 0.95
+"""Coverage of every interval."""
+N_BOOT = 2000
+"""Bootstrap resamples."""
+MIN_RUNS = 10
+"""Fewest runs (or paired cases) per compared arm for a "not reproduced" verdict."""
+
+
+@dataclass(frozen=True)
+class Test:
+    """A test's outcome.
+
+    Attributes
+    ----------
+    name : str
+        The test (e.g. ``"paired McNemar (exact, one-sided)"``).
+    statistic : float
+        Its statistic (z, χ², or the discordant count), NaN where none.
+    p_value : float
+        One-sided p-value in the paper's direction (χ²: upper tail).
+    """
+
+    name: str
+    statistic: float
+    p_value: float
+
+
+def norm_sf(z: float) -> float:
+    """P(Z > z) for a standard normal Z."""
+    return 0.5 * math.erfc(z / math.sqrt(2.0))
+
+
+def norm_ppf(q: float) -> float:
+    """The standard normal quantile: z with P(Z <= z) = q, 0 < q < 1 (bisection, 1e-12)."""
+    if not 0.0 < q < 1.0:
+        raise ValueError(f"q must be in (0, 1), got {q}")
+    lo, hi = -40.0, 40.0
+    while hi - lo > 1e-12:
+        mid = 0.5 * (lo + hi)
+        if 1.0 - norm_sf(mid) < q:
+            lo = mid
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
+def wilson(k: int, n: int, level: float = LEVEL) -> tuple[float, float]:
+    """Wilson score interval of a rate k/n, as fractions in [0, 1]; (nan, nan) for n = 0."""
+    if n <= 0:
+        return (float("nan"), float("nan"))
+    if not 0 <= k <= n:
+        raise ValueError(f"need 0 <= k <= n, got k={k}, n={n}")
+    z = norm_ppf(0.5 + level / 2.0)
+    p = k / n
+    den = 1.0 + z * z / n
+    centre = (p + z * z / (2 * n)) / den
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / den
+    return (max(0.0, centre - half), min(1.0, centre + half))
+
+
+def newcombe_diff(k1: int, n1: int, k2: int, n2: int,
+                  level: float = LEVEL) -> tuple[float, float]:
+    """Newcombe's hybrid score interval of p1 − p2 (from the two Wilson intervals)."""
+    p1, p2 = k1 / n1, k2 / n2
+    l1, u1 = wilson(k1, n1, level)
+    l2, u2 = wilson(k2, n2, level)
+    d = p1 - p2
+    return (d - math.sqrt((p1 - l1) ** 2 + (u2 - p2) ** 2),
+            d + math.sqrt((u1 - p1) ** 2 + (p2 - l2) ** 2))
+
+
+def two_proportion_z(k1: int, n1: int, k2: int, n2: int) -> Test:
+    """Pooled two-proportion z test of p1 > p2 (one-sided)."""
+    p = (k1 + k2) / (n1 + n2)
+    se = math.sqrt(p * (1 - p) * (1 / n1 + 1 / n2))
+    d = k1 / n1 - k2 / n2
+    if se == 0:
+        z = 0.0 if d == 0 else math.copysign(math.inf, d)
+    else:
+        z = d / se
+    return Test("two-proportion z (pooled, one-sided)", z, norm_sf(z))
+
+
+def mcnemar_exact(n_sf: int, n_fs: int) -> Test:
+    """Exact McNemar test that A succeeds more often than B over paired cases.
+
+    ``n_sf``: cases where A succeeds and B fails; ``n_fs``: the reverse. The p-value is
+    P(X >= n_sf) for X ~ Binomial(n_sf + n_fs, 1/2); 1.0 without discordant pairs.
+    """
+    n = n_sf + n_fs
+    p = sum(math.comb(n, i) for i in range(n_sf, n + 1)) / 2.0**n if n else 1.0
+    return Test("paired McNemar (exact binomial, one-sided)", float(n_sf), min(1.0, p))
+
+
+def binomial_greater(k: int, n: int, p0: float) -> Test:
+    """Exact binomial test that a rate exceeds p0: P(X >= k) for X ~ Binomial(n, p0)."""
+    p = sum(math.comb(n, i) * p0**i * (1 - p0) ** (n - i) for i in range(k, n + 1))
+    return Test(f"exact binomial (rate > {p0:g}, one-sided)", float(k), min(1.0, p))
+
+
+def chi2_sf(x: float, df: int) -> float:
+    """P(X > x) for X ~ χ² with integer ``df`` >= 1 (closed forms, no special functions)."""
+    if df < 1:
+        raise ValueError(f"df must be >= 1, got {df}")
+    if x <= 0:
+        return 1.0
+    h = x / 2.0
+    if df % 2 == 0:
+        term, total = 1.0, 1.0
+        for k in range(1, df // 2):
+            term *= h / k
+            total += term
+        return min(1.0, math.exp(-h) * total)
+    total = math.erfc(math.sqrt(h))
+    term = math.sqrt(h) * 2.0 / math.sqrt(math.pi) * math.exp(-h)
+    for k in range(1, (df - 1) // 2 + 1):
+        total += term
+        term *= h / (k + 0.5)
+    return min(1.0, total)
+
+
+def chi2_homogeneity(successes: Sequence[int], totals: Sequence[int]) -> Test:
+    """Pearson χ² test that k rates are equal (k x 2 table, df = k − 1)."""
+    s = np.asarray(successes, dtype=np.float64)
+    n = np.asarray(totals, dtype=np.float64)
+    if s.size < 2:
+        raise ValueError("need at least two rates")
+    p = s.sum() / n.sum()
+    exp_s, exp_f = n * p, n * (1 - p)
+    if p in (0.0, 1.0):
+        return Test("Pearson χ² homogeneity", 0.0, 1.0)
+    chi2 = float(np.sum((s - exp_s) ** 2 / exp_s + ((n - s) - exp_f) ** 2 / exp_f))
+    return Test(f"Pearson χ² homogeneity (df {s.size - 1})", chi2, chi2_sf(chi2, s.size - 1))
+
+
+def _rng(seed: int | np.random.Generator) -> np.random.Generator:
+    return seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
+
+
+def bootstrap_mean(values: ArrayLike, rng: int | np.random.Generator, *,
+                   n_boot: int = N_BOOT, level: float = LEVEL) -> tuple[float, float]:
+    """Percentile bootstrap interval of the mean of ``values`` (shape (n,), NaN dropped).
+
+    Seeded through ``rng``: the same seed gives the same interval. (nan, nan) if empty.
+    """
+    v = np.asarray(values, dtype=np.float64)
+    v = v[np.isfinite(v)]
+    if v.size == 0:
+        return (float("nan"), float("nan"))
+    idx = _rng(rng).integers(0, v.size, size=(n_boot, v.size))
+    means = v[idx].mean(axis=1)
+    a = (1.0 - level) / 2.0
+    return (float(np.quantile(means, a)), float(np.quantile(means, 1.0 - a)))
+
+
+def bootstrap_paired_diff(a: ArrayLike, b: ArrayLike, rng: int | np.random.Generator, *,
+                          n_boot: int = N_BOOT, level: float = LEVEL
+                          ) -> tuple[float, tuple[float, float], Test]:
+    """Mean of a − b over paired cases, its percentile bootstrap interval and a test.
+
+    The test's p-value is the share of resampled means <= 0 (one-sided: mean(a − b) > 0),
+    at least 1 / n_boot. Pairs with a NaN are dropped.
+
+    Returns
+    -------
+    mean : float
+    interval : (float, float)
+    test : Test
+    """
+    d = np.asarray(a, dtype=np.float64) - np.asarray(b, dtype=np.float64)
+    d = d[np.isfinite(d)]
+    if d.size == 0:
+        nan = float("nan")
+        return nan, (nan, nan), Test("paired bootstrap of the mean difference", nan, 1.0)
+    idx = _rng(rng).integers(0, d.size, size=(n_boot, d.size))
+    means = d[idx].mean(axis=1)
+    al = (1.0 - level) / 2.0
+    p = max(float(np.mean(means <= 0.0)), 1.0 / n_boot)
+    return (float(d.mean()),
+            (float(np.quantile(means, al)), float(np.quantile(means, 1.0 - al))),
+            Test("paired bootstrap of the mean difference (one-sided)", float(d.mean()), p))
+
+
+def verdict(p_value: float, interval: tuple[float, float], delta: float, n: int,
+            alpha: float = ALPHA) -> str:
+    """Judge a claim "effect > 0" from its one-sided p-value and an interval for the effect.
+
+    Parameters
+    ----------
+    p_value : float
+        One-sided p-value in the claim's direction.
+    interval : (float, float)
+        Interval for the effect (positive = the paper's direction).
+    delta : float
+        Effect of interest (> 0): the paper's effect, or a stated smallest effect that
+        matters where the paper prints none.
+    n : int
+        Runs (or paired cases) of the smaller compared arm.
+    alpha : float
+
+    Returns
+    -------
+    str
+        ``"reproduced"`` (p < alpha), ``"not reproduced"`` (n >= :data:`MIN_RUNS` and the
+        interval lies below delta, i.e. an effect that large is ruled out, or wholly below
+        0), else ``"inconclusive"`` (too few runs to tell).
+    """
+    lo, hi = interval
+    if p_value < alpha:
+        return "reproduced"
+    if n >= MIN_RUNS and math.isfinite(hi) and (hi < delta or hi < 0):
+        return "not reproduced"
+    return "inconclusive"
