@@ -110,16 +110,24 @@ def cmd_generate(args: argparse.Namespace) -> int:
     return 0
 
 
-def _inspect(path: Path) -> dict[str, Any]:
+_DAMAGE = (KeyError, OSError, RuntimeError, TypeError, ValueError)
+
+
+def _inspect(path: str) -> dict[str, Any]:
+    """Summary of a file; runs in a guarded child (``cmd_inspect``)."""
     from scenegen.io import open_checked
 
-    out: dict[str, Any] = {"file": str(path)}
+    out: dict[str, Any] = {"file": path}
     with open_checked(path) as f:
-        out["schema"] = str(f.attrs["schema"])
-        out["generator_version"] = str(f.attrs.get("generator_version", ""))
+        try:
+            out["schema"] = str(f.attrs["schema"])
+            out["generator_version"] = str(f.attrs.get("generator_version", ""))
+        except _DAMAGE as err:
+            raise DataError(f"{path}: damaged file attributes: {_first_line(err)}") from None
         out["sequences"] = []
-        for name, g in f.get("sequences", {}).items():
+        for name in _keys(path, f, "sequences"):
             try:
+                g = f[f"sequences/{name}"]
                 roles = [
                     r.decode() if isinstance(r, bytes) else str(r) for r in g["entities/role"][()]
                 ]
@@ -137,19 +145,39 @@ def _inspect(path: Path) -> dict[str, Any]:
                         "chunks": list(frames.chunks or ()),
                     }
                 )
-            except (KeyError, OSError) as err:
-                raise DataError(f"{path}: sequence {name!r} is damaged: {err}") from None
+            except _DAMAGE as err:
+                raise DataError(
+                    f"{path}: sequence {name!r} is damaged: {_first_line(err)}"
+                ) from None
         out["results"] = []
-        for name, g in f.get("results", {}).items():
-            out["results"].append(
-                {"tracker": name, "sequence": str(g.attrs.get("sequence", "")),
-                 "shape": list(g["boxes"].shape) if "boxes" in g else None}
-            )  # fmt: skip
+        for name in _keys(path, f, "results"):
+            try:
+                g = f[f"results/{name}"]
+                out["results"].append(
+                    {"tracker": name, "sequence": str(g.attrs.get("sequence", "")),
+                     "shape": list(g["boxes"].shape) if "boxes" in g else None}
+                )  # fmt: skip
+            except _DAMAGE as err:
+                raise DataError(f"{path}: result {name!r} is damaged: {_first_line(err)}") from None
     return out
 
 
+def _keys(path: str, f: Any, group: str) -> list[str]:
+    try:
+        return list(f[group].keys()) if group in f else []
+    except _DAMAGE as err:
+        raise DataError(f"{path}: /{group} is damaged: {_first_line(err)}") from None
+
+
+def _first_line(err: BaseException) -> str:
+    text = str(err).strip().splitlines()
+    return text[0][:200] if text else type(err).__name__
+
+
 def cmd_inspect(args: argparse.Namespace) -> int:
-    info = _inspect(args.file)
+    from scenegen.io import guard
+
+    info = guard.call(_inspect, str(args.file), label=str(args.file))
     if args.json:
         print(json.dumps(info, indent=2))
         return 0

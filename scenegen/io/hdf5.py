@@ -45,6 +45,7 @@ from numpy.typing import NDArray
 
 from scenegen.config import from_dict, to_dict
 from scenegen.errors import ConfigError, DataError
+from scenegen.io import guard
 from scenegen.io.atomic import (
     atomic_path,
     clean_temp_files,
@@ -437,6 +438,8 @@ class LazyArray:
         if self._file is None or not self._file.id.valid:
             if not os.path.exists(self.path):
                 raise DataError(f"{self.path}: no longer exists")
+            if self._stamp is None:  # not opened through read(): a file not yet checked
+                guard.preflight(self.path)
             try:
                 f = h5py.File(self.path, "r")
             except OSError as err:
@@ -508,7 +511,9 @@ def open_checked(path: str | Path) -> h5py.File:
     ------
     DataError
         If the file is missing, a folder, a temporary file of an unfinished write, not
-        HDF5, truncated, being written by another process, or of another schema.
+        HDF5, truncated, being written by another process, or of another schema; or if
+        its metadata is damaged or cannot be read within the deadline
+        (:func:`scenegen.io.guard.preflight`).
     """
     p = Path(path)
     if not p.exists():
@@ -518,6 +523,7 @@ def open_checked(path: str | Path) -> h5py.File:
     temp = describe_temp_file(p)
     if temp is not None:  # incomplete by construction, even when HDF5 could open it
         raise DataError(temp)
+    guard.preflight(p)  # metadata read in a child under a deadline, once per version
     try:
         f = h5py.File(p, "r")
     except OSError as err:

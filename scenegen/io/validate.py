@@ -18,11 +18,7 @@ file's length; ground truth (T x K) is read whole. Nothing here raises on a dama
 
 from __future__ import annotations
 
-import faulthandler
 import json
-import multiprocessing
-import signal
-from multiprocessing.connection import Connection
 from pathlib import Path
 from typing import Any
 
@@ -32,8 +28,9 @@ from numpy.typing import NDArray
 from scipy import ndimage
 
 from scenegen.config import from_dict
-from scenegen.errors import ConfigError
+from scenegen.errors import ConfigError, DataError
 from scenegen.io import SCHEMA, describe_open_error, describe_read_error, describe_temp_file
+from scenegen.io.guard import beat, call
 from scenegen.sequence import GT_FIELDS
 
 __all__ = ["check_file"]
@@ -55,9 +52,11 @@ def check_file(path: str | Path, *, check_pixels: bool = True, isolate: bool = F
         Also read every frame (checksums) and re-derive visible boxes and visibility
         from ``labels`` frame by frame.
     isolate : bool
-        Run the check in a child process. The HDF5 library can crash (segmentation
-        fault) on some corrupted metadata; isolated, such a crash becomes one problem
-        line instead of killing the caller. ``scenegen validate`` always isolates.
+        Run the check in a guarded child process (:func:`scenegen.io.guard.call`). The
+        HDF5 library can crash (segmentation fault) or loop forever on some corrupted
+        metadata; isolated, a crash or a stall (no progress within the deadline) becomes
+        one problem line instead of killing or hanging the caller. ``scenegen validate``
+        always isolates.
 
     Returns
     -------
@@ -90,38 +89,18 @@ def check_file(path: str | Path, *, check_pixels: bool = True, isolate: bool = F
         return [f"{p}: damaged HDF5 metadata ({_one_line(err)})"]
 
 
-def _child(path: str, check_pixels: bool, conn: Connection) -> None:
-    faulthandler.disable()  # a crash is reported by the parent, in one line
-    try:
-        problems = check_file(path, check_pixels=check_pixels)
-    except Exception as err:  # whatever else a damaged file provokes: one line, no traceback
-        problems = [f"{path}: could not be checked ({type(err).__name__}: {_one_line(err)})"]
-    conn.send(problems)
-    conn.close()
+def _checked(path: str, check_pixels: bool) -> list[str]:
+    return check_file(path, check_pixels=check_pixels)
 
 
 def _check_in_child(p: Path, check_pixels: bool) -> list[str]:
-    methods = multiprocessing.get_all_start_methods()
-    ctx = multiprocessing.get_context("fork" if "fork" in methods else "spawn")
-    recv, send = ctx.Pipe(duplex=False)
-    proc = ctx.Process(target=_child, args=(str(p), check_pixels, send), daemon=True)
-    proc.start()
-    send.close()
+    """:func:`check_file` in a guarded child (:mod:`scenegen.io.guard`): a crash or a
+    stall of the HDF5 library (no progress within the deadline) is one problem line."""
     try:
-        problems: list[str] | None = recv.recv()
-    except EOFError:
-        problems = None
-    finally:
-        recv.close()
-        proc.join()
-    if problems is not None:
-        return problems
-    code = proc.exitcode or 0
-    try:
-        how = signal.Signals(-code).name if code < 0 else f"exit status {code}"
-    except ValueError:
-        how = f"signal {-code}"
-    return [f"{p}: damaged HDF5 file: the HDF5 library crashed reading it ({how})"]
+        problems: list[str] = call(_checked, str(p), check_pixels, label=str(p))
+    except DataError as err:
+        return [str(err)]
+    return problems
 
 
 def _check_open_file(p: Path, f: h5py.File, check_pixels: bool) -> list[str]:
@@ -339,6 +318,7 @@ def _check_gt(where: str, gt: dict[str, NDArray[Any]]) -> list[str]:
 def _check_frames(where: str, frames: h5py.Dataset) -> list[str]:
     bad, reason = [], ""
     for t in range(frames.shape[0]):
+        beat()
         try:
             frames[t]
         except _READ_ERRORS as err:
@@ -360,6 +340,7 @@ def _check_labels(
     reason = ""
     vbox, vis, present = gt["visible_box"], gt["visibility"], gt["present"]
     for t in range(labels.shape[0]):
+        beat()
         try:
             lab = labels[t]
         except _READ_ERRORS as err:

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import os
 import shutil
-import signal
 
 import h5py
 import numpy as np
@@ -372,26 +371,27 @@ def test_other_verbs_on_a_damaged_chunk_exit_1_with_one_line(copy, tmp_path, cap
 
 def test_a_crash_of_the_hdf5_library_becomes_one_line(copy, monkeypatch):
     """Some corrupted metadata crashes libhdf5 itself (segmentation fault); the isolated
-    check reports that instead of dying. Simulated: the forked child kills itself."""
-
-    def crash(*args, **kwargs):
-        os.kill(os.getpid(), signal.SIGSEGV)
-
-    monkeypatch.setattr(validate, "_check_open_file", crash)
+    check reports that instead of dying. Simulated: the guarded child aborts."""
+    monkeypatch.setattr(validate, "_checked", _abort)
     p = copy()
     assert check_file(p, isolate=True) == [
-        f"{p}: damaged HDF5 file: the HDF5 library crashed reading it (SIGSEGV)"
+        f"{p}: metadata unreadable: the HDF5 library crashed reading it (SIGABRT)"
     ]
 
 
-def test_an_unexpected_error_in_the_isolated_check_is_one_line(copy, monkeypatch, capfd):
-    def fail(*args, **kwargs):
-        raise MemoryError("simulated")
+def _abort(path, check_pixels):
+    os.abort()
 
-    monkeypatch.setattr(validate, "_check_open_file", fail)
+
+def test_an_unexpected_error_in_the_isolated_check_is_one_line(copy, monkeypatch, capfd):
+    monkeypatch.setattr(validate, "_checked", _memory_error)
     p = copy()
-    assert check_file(p, isolate=True) == [f"{p}: could not be checked (MemoryError: simulated)"]
+    assert check_file(p, isolate=True) == [f"{p}: could not be read (MemoryError: simulated)"]
     assert "Traceback" not in capfd.readouterr().err
+
+
+def _memory_error(path, check_pixels):
+    raise MemoryError("simulated")
 
 
 def test_random_byte_damage_never_raises(copy):
