@@ -198,6 +198,26 @@ def _context() -> Any:
     return multiprocessing.get_context("spawn")
 
 
+@contextlib.contextmanager
+def _main_hidden() -> Any:
+    """Start children without re-running the caller's ``__main__``: ``spawn`` and
+    ``forkserver`` children import the main script unless it has neither ``__file__``
+    nor ``__spec__``, and a plain script calling :func:`scenegen.io.read` at top level
+    would then run again in every child (the functions run there live in scenegen)."""
+    main = sys.modules.get("__main__")
+    if main is None:
+        yield
+        return
+    saved = {k: main.__dict__[k] for k in ("__file__", "__spec__") if k in main.__dict__}
+    main.__dict__.pop("__file__", None)
+    main.__dict__["__spec__"] = None
+    try:
+        yield
+    finally:
+        main.__dict__.pop("__spec__", None)
+        main.__dict__.update(saved)
+
+
 def _how(code: int | None) -> str:
     if code is None:
         return "no exit status"
@@ -251,7 +271,8 @@ def call(
     proc = ctx.Process(
         target=_child, args=(send, os.getpid(), limit, fn, args), name="scenegen-guard"
     )
-    proc.start()
+    with _main_hidden():
+        proc.start()
     send.close()
     msg: tuple[Any, ...] | None = None
     try:
