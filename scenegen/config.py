@@ -91,7 +91,7 @@ def _check_color(path: str, c: Color) -> None:
 
 @dataclass(frozen=True)
 class AR2:
-    """Second-order autoregression of one coordinate (ALGORITHMS §1.1).
+    """Second-order autoregression of one coordinate (docs/algorithms.md §1).
 
     ``c_t = mean + a1 (c_{t-1} - mean) + a2 (c_{t-2} - mean) + sigma * eps_t``.
     ``a1 = 2, a2 = -1`` is constant velocity plus acceleration noise; ``a1 = 1 + d,

@@ -61,7 +61,7 @@ def describe(name: str) -> str:
 
 
 def _walk(sigma: float, margin: float = 2.0, damping: float = 0.5) -> AR2:
-    # Damped-velocity AR2 (ALGORITHMS §1.1: A1 = 1 + d, A2 = -d), reflected at the border.
+    # Damped-velocity AR2 (docs/algorithms.md §1: A1 = 1 + d, A2 = -d), reflected at the border.
     return AR2(boundary="reflect", a1=1.0 + damping, a2=-damping, sigma=sigma, margin=margin)
 
 

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Any
 
 import numpy as np
@@ -10,17 +10,17 @@ from numpy.typing import NDArray
 
 from scenegen.config import SceneConfig
 
-__all__ = ["GT_FIELDS", "Entities", "GroundTruth", "Sequence"]
+__all__ = ["Entities", "GroundTruth", "Sequence"]
 
-# HDF5 name -> dtype of every ground-truth array (CONTRACT, schema scenegen/1).
-GT_FIELDS: dict[str, Any] = {
-    "box": np.float32,
-    "visible_box": np.float32,
-    "center": np.float32,
-    "visibility": np.float32,
-    "present": np.bool_,
-    "depth": np.int16,
-}
+
+def __getattr__(name: str) -> Any:
+    # GT_FIELDS (HDF5 name -> dtype of every ground-truth array) is defined by the layout,
+    # scenegen.io.schema; imported lazily because scenegen.io imports this module.
+    if name == "GT_FIELDS":
+        from scenegen.io.schema import GT_FIELDS
+
+        return GT_FIELDS
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 @dataclass
@@ -53,7 +53,8 @@ class Entities:
 
 @dataclass
 class GroundTruth:
-    """Per-frame ground truth (CONTRACT field names).
+    """Per-frame ground truth: the ``gt/*`` datasets of the file layout (``docs/format.md``,
+    :mod:`scenegen.io.schema`). Boxes are [x, y, w, h] with x = column, in pixels.
 
     Attributes
     ----------
@@ -70,6 +71,10 @@ class GroundTruth:
         The entity exists at that frame and part of its amodal extent is inside the frame.
     depth : ndarray of shape (T, K), int16
         Depth rank, 0 = nearest the camera.
+    path_center : ndarray of shape (T, K, 2), float32
+        Centre (x, y) of the noise-free motion path (before the per-frame position noise,
+        not rounded to pixels); NaN where absent. NaN everywhere when read from a file
+        written before this field existed.
     """
 
     box: NDArray[np.float32]
@@ -78,9 +83,11 @@ class GroundTruth:
     visibility: NDArray[np.float32]
     present: NDArray[np.bool_]
     depth: NDArray[np.int16]
+    path_center: NDArray[np.float32]
 
     def as_dict(self) -> dict[str, NDArray[Any]]:
-        return {name: getattr(self, name) for name in GT_FIELDS}
+        """Every array keyed by its name under ``gt/``."""
+        return {f.name: getattr(self, f.name) for f in fields(self)}
 
 
 @dataclass

@@ -65,7 +65,3 @@ def main(argv: Sequence[str] | None = None) -> int:
             file=sys.stderr,
         )
         return 1
-
-
-def entry() -> None:  # pragma: no cover - console script wrapper
-    sys.exit(main())

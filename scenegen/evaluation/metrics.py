@@ -2,7 +2,7 @@
 
 Everything here is pure numpy (plus ``scipy.optimize.linear_sum_assignment`` for the
 matchings of CLEAR MOT and IDF1) and works on boxes ``[x, y, w, h]`` in pixels
-(CONTRACT "Coordinates"). A box with any NaN coordinate means "no box": an absent
+(docs/format.md, "Conventions"). A box with any NaN coordinate means "no box": an absent
 ground-truth entity or a missing estimate.
 
 Frame conventions
@@ -383,7 +383,7 @@ def otb_curves(
 
 
 def failure_frame(error: ArrayLike, threshold: float, *, persist: int = 10) -> int:
-    """Frame at which a run fails (KAMS §3.1, ALGORITHMS §4.6), or -1 if it never does.
+    """Frame at which a run fails (KAMS §3.1, docs/algorithms.md §5), or -1 if it never does.
 
     (open) A run "fails when the error stays above a threshold". Here it fails at the first
     frame t that starts ``persist`` consecutive frames whose error is above ``threshold``

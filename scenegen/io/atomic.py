@@ -15,11 +15,17 @@ Leftover temporary files
     whose writing process (on this host) no longer runs. Every atomic write first cleans
     the stale leftovers of its own target, so rerunning a killed command tidies up after
     it. Files written by other hosts (shared folders) are left alone.
+
+Helpers
+    :func:`write_text`, :func:`write_json` and :func:`write_npy` are the one way the
+    package writes a text, JSON or ``.npy`` file; everything else uses :func:`atomic_path`
+    directly (HDF5, images, videos).
 """
 
 from __future__ import annotations
 
 import contextlib
+import json
 import os
 import re
 import shutil
@@ -27,6 +33,10 @@ import socket
 import tempfile
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
 
 from scenegen.errors import ConfigError
 
@@ -36,6 +46,9 @@ __all__ = [
     "describe_temp_file",
     "temp_file_owner",
     "temp_prefix",
+    "write_json",
+    "write_npy",
+    "write_text",
 ]
 
 _TEMP_NAME = re.compile(r"^\.(?P<target>.+)\.(?P<kind>tmp|old)-(?P<pid>\d+)@(?P<host>[\w.]*)-")
@@ -234,3 +247,96 @@ def describe_temp_file(path: str | Path) -> str | None:
     if host == _host():
         where += ", running" if _running(pid) else ", no longer running"
     return f"{path}: an unfinished temporary file of a write to {target!r} ({where})"
+
+
+# ---------------------------------------------------------------------------------------
+# Helpers
+
+
+def _prepare(path: str | Path, parents: bool) -> Path:
+    target = Path(path)
+    if parents:
+        target.parent.mkdir(parents=True, exist_ok=True)
+    return target
+
+
+def write_text(path: str | Path, text: str, *, parents: bool = False) -> None:
+    """Write ``text`` (UTF-8) to ``path`` atomically (see :func:`atomic_path`).
+
+    Parameters
+    ----------
+    path : str or Path
+    text : str
+        Written as is (no newline added).
+    parents : bool
+        Create missing parent folders first.
+
+    Raises
+    ------
+    ConfigError
+        If the folder does not exist (and ``parents`` is false) or ``path`` is a folder.
+    """
+    target = _prepare(path, parents)
+    with atomic_path(target, target.suffix) as tmp:
+        tmp.write_text(text, encoding="utf-8")
+
+
+def write_json(
+    path: str | Path,
+    data: Any,
+    *,
+    indent: int | None = None,
+    sort_keys: bool = True,
+    allow_nan: bool = False,
+    parents: bool = False,
+) -> None:
+    """Write ``data`` as JSON, ending with a newline, to ``path`` atomically.
+
+    Parameters
+    ----------
+    path : str or Path
+    data : any JSON-serialisable value
+    indent : int, optional
+        None writes one compact line (no spaces after separators).
+    sort_keys : bool
+    allow_nan : bool
+        False refuses NaN and infinities (``ValueError``): they are not JSON.
+    parents : bool
+        Create missing parent folders first.
+
+    Raises
+    ------
+    ValueError
+        For NaN or infinite values when ``allow_nan`` is false.
+    ConfigError
+        As :func:`write_text`.
+    """
+    text = json.dumps(
+        data,
+        sort_keys=sort_keys,
+        allow_nan=allow_nan,
+        indent=indent,
+        separators=(",", ":") if indent is None else (",", ": "),
+    )
+    write_text(path, text + "\n", parents=parents)
+
+
+def write_npy(path: str | Path, array: ArrayLike, *, parents: bool = False) -> None:
+    """Write ``array`` in NumPy's ``.npy`` format to ``path`` atomically.
+
+    Parameters
+    ----------
+    path : str or Path
+        Written as given (no ``.npy`` appended).
+    array : array-like
+    parents : bool
+        Create missing parent folders first.
+
+    Raises
+    ------
+    ConfigError
+        As :func:`write_text`.
+    """
+    target = _prepare(path, parents)
+    with atomic_path(target) as tmp, open(tmp, "wb") as fh:
+        np.save(fh, np.asarray(array))

@@ -1,5 +1,11 @@
-"""HDF5 reading and writing (schema ``scenegen/1``, CONTRACT.md). The only module that
-touches files.
+"""HDF5 reading and writing (schema ``scenegen/1``: the layout is :mod:`scenegen.io.schema`,
+described for readers in ``docs/format.md``). The only module that touches files.
+
+Layout
+    Every dataset is created from its :class:`scenegen.io.schema.Field` (shape, dtype) and
+    carries its ``description`` and ``units`` attributes; the root carries the
+    ``conventions``. Reading does not need these attributes, so older files without them
+    read the same; a file without ``gt/path_center`` reads it as NaN.
 
 Atomic writes
     Every write goes through :func:`scenegen.io.atomic.atomic_path` (a temporary file in
@@ -53,7 +59,8 @@ from scenegen.io.atomic import (
     temp_file_owner,
     temp_prefix,
 )
-from scenegen.sequence import GT_FIELDS, Entities, GroundTruth, Sequence
+from scenegen.io.schema import CONVENTIONS, GT_FIELDS, SCHEMA, Field, dataset_attrs, field
+from scenegen.sequence import Entities, GroundTruth, Sequence
 
 __all__ = [
     "BLOCK_BYTES",
@@ -80,7 +87,6 @@ __all__ = [
     "write_scenario",
 ]
 
-SCHEMA = "scenegen/1"
 COMPRESSIONS = ("gzip", "lzf", "none")
 BLOCK_BYTES = 32 * 2**20
 """Upper bound on the pixel bytes (frames + labels) of one block rendered and written at
@@ -159,6 +165,15 @@ def frames_per_block(height: int, width: int, limit: int = _BLOCK) -> int:
 def _write_header(f: h5py.File) -> None:
     f.attrs["schema"] = SCHEMA
     f.attrs["generator_version"] = _version()
+    f.attrs["conventions"] = "\n".join(CONVENTIONS)
+
+
+def _dataset(g: h5py.Group, f: Field, *, name: str | None = None, **kwargs: Any) -> h5py.Dataset:
+    """Create the dataset of ``f`` in ``g`` (at ``name``, default its path) with its
+    ``description`` and ``units`` attributes; ``kwargs`` go to ``create_dataset``."""
+    ds = g.create_dataset(f.path if name is None else name, **kwargs)
+    ds.attrs.update(dataset_attrs(f))
+    return ds
 
 
 def _create_sequence_group(
@@ -176,30 +191,29 @@ def _create_sequence_group(
     g.attrs["height"] = h
     g.attrs["width"] = w
     filt = filter_options(compression)
-    frames = g.create_dataset("frames", (t, h, w, 3), np.uint8, chunks=(1, h, w, 3), **filt)
-    labels = g.create_dataset("labels", (t, h, w), np.uint16, chunks=(1, h, w), **filt)
-    e = g.create_group("entities")
-    e.create_dataset("id", data=entities.id.astype(np.int32))
-    e.create_dataset("role", data=entities.role.astype(object), dtype=_STR)
-    e.create_dataset("name", data=entities.name.astype(object), dtype=_STR)
-    return g, frames, labels
-
-
-def _gt_shape(key: str, t: int, k: int) -> tuple[int, ...]:
-    return {"box": (t, k, 4), "visible_box": (t, k, 4), "center": (t, k, 2)}.get(key, (t, k))
+    pixels = []
+    for f in (field("frames"), field("labels")):
+        shape = f.shape_for(T=t, H=h, W=w)
+        pixels.append(_dataset(g, f, shape=shape, dtype=f.dtype, chunks=(1, *shape[1:]), **filt))
+    g.create_group("entities")
+    _dataset(g, field("entities/id"), data=entities.id.astype(np.int32))
+    _dataset(g, field("entities/role"), data=entities.role.astype(object), dtype=_STR)
+    _dataset(g, field("entities/name"), data=entities.name.astype(object), dtype=_STR)
+    return g, pixels[0], pixels[1]
 
 
 def _create_gt(g: h5py.Group, t: int, k: int, rows: int) -> dict[str, h5py.Dataset]:
     """Empty ground-truth datasets, chunked by ``rows`` frames, checksummed."""
-    grp = g.create_group("gt")
+    g.create_group("gt")
     out = {}
     for key, dtype in GT_FIELDS.items():
-        shape = _gt_shape(key, t, k)
+        f = field(f"gt/{key}")
+        shape = f.shape_for(T=t, K=k)
         if k == 0:  # nothing to checksum; HDF5 chunks cannot have a zero side
-            out[key] = grp.create_dataset(key, shape, dtype)
+            out[key] = _dataset(g, f, shape=shape, dtype=dtype)
         else:
             chunks = (max(1, min(rows, t)), *shape[1:])
-            out[key] = grp.create_dataset(key, shape, dtype, chunks=chunks, fletcher32=True)
+            out[key] = _dataset(g, f, shape=shape, dtype=dtype, chunks=chunks, fletcher32=True)
     return out
 
 
@@ -211,13 +225,15 @@ def _write_gt(g: h5py.Group, gt: dict[str, NDArray[Any]]) -> None:
 
 
 def _write_templates(g: h5py.Group, templates: dict[int, NDArray[np.uint8]]) -> None:
-    grp = g.create_group("templates")
+    g.create_group("templates")
+    f = field("templates/<id>")
     for eid, tpl in templates.items():
         arr = np.asarray(tpl, dtype=np.uint8)
+        name = f"templates/{int(eid)}"
         if arr.size:
-            grp.create_dataset(str(int(eid)), data=arr, chunks=arr.shape, fletcher32=True)
+            _dataset(g, f, name=name, data=arr, chunks=arr.shape, fletcher32=True)
         else:
-            grp.create_dataset(str(int(eid)), data=arr)
+            _dataset(g, f, name=name, data=arr)
 
 
 def _meta(seq: Sequence) -> dict[str, Any]:
@@ -562,6 +578,21 @@ def _str_array(ds: h5py.Dataset) -> NDArray[np.str_]:
     return np.array([v.decode() if isinstance(v, bytes) else str(v) for v in ds[()]], dtype=str)
 
 
+def _read_gt(g: h5py.Group) -> GroundTruth:
+    """The ground truth of sequence group ``g``; an optional field the file lacks (files
+    written before it existed) is NaN-filled at its shape."""
+    arrays = {}
+    t, k = g["gt/present"].shape
+    for key, dtype in GT_FIELDS.items():
+        if key in g["gt"]:
+            arrays[key] = g[f"gt/{key}"][()].astype(dtype)
+        elif field(f"gt/{key}").optional:
+            arrays[key] = np.full(field(f"gt/{key}").shape_for(T=t, K=k), np.nan, dtype)
+        else:
+            raise KeyError(f"missing dataset gt/{key}")
+    return GroundTruth(**arrays)
+
+
 def read(path: str | Path, name: str | None = None) -> Sequence:
     """Read one sequence; frames and labels stay on disk as :class:`LazyArray`.
 
@@ -611,7 +642,7 @@ def _read_once(p: Path, name: str | None) -> Sequence:
                 role=_str_array(g["entities/role"]),
                 name=_str_array(g["entities/name"]),
             )
-            gt = GroundTruth(**{k: g[f"gt/{k}"][()].astype(dt) for k, dt in GT_FIELDS.items()})
+            gt = _read_gt(g)
             templates = {int(k): v[()] for k, v in g["templates"].items()}
             seed, preset = int(g.attrs["seed"]), str(g.attrs["preset"])
             frames = LazyArray(p, f"sequences/{name}/frames", stamp=stamp)
@@ -694,11 +725,12 @@ def write_result(path: str | Path, *results: TrackerResult) -> None:
             g.attrs["params"] = json.dumps(r.params, sort_keys=True, default=str)
             g.attrs["seed"] = int(r.seed)
             g.attrs["sequence"] = r.sequence
-            g.create_dataset("target_ids", data=np.asarray(r.target_ids, dtype=np.int32))
-            g.create_dataset("boxes", data=np.asarray(r.boxes, dtype=np.float32))
+            arrays = {"target_ids": r.target_ids, "boxes": r.boxes}
             if r.orderings is not None and r.order_prob is not None:
-                g.create_dataset("orderings", data=np.asarray(r.orderings, dtype=np.int16))
-                g.create_dataset("order_prob", data=np.asarray(r.order_prob, dtype=np.float32))
+                arrays |= {"orderings": r.orderings, "order_prob": r.order_prob}
+            for key, arr in arrays.items():
+                f = field(f"results/{key}")
+                _dataset(g, f, name=key, data=np.asarray(arr, dtype=f.dtype))
 
 
 def read_result(path: str | Path, tracker: str | None = None) -> TrackerResult:

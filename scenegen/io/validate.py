@@ -29,15 +29,17 @@ from scipy import ndimage
 
 from scenegen.config import from_dict
 from scenegen.errors import ConfigError, DataError
-from scenegen.io import SCHEMA, describe_open_error, describe_read_error, describe_temp_file
+from scenegen.io import describe_open_error, describe_read_error, describe_temp_file
 from scenegen.io.guard import beat, call
-from scenegen.sequence import GT_FIELDS
+from scenegen.io.schema import GT_FIELDS, RESULT_FIELDS, ROLES, SCHEMA, SEQUENCE_FIELDS
 
 __all__ = ["check_file"]
 
 _MAX_PER_KIND = 5  # frames listed per kind of problem
 _READ_ERRORS = (OSError, RuntimeError, KeyError, ValueError, TypeError)
-_ROLES = {"target", "distractor", "occluder", "clutter"}
+_ROLES = set(ROLES)
+_OPTIONAL = {f.path for f in SEQUENCE_FIELDS if f.optional}  # absent from older files
+_RESULT_DTYPE = {f.path: f.numpy_dtype for f in RESULT_FIELDS}
 _ATTRS = ("seed", "config", "preset", "n_frames", "height", "width")
 
 
@@ -143,18 +145,11 @@ def _frames(idx: list[int] | NDArray[Any]) -> str:
 
 
 def _expected(t: int, h: int, w: int, k: int) -> dict[str, tuple[tuple[int, ...], Any]]:
+    """Shape and dtype of each dataset of the layout (scenegen.io.schema), by path."""
     return {
-        "frames": ((t, h, w, 3), np.uint8),
-        "labels": ((t, h, w), np.uint16),
-        "entities/id": ((k,), np.int32),
-        "entities/role": ((k,), str),
-        "entities/name": ((k,), str),
-        "gt/box": ((t, k, 4), np.float32),
-        "gt/visible_box": ((t, k, 4), np.float32),
-        "gt/center": ((t, k, 2), np.float32),
-        "gt/visibility": ((t, k), np.float32),
-        "gt/present": ((t, k), np.bool_),
-        "gt/depth": ((t, k), np.int16),
+        f.path: (f.shape_for(T=t, H=h, W=w, K=k), f.numpy_dtype)
+        for f in SEQUENCE_FIELDS
+        if "<" not in f.path
     }
 
 
@@ -201,7 +196,8 @@ def _layout(where: str, g: h5py.Group) -> tuple[list[str], tuple[int, int, int, 
     for key, (shape, dtype) in _expected(t, h, w, max(k, 0)).items():
         obj = g.get(key)
         if obj is None:
-            problems.append(f"{where}: missing dataset {key}")
+            if key not in _OPTIONAL:
+                problems.append(f"{where}: missing dataset {key}")
         elif not isinstance(obj, h5py.Dataset):
             problems.append(f"{where}: {key} is not a dataset")
         else:
@@ -232,7 +228,7 @@ def _check_sequence(where: str, g: h5py.Group, check_pixels: bool) -> list[str]:
     problems, (t, h, w, k) = _layout(where, g)
     if problems:
         return problems
-    keys = ["entities/id", "entities/role", *(f"gt/{key}" for key in GT_FIELDS)]
+    keys = ["entities/id", "entities/role", *(f"gt/{key}" for key in GT_FIELDS if f"gt/{key}" in g)]
     data, problems = _read_small(where, g, keys)
     if "entities/id" not in data:
         return problems
@@ -245,7 +241,7 @@ def _check_sequence(where: str, g: h5py.Group, check_pixels: bool) -> list[str]:
         if roles - _ROLES:
             problems.append(f"{where}: entities/role has unknown roles {sorted(roles - _ROLES)}")
     problems += _check_templates(where, g["templates"], ids)
-    gt = {key: data.get(f"gt/{key}") for key in GT_FIELDS}
+    gt = {key: data.get(f"gt/{key}") for key in GT_FIELDS if f"gt/{key}" in g}
     if all(v is not None for v in gt.values()):
         problems += _check_gt(where, gt)
     if check_pixels:
@@ -278,7 +274,9 @@ def _check_templates(where: str, grp: h5py.Group, ids: NDArray[Any]) -> list[str
 def _check_gt(where: str, gt: dict[str, NDArray[Any]]) -> list[str]:
     problems = []
     present = gt["present"].astype(bool)
-    for key in ("box", "center"):
+    for key in ("box", "center", "path_center"):
+        if key not in gt:  # path_center: optional, absent from older files
+            continue
         nan = np.isnan(gt[key])
         bad = np.flatnonzero((nan.any(axis=-1) == present).any(axis=1) | (
             nan.any(axis=-1) != nan.all(axis=-1)).any(axis=1))  # fmt: skip
@@ -414,15 +412,15 @@ def _check_results(p: Path, root: h5py.Group) -> list[str]:
         m = g["target_ids"].shape[0] if g["target_ids"].ndim == 1 else -1
         t = g["boxes"].shape[0] if g["boxes"].ndim else 0
         expect: dict[str, tuple[tuple[int, ...] | str, Any]] = {
-            "target_ids": ((m,) if m >= 0 else "(M,)", np.int32),
-            "boxes": ((t, m, 4), np.float32),
+            "target_ids": ((m,) if m >= 0 else "(M,)", _RESULT_DTYPE["target_ids"]),
+            "boxes": ((t, m, 4), _RESULT_DTYPE["boxes"]),
         }
         if ("orderings" in g) != ("order_prob" in g):
             problems.append(f"{where}: orderings and order_prob must come together")
         elif "orderings" in g:
             n_ord = g["orderings"].shape[0] if g["orderings"].ndim == 2 else -1
-            expect["orderings"] = ((n_ord, m), np.int16)
-            expect["order_prob"] = ((t, n_ord), np.float32)
+            expect["orderings"] = ((n_ord, m), _RESULT_DTYPE["orderings"])
+            expect["order_prob"] = ((t, n_ord), _RESULT_DTYPE["order_prob"])
         for key, (shape, dtype) in expect.items():
             ds = g[key]
             if ds.shape != shape:

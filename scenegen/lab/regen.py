@@ -24,6 +24,7 @@ from scenegen.testing.fixtures import (
     FAST_PARTICLES,
     SCHEMA,
     TRACKER_SEED,
+    FixtureDef,
     compare_boxes,
     default_dir,
     definitions,
@@ -50,6 +51,11 @@ def _run(seq: Any, tracker: str, params: dict[str, Any], seed: int) -> NDArray[n
 def _error_line(err: BaseException) -> str:
     text = str(err).strip().splitlines()
     return f"{type(err).__name__}: {text[0] if text else ''}"
+
+
+def _differing(a: dict[str, Any], b: dict[str, Any]) -> list[str]:
+    """The keys whose values differ between two digest tables (missing counts)."""
+    return sorted(k for k in set(a) | set(b) if a.get(k) != b.get(k))
 
 
 def verify(
@@ -82,8 +88,6 @@ def verify(
         For an unknown fixture or tracker name.
     """
     import trackers
-    from scenegen.io import read
-    from scenegen.render.plan import generate
 
     root = default_dir() if folder is None else Path(folder)
     reg = load_registry(root, missing_ok=False)
@@ -98,74 +102,73 @@ def verify(
             for n in sorted(set(entries) - set(defs))
         ]
     for name in names:
-        d = defs[name]
         if progress is not None:
             progress(name)
         entry = entries.get(name)
         if entry is None:
             problems.append(f"fixture {name}: not in the registry (run `scenegen fixtures regen`)")
             continue
-        if entry.get("config") != to_dict(d.config) or entry.get("seed") != d.seed:
-            problems.append(
-                f"fixture {name}: its definition (config or seed) differs from the registry"
-            )
-        stored = entry.get("digests", {})
-        seq = generate(from_dict(entry["config"]), seed=int(entry["seed"]))
-        regenerated = digests(seq)
-        bad = sorted(
-            k for k in set(stored) | set(regenerated) if stored.get(k) != regenerated.get(k)
-        )
-        if bad:
-            problems.append(f"fixture {name}: regenerating gives different {', '.join(bad)}")
-        path = root / entry.get("file", f"{name}.h5")
-        try:
-            on_disk = digests(read(path))
-        except DataError as err:
-            problems.append(f"fixture {name}: {err}")
-        else:
-            bad = sorted(k for k in set(stored) | set(on_disk) if stored.get(k) != on_disk.get(k))
-            if bad:
-                problems.append(f"fixture {name}: {path} holds different {', '.join(bad)}")
+        seq, found = _verify_sequence(root, name, defs[name], entry)
+        problems += found
         runs = entry.get("trackers", {})
         for tname in tnames:
-            run = runs.get(tname)
-            if run is None:
-                problems.append(
-                    f"fixture {name}, tracker {tname}: no expected output "
-                    "(run `scenegen fixtures regen`)"
-                )
-                continue
-            if progress is not None:
+            if tname in runs and progress is not None:
                 progress(f"{name} {tname}")
-            refusal = run.get("raises")
-            exp_path = root / run.get("expected", "")
-            if refusal is None and not exp_path.is_file():
-                problems.append(f"fixture {name}, tracker {tname}: {exp_path} is missing")
-                continue
-            try:
-                boxes = _run(seq, tname, run["params"], int(run["seed"]))
-            except Exception as err:  # any tracker failure is a mismatch to report
-                if refusal is None or _error_line(err) != refusal:
-                    problems.append(
-                        f"fixture {name}, tracker {tname}: raised {_error_line(err)}"
-                        + (f" (expected {refusal})" if refusal else "")
-                    )
-                continue
-            if refusal is not None:
-                problems.append(f"fixture {name}, tracker {tname}: expected {refusal}, ran")
-                continue
-            diff = compare_boxes(boxes, np.load(exp_path))
-            if diff is not None:
-                problems.append(f"fixture {name}, tracker {tname}: boxes {diff}")
+            problem = _verify_run(root, seq, tname, runs.get(tname))
+            if problem is not None:
+                problems.append(f"fixture {name}, tracker {tname}: {problem}")
     return problems
 
 
-def _write_npy(path: Path, arr: NDArray[Any]) -> None:
-    from scenegen.io import atomic_path
+def _verify_sequence(
+    root: Path, name: str, d: FixtureDef, entry: dict[str, Any]
+) -> tuple[Any, list[str]]:
+    """Regenerate fixture ``name`` from its registry entry and check definition, digests
+    and file; returns the regenerated sequence and the problems found."""
+    from scenegen.io import read
+    from scenegen.render.plan import generate
 
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_path(path) as tmp, open(tmp, "wb") as fh:
-        np.save(fh, arr)
+    problems = []
+    if entry.get("config") != to_dict(d.config) or entry.get("seed") != d.seed:
+        problems.append(
+            f"fixture {name}: its definition (config or seed) differs from the registry"
+        )
+    stored = entry.get("digests", {})
+    seq = generate(from_dict(entry["config"]), seed=int(entry["seed"]))
+    bad = _differing(stored, digests(seq))
+    if bad:
+        problems.append(f"fixture {name}: regenerating gives different {', '.join(bad)}")
+    path = root / entry.get("file", f"{name}.h5")
+    try:
+        on_disk = digests(read(path))
+    except DataError as err:
+        problems.append(f"fixture {name}: {err}")
+    else:
+        bad = _differing(stored, on_disk)
+        if bad:
+            problems.append(f"fixture {name}: {path} holds different {', '.join(bad)}")
+    return seq, problems
+
+
+def _verify_run(root: Path, seq: Any, tname: str, run: dict[str, Any] | None) -> str | None:
+    """What is wrong with tracker ``tname``'s run on ``seq`` against its registry entry
+    ``run`` (its expected boxes, or the refusal it is expected to raise), or None."""
+    if run is None:
+        return "no expected output (run `scenegen fixtures regen`)"
+    refusal = run.get("raises")
+    exp_path = root / run.get("expected", "")
+    if refusal is None and not exp_path.is_file():
+        return f"{exp_path} is missing"
+    try:
+        boxes = _run(seq, tname, run["params"], int(run["seed"]))
+    except Exception as err:  # any tracker failure is a mismatch to report
+        if refusal is None or _error_line(err) != refusal:
+            return f"raised {_error_line(err)}" + (f" (expected {refusal})" if refusal else "")
+        return None
+    if refusal is not None:
+        return f"expected {refusal}, ran"
+    diff = compare_boxes(boxes, np.load(exp_path))
+    return None if diff is None else f"boxes {diff}"
 
 
 def regen(
@@ -198,9 +201,6 @@ def regen(
         One line per tracker that raised (its expectation is left out of the registry).
     """
     import trackers
-    from scenegen import __version__
-    from scenegen.io import atomic_path, write
-    from scenegen.render.plan import generate
 
     root = default_dir() if folder is None else Path(folder)
     root.mkdir(parents=True, exist_ok=True)
@@ -212,65 +212,27 @@ def regen(
     changes: list[str] = []
     errors: list[str] = []
     if fixtures is None:
-        for gone in sorted(set(entries) - set(defs)):
-            old = entries.pop(gone)
-            (root / old.get("file", f"{gone}.h5")).unlink(missing_ok=True)
-            shutil.rmtree(root / "expected" / gone, ignore_errors=True)
-            changes.append(f"fixture {gone}: removed")
+        changes += _remove_undefined(root, entries, defs)
     for name in names:
         d = defs[name]
         if progress is not None:
             progress(name)
-        seq = generate(d.config, seed=d.seed)
-        new = digests(seq)
         old_entry = entries.get(name, {})
-        old = old_entry.get("digests", {})
-        path = root / f"{name}.h5"
-        if old != new or not path.exists():
-            write(path, seq, compression="gzip")
-            if not old:
-                changes.append(f"fixture {name}: new")
-            else:
-                bad = sorted(k for k in set(old) | set(new) if old.get(k) != new.get(k))
-                changes.append(f"fixture {name}: rewritten ({', '.join(bad) or 'file missing'})")
+        seq, new, change = _regen_sequence(root, d, old_entry.get("digests", {}))
+        changes += [change] if change else []
         runs: dict[str, Any] = dict(old_entry.get("trackers", {}))
         for tname in tnames:
             if progress is not None:
                 progress(f"{name} {tname}")
-            params = tracker_params(tname)
-            rel = f"expected/{name}/{tname}.npy"
-            try:
-                boxes = _run(seq, tname, params, TRACKER_SEED)
-            except ConfigError as err:
-                # A documented refusal (e.g. too many targets for exhaustive orderings) is
-                # the expected outcome, and verify checks that it stays the same.
-                refusal = _error_line(err)
-                if runs.get(tname, {}).get("raises") != refusal:
-                    changes.append(f"fixture {name}, tracker {tname}: refuses: {refusal}")
-                (root / rel).unlink(missing_ok=True)
-                runs[tname] = {"params": params, "seed": TRACKER_SEED, "raises": refusal}
-                continue
-            except Exception as err:  # reported; the other trackers still get written
+            run, change, error = _regen_run(root, name, seq, tname, runs.get(tname, {}))
+            if run is None:
                 runs.pop(tname, None)
-                errors.append(f"fixture {name}, tracker {tname}: raised {_error_line(err)}")
-                continue
-            exp_path = root / rel
-            previous = np.load(exp_path) if exp_path.exists() else None
-            if previous is None or not np.array_equal(previous, boxes, equal_nan=True):
-                _write_npy(exp_path, boxes)
-                if previous is None:
-                    changes.append(f"fixture {name}, tracker {tname}: new expected output")
-                else:
-                    what = compare_boxes(boxes, previous) or "changed within tolerance"
-                    changes.append(f"fixture {name}, tracker {tname}: boxes {what}")
-            runs[tname] = {
-                "params": params,
-                "seed": TRACKER_SEED,
-                "expected": rel,
-                "sha256": digest_array(boxes),
-            }
+            else:
+                runs[tname] = run
+            changes += [f"fixture {name}, tracker {tname}: {change}"] if change else []
+            errors += [f"fixture {name}, tracker {tname}: {error}"] if error else []
         entries[name] = {
-            "file": path.name,
+            "file": f"{name}.h5",
             "description": d.description,
             "preset": d.preset,
             "seed": d.seed,
@@ -278,15 +240,87 @@ def regen(
             "digests": new,
             "trackers": dict(sorted(runs.items())),
         }
+    _write_registry(root, {n: entries[n] for n in defs if n in entries})
+    return changes, errors
+
+
+def _remove_undefined(root: Path, entries: dict[str, Any], defs: dict[str, Any]) -> list[str]:
+    """Remove (from ``entries`` and disk) the fixtures no longer defined; one line each."""
+    changes = []
+    for gone in sorted(set(entries) - set(defs)):
+        old = entries.pop(gone)
+        (root / old.get("file", f"{gone}.h5")).unlink(missing_ok=True)
+        shutil.rmtree(root / "expected" / gone, ignore_errors=True)
+        changes.append(f"fixture {gone}: removed")
+    return changes
+
+
+def _regen_sequence(
+    root: Path, d: FixtureDef, old: dict[str, str]
+) -> tuple[Any, dict[str, str], str | None]:
+    """Generate fixture ``d``; write its file if its digests differ from ``old`` or it is
+    missing. Returns the sequence, its digests and the change line (None: unchanged)."""
+    from scenegen.io import write
+    from scenegen.render.plan import generate
+
+    seq = generate(d.config, seed=d.seed)
+    new = digests(seq)
+    path = root / f"{d.name}.h5"
+    if old == new and path.exists():
+        return seq, new, None
+    write(path, seq, compression="gzip")
+    if not old:
+        return seq, new, f"fixture {d.name}: new"
+    bad = _differing(old, new)
+    return seq, new, f"fixture {d.name}: rewritten ({', '.join(bad) or 'file missing'})"
+
+
+def _regen_run(
+    root: Path, name: str, seq: Any, tname: str, old: dict[str, Any]
+) -> tuple[dict[str, Any] | None, str | None, str | None]:
+    """Run tracker ``tname`` on fixture ``name``; rewrite its expected boxes if they
+    changed. Returns the registry entry of the run (None when the tracker failed), the
+    change (None: unchanged) and the error (None: it ran or refused as documented)."""
+    from scenegen.io.atomic import write_npy
+
+    params = tracker_params(tname)
+    rel = f"expected/{name}/{tname}.npy"
+    exp_path = root / rel
+    try:
+        boxes = _run(seq, tname, params, TRACKER_SEED)
+    except ConfigError as err:
+        # A documented refusal (e.g. too many targets for exhaustive orderings) is the
+        # expected outcome, and verify checks that it stays the same.
+        refusal = _error_line(err)
+        change = f"refuses: {refusal}" if old.get("raises") != refusal else None
+        exp_path.unlink(missing_ok=True)
+        return {"params": params, "seed": TRACKER_SEED, "raises": refusal}, change, None
+    except Exception as err:  # reported; the other trackers still get written
+        return None, None, f"raised {_error_line(err)}"
+    previous = np.load(exp_path) if exp_path.exists() else None
+    change = None
+    if previous is None or not np.array_equal(previous, boxes, equal_nan=True):
+        write_npy(exp_path, boxes, parents=True)
+        if previous is None:
+            change = "new expected output"
+        else:
+            change = f"boxes {compare_boxes(boxes, previous) or 'changed within tolerance'}"
+    run = {"params": params, "seed": TRACKER_SEED, "expected": rel, "sha256": digest_array(boxes)}
+    return run, change, None
+
+
+def _write_registry(root: Path, entries: dict[str, Any]) -> None:
+    """Write ``registry.json`` (only if its text changes)."""
+    from scenegen import __version__
+    from scenegen.io.atomic import write_text
+
     out = {
         "schema": SCHEMA,
         "generator_version": __version__,
         "tolerance": {"atol": EXPECTED_ATOL, "rtol": 0.0},
-        "fixtures": {n: entries[n] for n in defs if n in entries},
+        "fixtures": entries,
     }
     text = json.dumps(out, indent=1, sort_keys=False) + "\n"
     reg_path = root / "registry.json"
     if not reg_path.exists() or reg_path.read_text(encoding="utf-8") != text:
-        with atomic_path(reg_path) as tmp:
-            tmp.write_text(text, encoding="utf-8")
-    return changes, errors
+        write_text(reg_path, text)

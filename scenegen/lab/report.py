@@ -142,10 +142,9 @@ def _rel(path: Path, root: Path) -> str:
 
 
 def _write_atomic(path: Path, text: str) -> None:
-    from scenegen.io import atomic_path
+    from scenegen.io.atomic import write_text
 
-    with atomic_path(path, path.suffix) as tmp:
-        tmp.write_text(text, encoding="utf-8")
+    write_text(path, text)
 
 
 def _fidelity(all_results: dict[str, dict[str, Any]]) -> list[str]:

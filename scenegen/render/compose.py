@@ -82,8 +82,6 @@ def scan_static(lab, tidx, x0, y0, toff_h, toff_w, vis_box, vis_count):  # pragm
 
 @njit(cache=True, nogil=True)
 def render_chunk(
-    static_rgb,
-    static_lab,
     tbuf,
     toff,
     th,
@@ -102,14 +100,13 @@ def render_chunk(
 ):  # pragma: no cover - compiled
     """Render F frames: per-frame entities back to front over the static layer, then stats.
 
-    ``out_rgb`` and ``out_lab`` must already hold the static layer (a broadcast copy in
-    numpy is a plain memcpy, much faster than an element loop here).
+    ``out_rgb`` and ``out_lab`` must already hold the static layer (background and
+    entities that never move and lie behind every per-frame entity, drawn once), copied
+    into every frame by the caller: a broadcast copy in numpy is a plain memcpy, much
+    faster than an element loop here.
 
     Parameters
     ----------
-    static_rgb : (H, W, 3) uint8, static_lab : (H, W) uint16
-        The static layer (background and entities that never move and lie behind every
-        per-frame entity), drawn once.
     tbuf : (N,) uint8, toff : (NT,) int64, th, tw : (NT,) int64
         Packed RGBA templates.
     order : (F, D) int64
@@ -126,54 +123,76 @@ def render_chunk(
     out_box : (F, K, 4) int64, out_count : (F, K) int64
         Visible box (c_min, r_min, c_max, r_max) and visible pixel count per entity.
     """
-    n_f = order.shape[0]
-    k_n = tidx.shape[1]
     box = np.empty(4, dtype=np.int64)
     cnt = np.empty(1, dtype=np.int64)
     drawn = np.empty((order.shape[1], 4), dtype=np.int64)
-    for f in range(n_f):
-        rgb = out_rgb[f]
-        lab = out_lab[f]
-        n_drawn = 0
-        for j in range(order.shape[1]):
-            k = order[f, j]
-            if k < 0:
-                break
-            ti = tidx[f, k]
-            if ti < 0:
+    for f in range(order.shape[0]):
+        n_drawn = _draw_frame(
+            out_rgb[f], out_lab[f], tbuf, toff, th, tw, order[f], tidx[f], x0[f], y0[f], drawn
+        )
+        _frame_stats(
+            out_lab[f], th, tw, tidx[f], x0[f], y0[f], is_static, static_box, static_count,
+            drawn, n_drawn, out_box[f], out_count[f], box, cnt,
+        )  # fmt: skip
+
+
+@njit(cache=True, nogil=True)
+def _draw_frame(
+    rgb, lab, tbuf, toff, th, tw, order, tidx, x0, y0, drawn
+):  # pragma: no cover - compiled
+    """Paint one frame's per-frame entities back to front (``order``: (D,), padded with
+    -1); record each painted rectangle [x0, y0, x1, y1) in ``drawn`` and return how many."""
+    n_drawn = 0
+    for j in range(order.shape[0]):
+        k = order[j]
+        if k < 0:
+            break
+        ti = tidx[k]
+        if ti < 0:
+            continue
+        paint(rgb, lab, tbuf, toff[ti], th[ti], tw[ti], x0[k], y0[k], k + 1)
+        drawn[n_drawn, 0] = x0[k]
+        drawn[n_drawn, 1] = y0[k]
+        drawn[n_drawn, 2] = x0[k] + tw[ti]
+        drawn[n_drawn, 3] = y0[k] + th[ti]
+        n_drawn += 1
+    return n_drawn
+
+
+@njit(cache=True, nogil=True)
+def _frame_stats(
+    lab, th, tw, tidx, x0, y0, is_static, static_box, static_count, drawn, n_drawn,
+    out_box, out_count, box, cnt,
+):  # pragma: no cover - compiled  # fmt: skip
+    """Visible box and pixel count (``out_box`` (K, 4), ``out_count`` (K,)) of every
+    entity in one frame's labels. A static entity that no per-frame entity was drawn over
+    keeps its statistics on the static layer; the others are scanned."""
+    for k in range(tidx.shape[0]):
+        ti = tidx[k]
+        if ti < 0:
+            out_count[k] = 0
+            continue
+        bx0 = x0[k]
+        by0 = y0[k]
+        bx1 = bx0 + tw[ti]
+        by1 = by0 + th[ti]
+        if is_static[k]:
+            touched = False
+            for d in range(n_drawn):
+                if (
+                    drawn[d, 0] < bx1
+                    and bx0 < drawn[d, 2]
+                    and drawn[d, 1] < by1
+                    and by0 < drawn[d, 3]
+                ):
+                    touched = True
+                    break
+            if not touched:
+                for i in range(4):
+                    out_box[k, i] = static_box[k, i]
+                out_count[k] = static_count[k]
                 continue
-            paint(rgb, lab, tbuf, toff[ti], th[ti], tw[ti], x0[f, k], y0[f, k], k + 1)
-            drawn[n_drawn, 0] = x0[f, k]
-            drawn[n_drawn, 1] = y0[f, k]
-            drawn[n_drawn, 2] = x0[f, k] + tw[ti]
-            drawn[n_drawn, 3] = y0[f, k] + th[ti]
-            n_drawn += 1
-        for k in range(k_n):
-            ti = tidx[f, k]
-            if ti < 0:
-                out_count[f, k] = 0
-                continue
-            bx0 = x0[f, k]
-            by0 = y0[f, k]
-            bx1 = bx0 + tw[ti]
-            by1 = by0 + th[ti]
-            if is_static[k]:
-                touched = False
-                for d in range(n_drawn):
-                    if (
-                        drawn[d, 0] < bx1
-                        and bx0 < drawn[d, 2]
-                        and drawn[d, 1] < by1
-                        and by0 < drawn[d, 3]
-                    ):
-                        touched = True
-                        break
-                if not touched:
-                    for i in range(4):
-                        out_box[f, k, i] = static_box[k, i]
-                    out_count[f, k] = static_count[k]
-                    continue
-            _scan_visible(lab, k + 1, bx0, by0, tw[ti], th[ti], box, cnt)
-            for i in range(4):
-                out_box[f, k, i] = box[i]
-            out_count[f, k] = cnt[0]
+        _scan_visible(lab, k + 1, bx0, by0, tw[ti], th[ti], box, cnt)
+        for i in range(4):
+            out_box[k, i] = box[i]
+        out_count[k] = cnt[0]

@@ -1,4 +1,4 @@
-"""AR2 trajectories with boundary rules (ALGORITHMS §1.1)."""
+"""AR2 trajectories with boundary rules (docs/algorithms.md §1)."""
 
 from __future__ import annotations
 

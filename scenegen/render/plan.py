@@ -1,6 +1,6 @@
 """Scenario planning and rendering: config + seed -> frames, labels and ground truth.
 
-Data flows one way (STYLE.md): :func:`plan` turns a config and a seed into a
+Data flows one way: :func:`plan` turns a config and a seed into a
 :class:`Scenario` (trajectories, depths, templates: everything but pixels), and
 :meth:`Scenario.render` draws any frame range of it in one compiled call. The static
 layer (background, clutter and entities that never move and lie behind all others) is
@@ -10,6 +10,10 @@ Randomness: each entity draws from its own stream, keyed by the scenario seed an
 entity's *name*, so adding, removing or reordering other entities never changes its
 trajectory or appearance. Per-frame sensor noise is keyed by the frame index, so rendering
 in chunks gives the same bytes as rendering at once.
+
+Position noise is added to the planned motion path per frame; the path itself (before the
+noise) is kept as :attr:`Scenario.path_x`, :attr:`Scenario.path_y` and recorded as
+``gt/path_center``.
 """
 
 from __future__ import annotations
@@ -95,6 +99,8 @@ class Scenario:
         Base template of each entity.
     cx, cy : ndarray of shape (T, K)
         Drawn centre (motion plus position noise) before rounding to pixels.
+    path_x, path_y : ndarray of shape (T, K)
+        Centre of the noise-free motion path (``cx``, ``cy`` before the position noise).
     scale, angle, shade : ndarray of shape (T, K)
         Per-frame appearance transform.
     alive : ndarray of shape (T, K), bool
@@ -114,6 +120,8 @@ class Scenario:
     templates: list[NDArray[np.uint8]]
     cx: NDArray[np.float64]
     cy: NDArray[np.float64]
+    path_x: NDArray[np.float64]
+    path_y: NDArray[np.float64]
     scale: NDArray[np.float64]
     angle: NDArray[np.float64]
     shade: NDArray[np.float64]
@@ -226,7 +234,7 @@ class Scenario:
         out_box = np.zeros((f_n, k_n, 4), dtype=np.int64)
         out_count = np.zeros((f_n, k_n), dtype=np.int64)
         kernels.render_chunk(
-            s_rgb, s_lab, tbuf, toff, th, tw, order, tidx, x0, y0,
+            tbuf, toff, th, tw, order, tidx, x0, y0,
             self.in_static, s_box, s_count, out_rgb, out_lab, out_box, out_count,
         )  # fmt: skip
         if self.config.sensor_noise > 0:
@@ -237,6 +245,9 @@ class Scenario:
 
         gt = _ground_truth(tidx, x0, y0, th, tw, toff, tbuf, out_box, out_count)
         gt["depth"] = self.depth_rank[start:stop].copy()
+        path = np.stack([self.path_x[start:stop], self.path_y[start:stop]], axis=-1)
+        path[~gt["present"]] = np.nan
+        gt["path_center"] = path.astype(np.float32)
         return Chunk(start=start, frames=out_rgb, labels=out_lab, gt=gt)
 
     def chunks(self, size: int = 64) -> Iterator[Chunk]:
@@ -313,7 +324,8 @@ def _ground_truth(tidx, x0, y0, th, tw, toff, tbuf, vbox, vcount) -> dict[str, N
 def _entity_plan(
     e: EntitySpec, cfg: SceneConfig, seed: int, tpl: NDArray[np.uint8], start: tuple[float, float]
 ) -> tuple[NDArray[np.float64], ...]:
-    """Trajectory (T,) x, y, scale, angle, shade of one entity from its own stream."""
+    """Trajectory (T,) x, y, scale, angle, shade, path x, path y of one entity from its own
+    stream; x, y include the position noise, path x, path y do not."""
     t_n = cfg.n_frames
     rng = entity_rng(seed, e.name, 1)
     th, tw = tpl.shape[:2]
@@ -336,6 +348,7 @@ def _entity_plan(
             s = ar2_path(m.scale, 0.0, 0.0, t_n, rng=rng, lo=-lim, hi=lim)
         else:
             s = np.zeros(t_n)
+    path_x, path_y = x, y
     if e.position_noise > 0:
         noise = rng.standard_normal((t_n, 2)) * e.position_noise
         x = x + noise[:, 0]
@@ -350,7 +363,7 @@ def _entity_plan(
         angle = np.zeros(t_n)
         shade = np.ones(t_n)
     scale = np.clip(np.exp(s), *_SCALE_LIMITS)
-    return x, y, scale, angle, shade
+    return x, y, scale, angle, shade, path_x, path_y
 
 
 def _clutter(cfg: SceneConfig, seed: int) -> list[tuple[str, NDArray[np.uint8], float, float]]:
@@ -387,26 +400,21 @@ def _clutter(cfg: SceneConfig, seed: int) -> list[tuple[str, NDArray[np.uint8], 
     return items
 
 
-def plan(config: SceneConfig, seed: int | None = None, *, preset: str = "") -> Scenario:
-    """Plan a scenario: trajectories, depths, presence and templates of every entity.
+_Path = tuple[NDArray[np.float64], ...]  # (T,) x, y, scale, angle, shade, path x, path y
 
-    Parameters
-    ----------
-    config : SceneConfig
-    seed : int or None
-        ``None`` draws a fresh seed (recorded in the result).
-    preset : str
-        The preset name to record ("" if none).
+
+def _entity_paths(
+    cfg: SceneConfig, seed: int
+) -> tuple[dict[str, NDArray[np.uint8]], dict[str, _Path]]:
+    """Template and trajectory of every configured entity, by name.
+
+    Targets (and anything not mimicking) come first: a mimic starts where its model is at
+    the mimic's appear frame, and its own motion starts there.
     """
-    seed = resolve_seed(seed)
-    cfg = config
-    t_n, h, w = cfg.n_frames, cfg.height, cfg.width
+    t_n = cfg.n_frames
     by_name = {e.name: e for e in cfg.entities}
-    k_user = len(cfg.entities)
-
     templates: dict[str, NDArray[np.uint8]] = {}
-    paths: dict[str, tuple[NDArray[np.float64], ...]] = {}
-    # Targets (and anything not mimicking) first: a mimic starts where its model is.
+    paths: dict[str, _Path] = {}
     for e in sorted(cfg.entities, key=lambda e: e.mimic is not None):
         app_rng = entity_rng(seed, e.name, 0)
         app = e.appearance
@@ -422,48 +430,37 @@ def plan(config: SceneConfig, seed: int | None = None, *, preset: str = "") -> S
             start = (mx[t0] + e.mimic_offset[0], my[t0] + e.mimic_offset[1])
         path = _entity_plan(e, cfg, seed, tpl, start)
         if e.position is None and e.appear > 0:
-            # The mimic's own motion starts at its appear frame from the target's position.
-            shifted = []
-            for arr in path:
-                out = np.empty_like(arr)
-                out[e.appear :] = arr[: t_n - e.appear]
-                out[: e.appear] = arr[0]
-                shifted.append(out)
-            path = tuple(shifted)
+            path = tuple(_delayed(arr, e.appear) for arr in path)
         paths[e.name] = path
+    return templates, paths
 
-    clutter = _clutter(cfg, seed)
-    names = [e.name for e in cfg.entities] + [c[0] for c in clutter]
-    roles = [e.role for e in cfg.entities] + ["clutter"] * len(clutter)
-    tpls = [templates[e.name] for e in cfg.entities] + [c[1] for c in clutter]
-    k_n = len(names)
 
-    cx = np.empty((t_n, k_n))
-    cy = np.empty((t_n, k_n))
-    scale = np.ones((t_n, k_n))
-    angle = np.zeros((t_n, k_n))
-    shade = np.ones((t_n, k_n))
-    alive = np.zeros((t_n, k_n), dtype=bool)
-    for k, e in enumerate(cfg.entities):
-        cx[:, k], cy[:, k], scale[:, k], angle[:, k], shade[:, k] = paths[e.name]
-        stop = t_n if e.disappear is None else min(e.disappear, t_n)
-        alive[e.appear : stop, k] = True
-    for j, c in enumerate(clutter):
-        cx[:, k_user + j] = c[2]
-        cy[:, k_user + j] = c[3]
-        alive[:, k_user + j] = True
+def _delayed(arr: NDArray[np.float64], appear: int) -> NDArray[np.float64]:
+    """``arr`` starting at frame ``appear`` (held at its first value before)."""
+    out = np.empty_like(arr)
+    out[appear:] = arr[: arr.shape[0] - appear]
+    out[:appear] = arr[0]
+    return out
 
-    depth_value = np.empty((t_n, k_n), dtype=np.int64)
+
+def _depth_values(cfg: SceneConfig, n_clutter: int) -> NDArray[np.int64]:
+    """Configured depth (T, K) of every entity, then clutter behind every entity (later
+    clutter items drawn over earlier ones)."""
+    t_n, k_user = cfg.n_frames, len(cfg.entities)
+    depth_value = np.empty((t_n, k_user + n_clutter), dtype=np.int64)
     for k, e in enumerate(cfg.entities):
         for f, d in e.depth:
             depth_value[min(f, t_n) :, k] = d
     base = (max((d for e in cfg.entities for _, d in e.depth), default=-1)) + 1
-    n_cl = len(clutter)
-    # Clutter lies behind every entity; later items are drawn over earlier ones.
-    depth_value[:, k_user:] = base + (n_cl - 1 - np.arange(n_cl))
-    depth_rank = _ranks(depth_value)
+    depth_value[:, k_user:] = base + (n_clutter - 1 - np.arange(n_clutter))
+    return depth_value
 
-    static = np.zeros(k_n, dtype=bool)
+
+def _static_entities(cfg: SceneConfig, depth_value: NDArray[np.int64]) -> NDArray[np.bool_]:
+    """Entities drawn once into the static layer (K,): those that never move, change or
+    come and go (clutter included), and lie behind every entity that does."""
+    k_user = len(cfg.entities)
+    static = np.zeros(depth_value.shape[1], dtype=bool)
     for k, e in enumerate(cfg.entities):
         static[k] = (
             e.motion is None
@@ -476,8 +473,57 @@ def plan(config: SceneConfig, seed: int | None = None, *, preset: str = "") -> S
     static[k_user:] = True
     dyn_depth = depth_value[:, ~static]
     max_dyn = int(dyn_depth.max()) if dyn_depth.size else -1
-    in_static = static & (depth_value.min(axis=0) > max_dyn)
+    return static & (depth_value.min(axis=0) > max_dyn)
 
+
+def _per_frame(
+    cfg: SceneConfig, paths: dict[str, _Path], clutter: list[tuple[str, Any, float, float]]
+) -> tuple[NDArray[Any], ...]:
+    """Per-frame arrays (T, K) of the entities then the clutter items: x, y, scale,
+    angle, shade, path x, path y and alive (clutter stays put, always alive)."""
+    t_n, k_user = cfg.n_frames, len(cfg.entities)
+    k_n = k_user + len(clutter)
+    cx = np.empty((t_n, k_n))
+    cy = np.empty((t_n, k_n))
+    path_x = np.empty((t_n, k_n))
+    path_y = np.empty((t_n, k_n))
+    scale = np.ones((t_n, k_n))
+    angle = np.zeros((t_n, k_n))
+    shade = np.ones((t_n, k_n))
+    alive = np.zeros((t_n, k_n), dtype=bool)
+    for k, e in enumerate(cfg.entities):
+        cx[:, k], cy[:, k], scale[:, k], angle[:, k], shade[:, k], path_x[:, k], path_y[:, k] = (
+            paths[e.name]
+        )
+        stop = t_n if e.disappear is None else min(e.disappear, t_n)
+        alive[e.appear : stop, k] = True
+    for j, c in enumerate(clutter):
+        cx[:, k_user + j] = path_x[:, k_user + j] = c[2]
+        cy[:, k_user + j] = path_y[:, k_user + j] = c[3]
+        alive[:, k_user + j] = True
+    return cx, cy, scale, angle, shade, path_x, path_y, alive
+
+
+def plan(config: SceneConfig, seed: int | None = None, *, preset: str = "") -> Scenario:
+    """Plan a scenario: trajectories, depths, presence and templates of every entity.
+
+    Parameters
+    ----------
+    config : SceneConfig
+    seed : int or None
+        ``None`` draws a fresh seed (recorded in the result).
+    preset : str
+        The preset name to record ("" if none).
+    """
+    seed = resolve_seed(seed)
+    cfg = config
+    templates, paths = _entity_paths(cfg, seed)
+    clutter = _clutter(cfg, seed)
+    names = [e.name for e in cfg.entities] + [c[0] for c in clutter]
+    roles = [e.role for e in cfg.entities] + ["clutter"] * len(clutter)
+    tpls = [templates[e.name] for e in cfg.entities] + [c[1] for c in clutter]
+    cx, cy, scale, angle, shade, path_x, path_y, alive = _per_frame(cfg, paths, clutter)
+    depth_value = _depth_values(cfg, len(clutter))
     return Scenario(
         config=cfg,
         seed=seed,
@@ -487,14 +533,18 @@ def plan(config: SceneConfig, seed: int | None = None, *, preset: str = "") -> S
         templates=tpls,
         cx=cx,
         cy=cy,
+        path_x=path_x,
+        path_y=path_y,
         scale=scale,
         angle=angle,
         shade=shade,
         alive=alive,
         depth_value=depth_value,
-        depth_rank=depth_rank,
-        in_static=in_static,
-        background=_background(cfg.background, h, w, entity_rng(seed, "background")),
+        depth_rank=_ranks(depth_value),
+        in_static=_static_entities(cfg, depth_value),
+        background=_background(
+            cfg.background, cfg.height, cfg.width, entity_rng(seed, "background")
+        ),
     )
 
 

@@ -42,6 +42,7 @@ from scenegen.config import (
     SceneConfig,
 )
 from scenegen.errors import ConfigError, DataError
+from scenegen.testing.compare import difference
 
 __all__ = [
     "EXPECTED_ATOL",
@@ -162,41 +163,48 @@ def downsized(
     )
 
 
-def _edge_cases() -> list[FixtureDef]:
-    still = AR2(boundary="free", sigma=0.0)
-    white = Background(kind="uniform", color=(255, 255, 255))
-    disc = Appearance(
-        shape="ellipse",
-        size=(12, 12),
-        pattern="sectors",
-        colors=((230, 30, 30), (30, 170, 30), (30, 60, 230), (240, 210, 0)),
-    )
-    enter_leave = SceneConfig(
+_STILL = AR2(boundary="free", sigma=0.0)  # motion by the initial velocity only
+_WHITE = Background(kind="uniform", color=(255, 255, 255))
+_DISC = Appearance(
+    shape="ellipse",
+    size=(12, 12),
+    pattern="sectors",
+    colors=((230, 30, 30), (30, 170, 30), (30, 60, 230), (240, 210, 0)),
+)
+
+
+def _enter_leave() -> FixtureDef:
+    cfg = SceneConfig(
         name="enter-leave",
         width=80,
         height=60,
         n_frames=12,
-        background=white,
+        background=_WHITE,
         entities=(
             EntitySpec(
                 name="leaving",
                 role="target",
-                appearance=disc,
+                appearance=_DISC,
                 position=(60.0, 20.0),
-                motion=Motion(x=still, y=still, velocity=(3.0, 0.0)),
+                motion=Motion(x=_STILL, y=_STILL, velocity=(3.0, 0.0)),
                 depth=((0, 0),),
             ),
             EntitySpec(
                 name="entering",
                 role="target",
-                appearance=replace(disc, shape="rect", pattern="checker", stripe_width=3),
+                appearance=replace(_DISC, shape="rect", pattern="checker", stripe_width=3),
                 position=(-8.0, 40.0),
-                motion=Motion(x=still, y=still, velocity=(9.0, 0.0)),
+                motion=Motion(x=_STILL, y=_STILL, velocity=(9.0, 0.0)),
                 depth=((0, 1),),
             ),
         ),
     )
-    occlusion = SceneConfig(
+    what = "a tracked target leaves the frame; another object enters and leaves it"
+    return FixtureDef(cfg.name, what, cfg, seed=1)
+
+
+def _full_occlusion() -> FixtureDef:
+    cfg = SceneConfig(
         name="full-occlusion",
         width=96,
         height=64,
@@ -206,9 +214,9 @@ def _edge_cases() -> list[FixtureDef]:
             EntitySpec(
                 name="walker",
                 role="target",
-                appearance=replace(disc, pattern="bands"),
+                appearance=replace(_DISC, pattern="bands"),
                 position=(16.0, 32.0),
-                motion=Motion(x=still, y=still, velocity=(5.0, 0.0)),
+                motion=Motion(x=_STILL, y=_STILL, velocity=(5.0, 0.0)),
                 depth=((0, 1),),
             ),
             EntitySpec(
@@ -220,7 +228,12 @@ def _edge_cases() -> list[FixtureDef]:
             ),
         ),
     )
-    distractor = SceneConfig(
+    what = "a target passes behind a larger static occluder, totally hidden at frames 6-7"
+    return FixtureDef(cfg.name, what, cfg, seed=1)
+
+
+def _distractor_on_target() -> FixtureDef:
+    cfg = SceneConfig(
         name="distractor-on-target",
         width=80,
         height=60,
@@ -230,7 +243,7 @@ def _edge_cases() -> list[FixtureDef]:
             EntitySpec(
                 name="target",
                 role="target",
-                appearance=disc,
+                appearance=_DISC,
                 position=(30.0, 30.0),
                 motion=Motion(
                     x=AR2(boundary="reflect", a1=1.5, a2=-0.5, sigma=1.0, margin=2),
@@ -254,12 +267,17 @@ def _edge_cases() -> list[FixtureDef]:
             ),
         ),
     )
-    pixel = SceneConfig(
+    what = "a recoloured copy appears on the target at frame 2, drifts off, goes at 9"
+    return FixtureDef(cfg.name, what, cfg, seed=1)
+
+
+def _one_pixel() -> FixtureDef:
+    cfg = SceneConfig(
         name="one-pixel",
         width=64,
         height=48,
         n_frames=8,
-        background=white,
+        background=_WHITE,
         entities=(
             EntitySpec(
                 name="dot",
@@ -274,38 +292,32 @@ def _edge_cases() -> list[FixtureDef]:
             ),
         ),
     )
-    single = SceneConfig(
+    return FixtureDef(cfg.name, "a 1x1-pixel target on white", cfg, seed=1)
+
+
+def _single_frame() -> FixtureDef:
+    cfg = SceneConfig(
         name="single-frame",
         width=64,
         height=48,
         n_frames=1,
-        background=white,
+        background=_WHITE,
         entities=(
-            EntitySpec(name="target", role="target", appearance=disc, position=(32.0, 24.0)),
+            EntitySpec(name="target", role="target", appearance=_DISC, position=(32.0, 24.0)),
         ),
-        clutter=(ClutterSpec(count=12, appearance=disc, n_colors=3, min_size=6),),
+        clutter=(ClutterSpec(count=12, appearance=_DISC, n_colors=3, min_size=6),),
     )
+    return FixtureDef(cfg.name, "one frame: a target among clutter", cfg, seed=1)
+
+
+def _edge_cases() -> list[FixtureDef]:
+    """The hand-made fixtures, in registry order."""
     return [
-        FixtureDef(
-            "enter-leave",
-            "a tracked target leaves the frame; another object enters and leaves it",
-            enter_leave,
-            seed=1,
-        ),
-        FixtureDef(
-            "full-occlusion",
-            "a target passes behind a larger static occluder, totally hidden at frames 6-7",
-            occlusion,
-            seed=1,
-        ),
-        FixtureDef(
-            "distractor-on-target",
-            "a recoloured copy appears on the target at frame 2, drifts off, goes at 9",
-            distractor,
-            seed=1,
-        ),
-        FixtureDef("one-pixel", "a 1x1-pixel target on white", pixel, seed=1),
-        FixtureDef("single-frame", "one frame: a target among clutter", single, seed=1),
+        _enter_leave(),
+        _full_occlusion(),
+        _distractor_on_target(),
+        _one_pixel(),
+        _single_frame(),
     ]
 
 
@@ -367,21 +379,10 @@ def digests(seq: Any) -> dict[str, str]:
 
 
 def compare_boxes(actual: NDArray[Any], expected: NDArray[Any]) -> str | None:
-    """None if equal within EXPECTED_ATOL (NaN matching NaN), else what differs."""
-    if actual.shape != expected.shape:
-        return f"shape {actual.shape}, expected {expected.shape}"
-    nan_a, nan_e = np.isnan(actual), np.isnan(expected)
-    if np.any(nan_a != nan_e):
-        t = int(np.argwhere(nan_a != nan_e)[0][0])
-        return f"NaN pattern differs from frame {t}"
-    diff = np.abs(np.where(nan_a, 0.0, actual.astype(np.float64) - expected))
-    if diff.max(initial=0.0) <= EXPECTED_ATOL:
-        return None
-    bad = np.argwhere(diff > EXPECTED_ATOL)
-    return (
-        f"{len(bad)} of {diff.size} values differ beyond {EXPECTED_ATOL} px "
-        f"(largest {float(diff.max()):.3g} px), first at frame {int(bad[0][0])}"
-    )
+    """None if equal within :data:`EXPECTED_ATOL` pixels (NaN matching NaN), else what
+    differs (:func:`scenegen.testing.compare.difference`; the index is (frame, target,
+    coordinate))."""
+    return difference(actual, expected, atol=EXPECTED_ATOL)
 
 
 # --------------------------------------------------------------------------------------
@@ -418,5 +419,3 @@ def select_names(names: Iterable[str] | None, what: str, valid: Iterable[str]) -
         if n not in valid:
             raise ConfigError(f"unknown {what} {n!r}; valid: {', '.join(valid)}")
     return out
-
-

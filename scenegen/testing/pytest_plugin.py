@@ -294,12 +294,6 @@ def _check_digests(registry: Path, name: str, seq: Any) -> None:
         )
 
 
-def _nan_mask(arr: NDArray[Any]) -> NDArray[np.bool_]:
-    if arr.dtype.kind in "fc":
-        return np.isnan(arr)
-    return np.zeros(arr.shape, dtype=bool)
-
-
 def assert_close_to_expected(
     path: Path, actual: Any, *, atol: float = 0.0, rtol: float = 0.0, regen: bool = False
 ) -> bool:
@@ -320,7 +314,8 @@ def assert_close_to_expected(
         Naming the file, how many elements differ, the largest difference, the first
         differing element and the tolerances.
     """
-    from scenegen.io import atomic_path
+    from scenegen.io.atomic import write_npy
+    from scenegen.testing.compare import difference
 
     if atol < 0 or rtol < 0:
         raise ValueError(f"tolerances must be >= 0, got atol={atol}, rtol={rtol}")
@@ -332,33 +327,13 @@ def assert_close_to_expected(
                 old, arr, equal_nan=arr.dtype.kind in "fc"
             ):
                 return False
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with atomic_path(path) as tmp, open(tmp, "wb") as fh:
-            np.save(fh, arr)
+        write_npy(path, arr, parents=True)
         return True
     if not path.exists():
         raise AssertionError(f"no stored expectation {path}; run pytest with --scenegen-regen")
-    expected = np.load(path)
-    if expected.shape != arr.shape:
-        raise AssertionError(f"{path}: shape {arr.shape}, expected {expected.shape}")
-    nan_a, nan_e = _nan_mask(arr), _nan_mask(expected)
-    if np.any(nan_a != nan_e):
-        idx = tuple(int(i) for i in np.argwhere(nan_a != nan_e)[0])
-        raise AssertionError(
-            f"{path}: NaN pattern differs first at {idx}: got {arr[idx]!r}, "
-            f"expected {expected[idx]!r}"
-        )
-    a = arr.astype(np.float64) if arr.dtype.kind in "biu" else arr
-    e = expected.astype(np.float64) if expected.dtype.kind in "biu" else expected
-    ok = np.isclose(a, e, atol=atol, rtol=rtol) | nan_a
-    if not ok.all():
-        idx = tuple(int(i) for i in np.argwhere(~ok)[0])
-        diff = np.abs(np.where(ok, 0, a - e))
-        raise AssertionError(
-            f"{path}: {int((~ok).sum())} of {ok.size} values differ beyond atol={atol}, "
-            f"rtol={rtol} (largest difference {float(diff.max()):.6g}); first at {idx}: "
-            f"got {arr[idx]!r}, expected {expected[idx]!r}"
-        )
+    what = difference(arr, np.load(path), atol=atol, rtol=rtol)
+    if what is not None:
+        raise AssertionError(f"{path}: {what}")
     return False
 
 

@@ -198,7 +198,7 @@ def ar2_params(
     max_sigma: float = 2.0,
     margin: float = 0.0,
 ) -> SearchStrategy[AR2]:
-    """AR2 motion of one coordinate (ALGORITHMS §1.1), ``a1 = 1 + d, a2 = -d``.
+    """AR2 motion of one coordinate (docs/algorithms.md §1), ``a1 = 1 + d, a2 = -d``.
 
     ``d`` in [0, 1] spans a random walk (0), damped velocity and constant velocity plus
     acceleration noise (1); ``sigma`` is in [0, ``max_sigma``]. Shrinks towards a

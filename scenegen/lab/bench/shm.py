@@ -1,4 +1,4 @@
-"""Benchmark rows of the SHM trackers (ALGORITHMS.md §5) on the ``shm-crossing`` preset.
+"""Benchmark rows of the SHM trackers (docs/algorithms.md §4) on the ``shm-crossing`` preset.
 
 Two targets on 360x288 frames, 120 frames, one core (OpenCV limited to one thread for the
 run; the matching kernel is single-threaded). The baseline is the plain Kalman tracker,

@@ -72,10 +72,9 @@ def _round(x: Any) -> Any:
 
 
 def _write_text(path: Path, text: str) -> None:
-    from scenegen.io import atomic_path
+    from scenegen.io.atomic import write_text
 
-    with atomic_path(path, path.suffix) as tmp:
-        tmp.write_text(text, encoding="utf-8")
+    write_text(path, text)
 
 
 def run_experiment(

@@ -52,7 +52,7 @@ class Experiment:
     Attributes
     ----------
     name : str
-        CONTRACT name (``scenegen experiment NAME``).
+        public name (``scenegen experiment NAME``).
     title : str
         What it reproduces.
     presets : tuple of str

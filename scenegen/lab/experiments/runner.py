@@ -275,16 +275,12 @@ def run_task(task: Task) -> dict[str, Any]:
 def write_json_atomic(path: Path, data: Any, *, indent: int | None = None) -> None:
     """Write ``data`` as JSON (sorted keys, no NaN) to ``path`` atomically.
 
-    Uses :func:`scenegen.io.atomic_path`: a temporary file in the same folder, flushed and
-    renamed into place, so a killed process never leaves a half-written file there.
+    Uses :func:`scenegen.io.atomic.write_json`: a temporary file in the same folder,
+    flushed and renamed into place, so a killed process never leaves a half-written file.
     """
-    from scenegen.io import atomic_path
+    from scenegen.io.atomic import write_json
 
-    text = json.dumps(data, sort_keys=True, allow_nan=False, indent=indent,
-                      separators=(",", ":") if indent is None else (",", ": "))
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_path(path, ".json") as tmp:
-        tmp.write_text(text + "\n", encoding="utf-8")
+    write_json(path, data, indent=indent, parents=True)
 
 
 def load_record(path: Path, task: Task) -> dict[str, Any] | None:

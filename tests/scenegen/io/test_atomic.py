@@ -250,3 +250,24 @@ def test_rewriting_a_file_from_its_own_lazy_read(tmp_path, small_file):
     back = read(small_file)
     np.testing.assert_array_equal(np.asarray(back.frames), frames)
     assert check_file(small_file) == [] and temps(small_file.parent, small_file.name) == []
+
+
+def test_write_text_json_npy_helpers(tmp_path):
+    from scenegen.io.atomic import write_json, write_npy, write_text
+
+    write_text(tmp_path / "a.md", "héllo\n")
+    assert (tmp_path / "a.md").read_text(encoding="utf-8") == "héllo\n"
+    write_json(tmp_path / "b.json", {"z": 1, "a": [1.5, None]})
+    assert (tmp_path / "b.json").read_text() == '{"a":[1.5,null],"z":1}\n'
+    write_json(tmp_path / "c.json", {"z": 1, "a": 2}, indent=1, sort_keys=False)
+    assert (tmp_path / "c.json").read_text() == '{\n "z": 1,\n "a": 2\n}\n'
+    with pytest.raises(ValueError):
+        write_json(tmp_path / "b.json", {"x": float("nan")})
+    assert (tmp_path / "b.json").read_text() == '{"a":[1.5,null],"z":1}\n'  # untouched
+    arr = np.array([[1.0, np.nan]], np.float32)
+    write_npy(tmp_path / "deep" / "er" / "x.npy", arr, parents=True)
+    back = np.load(tmp_path / "deep" / "er" / "x.npy")
+    assert back.dtype == np.float32 and np.array_equal(back, arr, equal_nan=True)
+    with pytest.raises(ConfigError, match="does not exist"):
+        write_text(tmp_path / "missing" / "a.txt", "x")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.md", "b.json", "c.json", "deep"]

@@ -1,4 +1,4 @@
-"""HDF5 round trips, lazy reading and result files (CONTRACT layout)."""
+"""HDF5 round trips, lazy reading and result files (the layout of docs/format.md)."""
 
 from __future__ import annotations
 
@@ -48,7 +48,7 @@ def test_layout_matches_contract(tmp_path, seq):
             "entities/id": ((k,), np.int32), "gt/box": ((t, k, 4), np.float32),
             "gt/visible_box": ((t, k, 4), np.float32), "gt/center": ((t, k, 2), np.float32),
             "gt/visibility": ((t, k), np.float32), "gt/present": ((t, k), np.bool_),
-            "gt/depth": ((t, k), np.int16),
+            "gt/depth": ((t, k), np.int16), "gt/path_center": ((t, k, 2), np.float32),
         }  # fmt: skip
         for key, (shape, dtype) in expect.items():
             assert g[key].shape == shape and g[key].dtype == dtype, key

@@ -56,7 +56,7 @@ def reference_frame(scn: Scenario, t: int) -> tuple[np.ndarray, np.ndarray, dict
 
 
 def check_sequence(seq, scn: Scenario, *, pixels: bool = True) -> None:
-    """Assert every CONTRACT ground-truth invariant of ``seq`` against ``scn``."""
+    """Assert every ground-truth invariant (docs/format.md) of ``seq`` against ``scn``."""
     t_n, k_n = seq.gt.present.shape
     h, w = seq.height, seq.width
     for t in range(t_n):
@@ -79,11 +79,16 @@ def check_sequence(seq, scn: Scenario, *, pixels: bool = True) -> None:
             assert present == inside, (t, k)
             if not present:
                 assert np.all(np.isnan(box)) and np.all(np.isnan(seq.gt.center[t, k]))
+                assert np.all(np.isnan(seq.gt.path_center[t, k]))
                 assert seq.gt.visibility[t, k] == 0
                 assert np.all(np.isnan(seq.gt.visible_box[t, k]))
                 continue
             np.testing.assert_array_equal(box, np.float32([x0, y0, tw, th]))
             np.testing.assert_allclose(seq.gt.center[t, k], [x0 + tw / 2, y0 + th / 2])
+            # path_center: the planned centre before position noise, float32.
+            np.testing.assert_array_equal(
+                seq.gt.path_center[t, k], np.float32([scn.path_x[t, k], scn.path_y[t, k]])
+            )
             # visible_box is the box of the entity's pixels in labels.
             rows, cols = np.nonzero(lab == k + 1)
             if rows.size == 0:

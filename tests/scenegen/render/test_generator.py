@@ -303,3 +303,35 @@ def test_one_pixel_entity_and_single_frame():
     np.testing.assert_array_equal(seq.gt.visible_box[0, 0], [4, 3, 1, 1])
     assert seq.labels[0, 3, 4] == 1 and seq.labels.sum() == 1
     assert tuple(seq.frames[0, 3, 4]) == (10, 20, 30)
+
+
+def test_path_center_is_the_centre_before_position_noise():
+    # gt/path_center: the AR2 path; gt/center: the path plus per-frame noise, rounded to pixels.
+    walk = Motion(
+        x=AR2(boundary="reflect", sigma=0.5, margin=20),
+        y=AR2(boundary="reflect", sigma=0.5, margin=20),
+    )
+    app = Appearance(shape="rect", size=(5, 5))
+    cfg = SceneConfig(
+        width=400,
+        height=400,
+        n_frames=400,
+        background=Background(kind="uniform"),
+        entities=(
+            EntitySpec(name="calm", role="target", appearance=app, position=(100.0, 200.0),
+                       motion=walk, depth=((0, 0),)),
+            EntitySpec(name="noisy", role="target", appearance=app, position=(300.0, 200.0),
+                       motion=walk, position_noise=3.0, depth=((0, 1),)),
+            EntitySpec(name="late", role="distractor", appearance=app, position=(200.0, 50.0),
+                       appear=100, disappear=300, depth=((0, 2),)),
+        ),
+    )  # fmt: skip
+    gt = scenegen.generate(cfg, seed=4).gt
+    present = gt.present
+    assert np.array_equal(np.isnan(gt.path_center).any(axis=-1), ~present)
+    off = gt.center - gt.path_center
+    assert np.abs(off[:, 0]).max() <= 0.5  # no noise: rounding only
+    noisy = off[:, 1]
+    assert np.abs(noisy.mean(axis=0)).max() < 0.5
+    np.testing.assert_allclose(noisy.std(axis=0), np.hypot(3.0, 12**-0.5), rtol=0.15)
+    np.testing.assert_array_equal(gt.path_center[100:300, 2], np.float32([[200.0, 50.0]] * 200))

@@ -75,7 +75,7 @@ def test_verify_names_every_mismatch(tmp_path, capsys):
     err = capsys.readouterr().err.splitlines()
     assert len(err) == 3, err
     assert "fixture one-pixel, tracker meanshift: boxes" in err[0]
-    assert "differ beyond 0.01 px (largest 1 px)" in err[0]
+    assert "differ beyond atol=0.01, rtol=0.0 (largest difference 1)" in err[0]
     assert "fixture single-frame:" in err[1] and "holds different frames" in err[1]
     assert "fixture single-frame, tracker kalman:" in err[2] and "is missing" in err[2]
 

@@ -1,0 +1,110 @@
+"""The layout is defined once (scenegen.io.schema): files, reader, validator and docs agree."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+import scenegen
+from scenegen.io import TrackerResult, read, write, write_result
+from scenegen.io.schema import (
+    RESULT_FIELDS,
+    ROLES,
+    SEQUENCE_FIELDS,
+    field,
+    render_markdown,
+)
+from scenegen.io.validate import check_file
+
+DOC = Path(__file__).resolve().parents[3] / "docs" / "format.md"
+
+
+@pytest.fixture(scope="module")
+def seq():
+    return scenegen.generate("dps-occlusion", seed=2, frames=6)
+
+
+def _datasets(group: h5py.Group) -> dict[str, h5py.Dataset]:
+    out: dict[str, h5py.Dataset] = {}
+    group.visititems(
+        lambda name, obj: out.update({name: obj}) if isinstance(obj, h5py.Dataset) else None
+    )
+    return out
+
+
+def test_every_dataset_has_the_schema_description_and_units(tmp_path, seq):
+    path = tmp_path / "s.h5"
+    write(path, seq)
+    with h5py.File(path) as f:
+        assert f.attrs["conventions"].count("\n") >= 3
+        g = f[f"sequences/{seq.name}"]
+        t, h, w, k = seq.n_frames, seq.height, seq.width, len(seq.entities)
+        found = _datasets(g)
+        assert len(found) == len(SEQUENCE_FIELDS) - 1 + k  # one template per entity
+        for name, ds in found.items():
+            f_ = field("templates/<id>" if name.startswith("templates/") else name)
+            assert ds.attrs["description"] == f_.description and ds.attrs["units"] == f_.units
+            assert ds.dtype.kind in "OS" if f_.dtype == "string" else ds.dtype == f_.dtype
+            if "<" not in f_.path:
+                assert ds.shape == f_.shape_for(T=t, H=h, W=w, K=k), name
+
+
+def test_result_datasets_have_description_and_units(tmp_path):
+    res = TrackerResult(
+        tracker="shm", params={}, seed=0, sequence="x",
+        target_ids=np.array([1, 2], np.int32), boxes=np.zeros((3, 2, 4), np.float32),
+        orderings=np.array([[0, 1]], np.int16), order_prob=np.ones((3, 1), np.float32),
+    )  # fmt: skip
+    write_result(tmp_path / "r.h5", res)
+    with h5py.File(tmp_path / "r.h5") as f:
+        found = _datasets(f["results/shm"])
+        assert sorted(found) == sorted(r.path for r in RESULT_FIELDS)
+        for name, ds in found.items():
+            assert ds.attrs["units"] == field(f"results/{name}").units
+
+
+def test_file_without_path_center_or_attrs_reads_as_nan_and_validates(tmp_path, seq):
+    path = tmp_path / "old.h5"
+    write(path, seq)
+    with h5py.File(path, "r+") as f:  # what files written before the field looked like
+        g = f[f"sequences/{seq.name}"]
+        del g["gt/path_center"]
+        del f.attrs["conventions"]
+        for ds in _datasets(g).values():
+            del ds.attrs["description"], ds.attrs["units"]
+    back = read(path)
+    assert back.gt.path_center.shape == seq.gt.center.shape
+    assert back.gt.path_center.dtype == np.float32 and np.isnan(back.gt.path_center).all()
+    np.testing.assert_array_equal(back.gt.box, seq.gt.box)
+    assert check_file(path) == []
+
+
+def test_validate_checks_path_center(tmp_path, seq):
+    path = tmp_path / "bad.h5"
+    write(path, seq)
+    with h5py.File(path, "r+") as f:
+        ds = f[f"sequences/{seq.name}/gt/path_center"]
+        ds[0, 0] = np.nan
+    assert any("gt/path_center NaN pattern" in line for line in check_file(path))
+    with h5py.File(path, "r+") as f:
+        g = f[f"sequences/{seq.name}/gt"]
+        del g["path_center"]
+        g.create_dataset("path_center", data=np.zeros((2, 2), np.float64))
+    problems = check_file(path)
+    assert any("gt/path_center has shape (2, 2), expected" in line for line in problems)
+    assert any("gt/path_center has dtype float64, expected float32" in line for line in problems)
+
+
+def test_roles_are_the_config_roles():
+    assert ROLES == ("target", "distractor", "occluder", "clutter")
+
+
+def test_docs_format_is_rendered_from_the_schema():
+    assert DOC.read_text(encoding="utf-8") == render_markdown(), (
+        "docs/format.md is out of date: run "
+        "python -c 'from scenegen.io.schema import render_markdown as r; "
+        'open("docs/format.md", "w").write(r())\''
+    )
