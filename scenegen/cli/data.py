@@ -37,6 +37,10 @@ def register(sub: argparse._SubParsersAction) -> None:
 
     p = sub.add_parser("validate", help="check a scenegen file; exit 1 on any problem")
     p.add_argument("file", type=Path)
+    p.add_argument(
+        "--deep", action="store_true",
+        help="also re-render each sequence from its config and seed and compare",
+    )  # fmt: skip
     p.set_defaults(func=cmd_validate)
 
     p = sub.add_parser("preview", help="PNG contact sheet, GIF or MP4 with ground truth drawn")
@@ -116,12 +120,13 @@ _DAMAGE = (KeyError, OSError, RuntimeError, TypeError, ValueError)
 def _inspect(path: str) -> dict[str, Any]:
     """Summary of a file; runs in a guarded child (``cmd_inspect``)."""
     from scenegen.io import open_checked
+    from scenegen.io.integrity import as_text
 
     out: dict[str, Any] = {"file": path}
     with open_checked(path) as f:
         try:
-            out["schema"] = str(f.attrs["schema"])
-            out["generator_version"] = str(f.attrs.get("generator_version", ""))
+            out["schema"] = as_text(f.attrs["schema"])
+            out["generator_version"] = as_text(f.attrs.get("generator_version", ""))
         except _DAMAGE as err:
             raise DataError(f"{path}: damaged file attributes: {_first_line(err)}") from None
         out["sequences"] = []
@@ -135,7 +140,7 @@ def _inspect(path: str) -> dict[str, Any]:
                 out["sequences"].append(
                     {
                         "name": name,
-                        "preset": str(g.attrs["preset"]),
+                        "preset": as_text(g.attrs["preset"]),
                         "seed": int(g.attrs["seed"]),
                         "n_frames": int(g.attrs["n_frames"]),
                         "height": int(g.attrs["height"]),
@@ -154,7 +159,7 @@ def _inspect(path: str) -> dict[str, Any]:
             try:
                 g = f[f"results/{name}"]
                 out["results"].append(
-                    {"tracker": name, "sequence": str(g.attrs.get("sequence", "")),
+                    {"tracker": name, "sequence": as_text(g.attrs.get("sequence", "")),
                      "shape": list(g["boxes"].shape) if "boxes" in g else None}
                 )  # fmt: skip
             except _DAMAGE as err:
@@ -199,7 +204,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
 
     from scenegen.io.validate import check_file
 
-    problems = check_file(args.file, isolate=True)
+    problems = check_file(args.file, isolate=True, deep=args.deep)
     if problems:
         for line in problems:
             print(line, file=sys.stderr)

@@ -19,6 +19,7 @@ file's length; ground truth (T x K) is read whole. Nothing here raises on a dama
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 from typing import Any
 
@@ -31,6 +32,7 @@ from scenegen.config import from_dict
 from scenegen.errors import ConfigError, DataError
 from scenegen.io import describe_open_error, describe_read_error, describe_temp_file
 from scenegen.io.guard import beat, call
+from scenegen.io.integrity import ATTRS_DIGEST, DIGEST, INTEGRITY, Hasher, as_text, attrs_digest
 from scenegen.io.schema import GT_FIELDS, RESULT_FIELDS, ROLES, SCHEMA, SEQUENCE_FIELDS
 
 __all__ = ["check_file"]
@@ -43,7 +45,9 @@ _RESULT_DTYPE = {f.path: f.numpy_dtype for f in RESULT_FIELDS}
 _ATTRS = ("seed", "config", "preset", "n_frames", "height", "width")
 
 
-def check_file(path: str | Path, *, check_pixels: bool = True, isolate: bool = False) -> list[str]:
+def check_file(
+    path: str | Path, *, check_pixels: bool = True, isolate: bool = False, deep: bool = False
+) -> list[str]:
     """Validate a scenegen file; return one line per problem found.
 
     Parameters
@@ -59,6 +63,10 @@ def check_file(path: str | Path, *, check_pixels: bool = True, isolate: bool = F
         metadata; isolated, a crash or a stall (no progress within the deadline) becomes
         one problem line instead of killing or hanging the caller. ``scenegen validate``
         always isolates.
+    deep : bool
+        Also re-render every sequence from its stored config and seed (rendering is
+        deterministic) and name every dataset whose values differ: catches edits that
+        were written with valid checksums and digests.
 
     Returns
     -------
@@ -72,7 +80,7 @@ def check_file(path: str | Path, *, check_pixels: bool = True, isolate: bool = F
     """
     p = Path(path)
     if isolate:
-        return _check_in_child(p, check_pixels)
+        return _check_in_child(p, check_pixels, deep)
     if not p.exists():
         return [f"{p}: no such file"]
     if p.is_dir():
@@ -86,20 +94,23 @@ def check_file(path: str | Path, *, check_pixels: bool = True, isolate: bool = F
         return [describe_open_error(p, err)]
     try:
         with f:
-            return _check_open_file(p, f, check_pixels)
+            problems = _check_open_file(p, f, check_pixels)
+            if deep and "sequences" in f:
+                problems += _check_deep(p, f)
+            return problems
     except _READ_ERRORS as err:
         return [f"{p}: damaged HDF5 metadata ({_one_line(err)})"]
 
 
-def _checked(path: str, check_pixels: bool) -> list[str]:
-    return check_file(path, check_pixels=check_pixels)
+def _checked(path: str, check_pixels: bool, deep: bool) -> list[str]:
+    return check_file(path, check_pixels=check_pixels, deep=deep)
 
 
-def _check_in_child(p: Path, check_pixels: bool) -> list[str]:
+def _check_in_child(p: Path, check_pixels: bool, deep: bool) -> list[str]:
     """:func:`check_file` in a guarded child (:mod:`scenegen.io.guard`): a crash or a
     stall of the HDF5 library (no progress within the deadline) is one problem line."""
     try:
-        problems: list[str] = call(_checked, str(p), check_pixels, label=str(p))
+        problems: list[str] = call(_checked, str(p), check_pixels, deep, label=str(p))
     except DataError as err:
         return [str(err)]
     return problems
@@ -130,7 +141,7 @@ def _check_open_file(p: Path, f: h5py.File, check_pixels: bool) -> list[str]:
         problems += _check_results(p, f["results"])
     if "sequences" not in f and "results" not in f:
         problems.append(f"{p}: holds neither /sequences nor /results")
-    return problems
+    return problems + _check_digests(p, f, check_pixels, problems)
 
 
 def _one_line(err: BaseException) -> str:
@@ -436,4 +447,178 @@ def _check_results(p: Path, root: h5py.Group) -> list[str]:
             and (orderings.min() < 0 or orderings.max() >= m)
         ):
             problems.append(f"{where}: orderings name positions outside 0..{m - 1}")
+    return problems
+
+
+# ---------------------------------------------------------------------------------------
+# Digests (scenegen.io.integrity) and the deep check
+
+
+def _named(problems: list[str], where: str, key: str) -> bool:
+    """Whether a problem line of ``where`` already names ``key`` (then a digest mismatch
+    of the same dataset is the same problem: not reported twice)."""
+    return any(
+        line.startswith(f"{where}: ") and re.search(rf"(^|[\s/]){re.escape(key)}(\s|\[|$)",
+                                                     line[len(where) + 2 :])
+        for line in problems
+    )  # fmt: skip
+
+
+def _values_digest(ds: h5py.Dataset) -> str:
+    """SHA-256 of a dataset's stored values, read a chunk row at a time."""
+    h = Hasher()
+    if ds.shape == () or ds.size == 0:
+        h.update(np.asarray(ds[()]))
+        return h.hexdigest()
+    step = ds.chunks[0] if ds.chunks else ds.shape[0]
+    for start in range(0, ds.shape[0], step):
+        beat()
+        h.update(ds[start : start + step])
+    return h.hexdigest()
+
+
+def _check_digests(p: Path, f: h5py.File, check_pixels: bool, found: list[str]) -> list[str]:
+    """Every dataset against its ``sha256``, every sealed group against ``attrs_sha256``.
+
+    Files written before digests existed (no root ``integrity``) are checked only where a
+    digest is present; files that declare ``integrity`` must carry all of them.
+    """
+    required = as_text(f.attrs.get(INTEGRITY, "")) == DIGEST
+    sealed = any(ATTRS_DIGEST in obj.attrs for obj in _groups(f))
+    if not required and sealed:
+        return [f"{p}: the root attribute {INTEGRITY} is missing (the file carries digests)"]
+    problems: list[str] = []
+    groups = [(f"{p}", f, "root")] + [(where, g, "") for where, g in _groups_named(p, f)]
+    for where, g, what in groups:
+        if ATTRS_DIGEST in g.attrs:
+            if as_text(g.attrs[ATTRS_DIGEST]) != attrs_digest(g.attrs) and not any(
+                line.startswith(f"{where}: ") and "attribute" in line for line in found
+            ):
+                problems.append(
+                    f"{where}: {what + ' ' if what else ''}attributes do not match their "
+                    "digest (changed after writing)"
+                )
+        elif required:
+            problems.append(f"{where}: missing attribute {ATTRS_DIGEST}")
+    for where, g in _groups_named(p, f):
+        for key, ds in _datasets(g):
+            beat()
+            if _named(found, where, key):
+                continue
+            if DIGEST not in ds.attrs:
+                if required:
+                    problems.append(f"{where}: {key} has no digest ({DIGEST} attribute)")
+                continue
+            if key in ("frames", "labels") and not check_pixels:
+                continue
+            try:
+                same = _values_digest(ds) == as_text(ds.attrs[DIGEST])
+                attrs_same = ATTRS_DIGEST not in ds.attrs or as_text(
+                    ds.attrs[ATTRS_DIGEST]) == attrs_digest(ds.attrs)  # fmt: skip
+            except _READ_ERRORS as err:
+                problems.append(f"{where}: {key} is unreadable ({describe_read_error(err)})")
+                continue
+            if not same:
+                problems.append(
+                    f"{where}: {key} does not match its digest (values changed after writing)"
+                )
+            elif not attrs_same:
+                problems.append(f"{where}: {key} attributes do not match their digest")
+    return problems
+
+
+def _datasets(g: h5py.Group) -> list[tuple[str, h5py.Dataset]]:
+    out: list[tuple[str, h5py.Dataset]] = []
+
+    def visit(key: str, obj: Any) -> None:
+        if isinstance(obj, h5py.Dataset):
+            out.append((key, obj))
+
+    g.visititems(visit)
+    return out
+
+
+def _groups_named(p: Path, f: h5py.File) -> list[tuple[str, h5py.Group]]:
+    out = []
+    for top, label in (("sequences", "sequence"), ("results", "result")):
+        if isinstance(f.get(top), h5py.Group):
+            for name, g in f[top].items():
+                if isinstance(g, h5py.Group):
+                    out.append((f"{p}: {label} {name!r}", g))
+    return out
+
+
+def _groups(f: h5py.File) -> list[Any]:
+    return [f] + [g for _, g in _groups_named(Path(""), f)]
+
+
+def _rows_differ(stored: NDArray[Any], fresh: NDArray[Any]) -> NDArray[np.bool_]:
+    """Per leading row: do the stored bytes differ from the re-rendered ones?"""
+    fresh = np.asarray(fresh).astype(stored.dtype, copy=False)
+    if stored.shape != fresh.shape:
+        return np.ones(max(len(stored), 1), dtype=bool)
+    n = stored.shape[0] if stored.ndim else 1
+    a = np.ascontiguousarray(stored).reshape(n, -1).view(np.uint8)
+    b = np.ascontiguousarray(fresh).reshape(n, -1).view(np.uint8)
+    return (a != b).any(axis=1)
+
+
+def _compare(
+    g: h5py.Group, changed: dict[str, list[int]], key: str, fresh: Any, start: int | None = None
+) -> None:
+    """Record in ``changed`` whether ``g[key]`` (rows ``start:``, or all) differs from
+    ``fresh``; an unreadable dataset is left to the other checks."""
+    try:
+        ds = g[key]
+        stored = ds[()] if start is None else ds[start : start + len(fresh)]
+    except _READ_ERRORS:
+        return
+    rows = np.flatnonzero(_rows_differ(stored, fresh))
+    if rows.size:
+        frames = [] if start is None else [start + int(r) for r in rows]
+        changed.setdefault(key, []).extend(frames)
+
+
+def _check_deep(p: Path, f: h5py.File) -> list[str]:
+    """Re-render each sequence from its config and seed; one line per dataset whose
+    values differ (naming the first frames where they do)."""
+    from scenegen.io.hdf5 import frames_per_block
+    from scenegen.render.plan import plan
+
+    problems: list[str] = []
+    for where, g in _groups_named(p, f):
+        if not where.startswith(f"{p}: sequence "):
+            continue
+        try:
+            cfg = from_dict(json.loads(as_text(g.attrs["config"])))
+            scn = plan(cfg, int(g.attrs["seed"]), preset=as_text(g.attrs["preset"]))
+        except (*_READ_ERRORS, ConfigError) as err:
+            problems.append(
+                f"{where}: cannot re-render (no usable config and seed: {_one_line(err)})"
+            )
+            continue
+        changed: dict[str, list[int]] = {}  # dataset -> frames (empty: not per frame)
+
+        for c in scn.chunks(frames_per_block(cfg.height, cfg.width)):
+            beat()
+            _compare(g, changed, "frames", c.frames, c.start)
+            _compare(g, changed, "labels", c.labels, c.start)
+            for key, values in c.gt.items():
+                if f"gt/{key}" in g:
+                    _compare(g, changed, f"gt/{key}", values, c.start)
+        ents = scn.entities()
+        _compare(g, changed, "entities/id", np.asarray(ents.id, np.int32))
+        for key, values in (("entities/role", ents.role), ("entities/name", ents.name)):
+            try:
+                stored = [as_text(v) for v in g[key][()]]
+            except _READ_ERRORS:
+                continue
+            if stored != [str(v) for v in values]:
+                changed.setdefault(key, [])
+        for eid, tpl in scn.template_images().items():
+            if f"templates/{int(eid)}" in g:
+                _compare(g, changed, f"templates/{int(eid)}", np.asarray(tpl, np.uint8))
+        for key, frames in changed.items():
+            at = f" at frames {_frames(sorted(set(frames)))}" if frames else ""
+            problems.append(f"{where}: {key} differs from a re-render of its config and seed{at}")
     return problems
