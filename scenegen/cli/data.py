@@ -215,7 +215,9 @@ def cmd_validate(args: argparse.Namespace) -> int:
 
 def _read(path: Path, name: str | None) -> Any:
     from scenegen.io import read
+    from scenegen.io.validate import require_valid
 
+    require_valid(path)  # no computing on a damaged or inconsistent file
     return read(path, name)
 
 
@@ -226,6 +228,9 @@ def cmd_preview(args: argparse.Namespace) -> int:
     seq = _read(args.file, args.sequence)
     boxes = None
     if args.result is not None:
+        from scenegen.io.validate import require_valid
+
+        require_valid(args.result)
         res = read_result(args.result)
         if res.boxes.shape[0] != seq.n_frames:
             raise DataError(

@@ -29,7 +29,10 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
     from scenegen.errors import DataError
     from scenegen.evaluation.evaluate import evaluate, format_table, to_json
     from scenegen.io import read, read_result
+    from scenegen.io.validate import require_valid
 
+    require_valid(args.file)  # no computing on a damaged or inconsistent file
+    require_valid(args.result)
     seq = read(args.file, args.sequence)
     res = read_result(args.result, args.tracker)
     if res.sequence and res.sequence != seq.name:

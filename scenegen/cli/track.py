@@ -42,11 +42,13 @@ def parse_params(items: list[str]) -> dict[str, Any]:
 
 def cmd_track(args: argparse.Namespace) -> int:
     from scenegen.io import read, write_result
+    from scenegen.io.validate import require_valid
     from scenegen.lab.run import run_tracker
 
     if args.seed < 0:
         raise ConfigError(f"--seed must be >= 0, got {args.seed}")
     params = parse_params(args.param)
+    require_valid(args.file)  # no computing on a damaged or inconsistent file
     seq = read(args.file, args.sequence)
     with bar(seq.n_frames - 1, f"track {args.tracker}", unit="frame") as pb:
         res = run_tracker(seq, args.tracker, params, args.seed, progress=lambda n: pb.update(1))

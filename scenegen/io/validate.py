@@ -35,7 +35,7 @@ from scenegen.io.guard import beat, call
 from scenegen.io.integrity import ATTRS_DIGEST, DIGEST, INTEGRITY, Hasher, as_text, attrs_digest
 from scenegen.io.schema import GT_FIELDS, RESULT_FIELDS, ROLES, SCHEMA, SEQUENCE_FIELDS
 
-__all__ = ["check_file"]
+__all__ = ["check_file", "require_valid"]
 
 _MAX_PER_KIND = 5  # frames listed per kind of problem
 _READ_ERRORS = (OSError, RuntimeError, KeyError, ValueError, TypeError)
@@ -100,6 +100,41 @@ def check_file(
             return problems
     except _READ_ERRORS as err:
         return [f"{p}: damaged HDF5 metadata ({_one_line(err)})"]
+
+
+def require_valid(path: str | Path) -> None:
+    """Refuse a file that :func:`check_file` (without the pixel pass) finds problems in.
+
+    The check verbs run before they compute on a file (``track``, ``evaluate``,
+    ``export``, ``preview``): layout, shapes, dtypes, NaN patterns against ``present``,
+    ids, roles and the digests of everything but frames and labels (whose chunks are
+    checksummed and fail when read). It runs in a guarded child, so it is also the
+    metadata preflight of :func:`scenegen.io.read`: a file that passes is not surveyed
+    again.
+
+    Parameters
+    ----------
+    path : str or Path
+
+    Raises
+    ------
+    DataError
+        The first problem line, with the count of the others: one line.
+    """
+    from scenegen.io import guard
+
+    p = Path(path)
+    try:
+        version = guard._version_key(p)
+    except OSError:
+        version = None
+    problems = check_file(p, check_pixels=False, isolate=True)
+    if problems:
+        more = len(problems) - 1
+        note = f" (and {more} more problem{'s' if more > 1 else ''}: run scenegen validate)"
+        raise DataError(problems[0] + (note if more else ""))
+    if version is not None:
+        guard._remember(version)
 
 
 def _checked(path: str, check_pixels: bool, deep: bool) -> list[str]:

@@ -410,3 +410,107 @@ def test_random_byte_damage_never_raises(copy):
         problems = check_file(p, isolate=True)
         assert all(isinstance(line, str) and line.startswith(f"{p}: ") for line in problems)
         assert all("\n" not in line for line in problems)
+
+
+def _nan_where_present(g, f):
+    box = g["gt/box"][()]
+    box[2, 0] = np.nan
+    g["gt/box"][...] = box
+
+
+@pytest.mark.parametrize(
+    ("verb", "damage", "needle"),
+    [
+        ("track", _nan_where_present, "gt/box NaN pattern disagrees with gt/present at frames 2"),
+        ("export", lambda g, f: replace(g, "gt/present", g["gt/present"][()].astype(np.int8)),
+         "gt/present has dtype int8, expected bool"),
+        ("preview", lambda g, f: replace(g, "gt/box", g["gt/box"][:5]),
+         "gt/box has shape (5, 3, 4), expected (8, 3, 4)"),
+        ("evaluate", lambda g, f: g["gt/depth"].__setitem__((1, 0), 9),
+         "gt/depth does not match its digest"),
+    ],
+)  # fmt: skip
+def test_verbs_refuse_bad_input_with_one_line(copy, tmp_path, capsys, verb, damage, needle):
+    p = edit(copy(), damage)
+    out = tmp_path / "out"
+    argv = {
+        "track": ["track", str(p), "--tracker", "kalman", "-o", str(out)],
+        "export": ["export", str(p), "--format", "mot", "-o", str(out)],
+        "preview": ["preview", str(p), "-o", str(out) + ".png"],
+        "evaluate": ["evaluate", str(p), str(p)],
+    }[verb]
+    assert main(argv) == 1
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and needle in err[0], err
+    assert not out.exists()
+
+
+def test_a_result_file_with_a_wrong_dtype_is_refused_by_evaluate(originals, tmp_path, capsys):
+    res = TrackerResult(
+        tracker="kalman", params={}, seed=0, sequence="small",
+        target_ids=np.array([1], np.int32), boxes=np.zeros((8, 1, 4), np.float32),
+    )  # fmt: skip
+    r = tmp_path / "r.h5"
+    write_result(r, res)
+    with h5py.File(r, "r+") as f:
+        del f["results/kalman/boxes"]
+        f["results/kalman/boxes"] = np.zeros((8, 1, 4), np.float64)
+    assert main(["evaluate", str(originals["gzip"]), str(r)]) == 1
+    (line,) = capsys.readouterr().err.splitlines()
+    assert "boxes has dtype float64, expected float32" in line
+
+
+def test_edits_with_valid_digests_are_caught_by_deep(copy):
+    def rewrite(g, f):
+        frame = g["frames"][3]
+        frame[0, 0] ^= 1
+        g["frames"][3] = frame
+        g["gt/depth"][...] = 9
+        for key in ("frames", "gt/depth"):
+            integrity.put_text(g[key], integrity.DIGEST, integrity.digest(g[key][()]))
+
+    p = edit(copy(), rewrite)
+    assert check_file(p) == []
+    assert check_file(p, deep=True) == [
+        f"{p}: {SEQ}: frames differs from a re-render of its config and seed at frames 3",
+        f"{p}: {SEQ}: gt/depth differs from a re-render of its config and seed at frames "
+        "0, 1, 2, 3, 4 (+3 more)",
+    ]
+    assert check_file(copy(), deep=True) == []
+
+
+def test_zeroed_chunks_and_renamed_entities_are_caught(copy):
+    p = copy("none")
+    with h5py.File(p) as f:
+        g = f["sequences/small"]
+        infos = {k: g[k].id.get_chunk_info(0) for k in ("gt/depth", "templates/1")}
+        names = g["entities/name"].id.get_chunk_info(0)
+    data = bytearray(p.read_bytes())
+    for info in infos.values():  # the data and its Fletcher-32 word: all zeros
+        data[info.byte_offset : info.byte_offset + info.size] = bytes(info.size)
+    at = data.index(b"wall", names.byte_offset)
+    data[at : at + 4] = b"wXll"
+    p.write_bytes(bytes(data))
+    problems = check_file(p)
+    for key in ("gt/depth", "templates/1"):
+        assert any(f"{SEQ}: {key} " in line for line in problems), problems
+    assert any("entities/name" in line for line in problems), problems
+
+
+def test_old_files_with_variable_length_strings_stay_readable_and_valid(copy):
+    p = copy()
+    with h5py.File(p, "r+") as f:
+        integrity.strip(f)
+        for obj in (f, f["sequences/small"]):
+            for key in list(obj.attrs):
+                value = obj.attrs[key]
+                if isinstance(value, bytes):
+                    obj.attrs[key] = value.decode()  # variable-length, as older writers did
+        g = f["sequences/small/entities"]
+        for key in ("role", "name"):
+            values = [v.decode() for v in g[key][()]]
+            del g[key]
+            g.create_dataset(key, data=values, dtype=h5py.string_dtype("utf-8"))
+    assert check_file(p) == []
+    seq = read(p)
+    assert list(seq.entities.name) == ["a", "b", "wall"] and seq.preset == ""
