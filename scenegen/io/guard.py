@@ -190,6 +190,11 @@ def _child(
 
 def _context() -> Any:
     methods = multiprocessing.get_all_start_methods()
+    if in_child() and "fork" in methods:
+        # A guarded child is a fresh single-threaded process that holds no HDF5 file open
+        # while it starts another guard (which it does only before any reading): forking it
+        # is safe, and spares a second fork server.
+        return multiprocessing.get_context("fork")
     if "forkserver" in methods:
         ctx = multiprocessing.get_context("forkserver")
         # Children fork from a server that has h5py imported already: ~10 ms per child.
