@@ -205,22 +205,29 @@ def _context() -> Any:
 
 @contextlib.contextmanager
 def _main_hidden() -> Any:
-    """Start children without re-running the caller's ``__main__``: ``spawn`` and
+    """Start a child without re-running the caller's ``__main__``: ``spawn`` and
     ``forkserver`` children import the main script unless it has neither ``__file__``
     nor ``__spec__``, and a plain script calling :func:`scenegen.io.read` at top level
     would then run again in every child (the functions run there live in scenegen)."""
+    # A daemonic process (a worker of a multiprocessing pool) may not start children,
+    # because it would leave them behind when it is terminated; a guarded child dies with
+    # its parent (PR_SET_PDEATHSIG, alarm), so the rule is lifted while it starts.
+    config = multiprocessing.current_process()._config
+    daemon = config.pop("daemon", None)
     main = sys.modules.get("__main__")
-    if main is None:
-        yield
-        return
-    saved = {k: main.__dict__[k] for k in ("__file__", "__spec__") if k in main.__dict__}
-    main.__dict__.pop("__file__", None)
-    main.__dict__["__spec__"] = None
+    saved = {}
+    if main is not None:
+        saved = {k: main.__dict__[k] for k in ("__file__", "__spec__") if k in main.__dict__}
+        main.__dict__.pop("__file__", None)
+        main.__dict__["__spec__"] = None
     try:
         yield
     finally:
-        main.__dict__.pop("__spec__", None)
-        main.__dict__.update(saved)
+        if main is not None:
+            main.__dict__.pop("__spec__", None)
+            main.__dict__.update(saved)
+        if daemon is not None:
+            config["daemon"] = daemon
 
 
 def _how(code: int | None) -> str:

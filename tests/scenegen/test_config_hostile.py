@@ -124,12 +124,12 @@ def test_ten_thousand_hostile_configs(data):
     check(data)
 
 
-def test_slowest_config_of_the_run_is_reported(capsys):
-    """Not a timing assertion: prints the slowest from_dict of the examples above."""
-    if TIMES:
-        with capsys.disabled():
-            print(f"\nhostile configs: {len(TIMES)} examples, slowest {max(TIMES):.3f} s")
-    assert all(t >= 0 for t in TIMES)
+@pytest.mark.slow
+def test_slowest_config_of_the_slow_run_is_reported(capsys):
+    """Not a timing assertion: prints how many examples ran and the slowest one."""
+    with capsys.disabled():
+        print(f"\nhostile configs: {len(TIMES)} examples, slowest {max(TIMES):.3f} s")
+    assert len(TIMES) >= 10_000
 
 
 def test_short_is_short_and_escaped():

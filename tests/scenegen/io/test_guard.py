@@ -158,3 +158,15 @@ def _alive(pid: int) -> bool:
             return fh.read().rsplit(")", 1)[1].split()[0] != "Z"
     except OSError:
         return False
+
+
+def _guarded_int(text):
+    return guard.call(int, text, label="x")
+
+
+def test_a_pool_worker_can_start_a_guard():
+    """Workers of a multiprocessing pool are daemonic; the guard still runs there."""
+    import multiprocessing
+
+    with multiprocessing.get_context("spawn").Pool(1) as pool:
+        assert pool.apply(_guarded_int, ("5",)) == 5
