@@ -536,6 +536,9 @@ def _check_digests(p: Path, f: h5py.File, check_pixels: bool, found: list[str]) 
         elif required:
             problems.append(f"{where}: missing attribute {ATTRS_DIGEST}")
     for where, g in _groups_named(p, f):
+        if required and where.startswith(f"{p}: sequence "):  # written by this version
+            problems += [f"{where}: missing dataset {key}" for key in sorted(_OPTIONAL)
+                         if key not in g and not _named(found, where, key)]  # fmt: skip
         for key, ds in _datasets(g):
             beat()
             if _named(found, where, key):
@@ -548,8 +551,10 @@ def _check_digests(p: Path, f: h5py.File, check_pixels: bool, found: list[str]) 
                 continue
             try:
                 same = _values_digest(ds) == as_text(ds.attrs[DIGEST])
-                attrs_same = ATTRS_DIGEST not in ds.attrs or as_text(
-                    ds.attrs[ATTRS_DIGEST]) == attrs_digest(ds.attrs)  # fmt: skip
+                attrs_same = (ATTRS_DIGEST not in ds.attrs and not required) or (
+                    ATTRS_DIGEST in ds.attrs
+                    and as_text(ds.attrs[ATTRS_DIGEST]) == attrs_digest(ds.attrs)
+                )
             except _READ_ERRORS as err:
                 problems.append(f"{where}: {key} is unreadable ({describe_read_error(err)})")
                 continue
