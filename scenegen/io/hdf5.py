@@ -678,10 +678,18 @@ def read(path: str | Path, name: str | None = None) -> Sequence:
     return _read_once(Path(path), name)
 
 
+def _members(p: Path, f: h5py.File, group: str) -> list[str]:
+    """Names in ``/group`` (none if absent); a damaged group is a DataError."""
+    try:
+        return list(f[group].keys()) if group in f else []
+    except (KeyError, ValueError, TypeError, OSError, RuntimeError) as err:
+        raise DataError(f"{p}: /{group} is damaged: {describe_read_error(err)}") from None
+
+
 def _read_once(p: Path, name: str | None) -> Sequence:
     with open_checked(p) as f:
         stamp = _stamp(f)
-        seqs = list(f.get("sequences", {}).keys())
+        seqs = _members(p, f, "sequences")
         if not seqs:
             raise DataError(f"{p}: holds no sequences")
         if name is None:
@@ -690,8 +698,8 @@ def _read_once(p: Path, name: str | None) -> Sequence:
             name = seqs[0]
         if name not in seqs:
             raise DataError(f"{p}: no sequence {name!r}; it holds {', '.join(seqs)}")
-        g = f[f"sequences/{name}"]
         try:
+            g = f[f"sequences/{name}"]
             config = from_dict(json.loads(g.attrs["config"]))
             entities = Entities(
                 id=g["entities/id"][()].astype(np.int32),
@@ -812,17 +820,17 @@ def read_result(path: str | Path, tracker: str | None = None) -> TrackerResult:
     """
     p = Path(path)
     with open_checked(p) as f:
-        if "results" not in f or not len(f["results"]):
+        names = _members(p, f, "results")
+        if not names:
             raise DataError(f"{p}: holds no tracker results")
-        names = list(f["results"].keys())
         if tracker is None:
             if len(names) > 1:
                 raise DataError(f"{p}: holds results of {', '.join(names)}; name one")
             tracker = names[0]
         if tracker not in names:
             raise DataError(f"{p}: no result for tracker {tracker!r}; it holds {', '.join(names)}")
-        g = f[f"results/{tracker}"]
         try:
+            g = f[f"results/{tracker}"]
             return TrackerResult(
                 tracker=as_text(g.attrs["tracker"]),
                 params=json.loads(g.attrs["params"]),
