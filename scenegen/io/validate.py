@@ -32,6 +32,7 @@ from scenegen.config import from_dict
 from scenegen.errors import ConfigError, DataError
 from scenegen.io import describe_open_error, describe_read_error, describe_temp_file
 from scenegen.io.guard import beat, call
+from scenegen.io.guard import timeout as guard_timeout
 from scenegen.io.integrity import ATTRS_DIGEST, DIGEST, INTEGRITY, Hasher, as_text, attrs_digest
 from scenegen.io.schema import GT_FIELDS, RESULT_FIELDS, ROLES, SCHEMA, SEQUENCE_FIELDS
 
@@ -145,7 +146,11 @@ def _check_in_child(p: Path, check_pixels: bool, deep: bool) -> list[str]:
     """:func:`check_file` in a guarded child (:mod:`scenegen.io.guard`): a crash or a
     stall of the HDF5 library (no progress within the deadline) is one problem line."""
     try:
-        problems: list[str] = call(_checked, str(p), check_pixels, deep, label=str(p))
+        # Planning a long scene for --deep may take a while before the first beat.
+        seconds = guard_timeout() * (10 if deep else 1)
+        problems: list[str] = call(
+            _checked, str(p), check_pixels, deep, label=str(p), seconds=seconds
+        )
     except DataError as err:
         return [str(err)]
     return problems
@@ -263,6 +268,7 @@ def _layout(where: str, g: h5py.Group) -> tuple[list[str], tuple[int, int, int, 
 def _read_small(where: str, g: h5py.Group, keys: list[str]) -> tuple[dict[str, Any], list[str]]:
     out, problems = {}, []
     for key in keys:
+        beat()
         try:
             out[key] = g[key][()]
         except _READ_ERRORS as err:
@@ -318,6 +324,7 @@ def _check_templates(where: str, grp: h5py.Group, ids: NDArray[Any]) -> list[str
 
 
 def _check_gt(where: str, gt: dict[str, NDArray[Any]]) -> list[str]:
+    beat()
     problems = []
     present = gt["present"].astype(bool)
     for key in ("box", "center", "path_center"):
