@@ -262,6 +262,24 @@ def variants(src: Path, n: int, seed: int, kinds: tuple[str, ...] = KINDS) -> li
     return out
 
 
+def old_format(src: Path, dst: Path) -> None:
+    """Copy ``src`` as files of older versions were: variable-length strings (on the
+    global heap), no digests."""
+    shutil.copyfile(src, dst)
+    with h5py.File(dst, "r+") as f:
+        integrity.strip(f)
+        groups = [*f.get("sequences", {}).values(), *f.get("results", {}).values()]
+        for obj in (f, *groups):
+            for key in list(obj.attrs):
+                if isinstance(obj.attrs[key], bytes):
+                    obj.attrs[key] = obj.attrs[key].decode()
+        for g in f.get("sequences", {}).values():
+            for key in ("entities/role", "entities/name"):
+                values = [v.decode() for v in g[key][()]]
+                del g[key]
+                g.create_dataset(key, data=values, dtype=h5py.string_dtype("utf-8"))
+
+
 # ---------------------------------------------------------------------------------------
 # Running the verbs on a variant (inside a guarded child)
 

@@ -18,14 +18,13 @@ import os
 import shutil
 from collections import Counter
 
-import h5py
 import numpy as np
 import pytest
-from damage import KINDS, RESULT_KINDS, content, run_case, variants
+from damage import KINDS, RESULT_KINDS, content, old_format, run_case, variants
 
 from scenegen.config import from_dict
 from scenegen.errors import DataError
-from scenegen.io import TrackerResult, guard, integrity, write_result, write_scenario
+from scenegen.io import TrackerResult, guard, write_result, write_scenario
 from scenegen.io.validate import check_file
 from scenegen.render.plan import plan
 
@@ -44,22 +43,6 @@ SCENE = {
 }  # fmt: skip
 
 
-def _old_format(src, dst):
-    """What files of older versions look like: variable-length strings, no digests."""
-    shutil.copyfile(src, dst)
-    with h5py.File(dst, "r+") as f:
-        integrity.strip(f)
-        for obj in (f, *f["sequences"].values()):
-            for key in list(obj.attrs):
-                if isinstance(obj.attrs[key], bytes):
-                    obj.attrs[key] = obj.attrs[key].decode()
-        for g in f["sequences"].values():
-            for key in ("entities/role", "entities/name"):
-                values = [v.decode() for v in g[key][()]]
-                del g[key]
-                g.create_dataset(key, data=values, dtype=h5py.string_dtype("utf-8"))
-
-
 @pytest.fixture(scope="module")
 def sources(tmp_path_factory):
     d = tmp_path_factory.mktemp("sources")
@@ -74,7 +57,7 @@ def sources(tmp_path_factory):
         orderings=np.array([[0]], np.int16), order_prob=np.ones((6, 1), np.float32),
     ))  # fmt: skip
     out["old"] = d / "old.h5"
-    _old_format(out["seq-none"], out["old"])
+    old_format(out["seq-none"], out["old"])
     for p in out.values():
         assert check_file(p) == [], p
     return out

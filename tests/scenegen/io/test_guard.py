@@ -10,9 +10,12 @@ import subprocess
 import sys
 import textwrap
 import time
+from pathlib import Path
 
 import pytest
+from damage import old_format
 
+import scenegen
 from scenegen.cli import main
 from scenegen.errors import ConfigError, DataError
 from scenegen.io import guard, read, read_result
@@ -23,11 +26,14 @@ FIXTURE = os.path.join(os.path.dirname(__file__), "..", "..", "..", "fixtures",
 
 
 def heap_zeroed(src: str, dst) -> None:
-    """Copy ``src`` with the body of its first global heap collection zeroed (the
-    collection header kept): libhdf5 then loops reading the strings stored there."""
-    data = bytearray(open(src, "rb").read())
+    """``src`` in the old format (strings on the global heap) with the body of its first
+    global heap collection zeroed (the collection header kept): libhdf5 then loops
+    reading the strings stored there."""
+    old = dst.with_name("old.h5")
+    old_format(Path(src), old)
+    data = bytearray(old.read_bytes())
     at = data.find(b"GCOL")
-    assert at > 0, "the fixture stores no variable-length strings"
+    assert at > 0, "no variable-length strings in the old-format copy"
     data[at + 16 : at + 4096] = bytes(4096 - 16)
     dst.write_bytes(bytes(data))
 
@@ -38,6 +44,13 @@ def looping(tmp_path, monkeypatch):
     path = tmp_path / "heap.h5"
     heap_zeroed(FIXTURE, path)
     return path
+
+
+def test_new_files_have_no_global_heap(tmp_path):
+    """Strings are fixed-length: nothing for a damaged heap to corrupt or loop on."""
+    path = tmp_path / "new.h5"
+    scenegen.write(path, scenegen.read(FIXTURE))
+    assert b"GCOL" not in path.read_bytes()
 
 
 def test_results_and_errors_come_back():
