@@ -113,7 +113,8 @@ def _changed(value: Any, rng: np.random.Generator) -> Any:
         return value + "x"
     if isinstance(value, (float, np.floating)):
         return 7.0 if np.isnan(value) else (np.nan if rng.random() < 0.3 else value + 1.0)
-    return value + 1
+    with np.errstate(over="ignore"):
+        return value + 1  # wraps at the top of an integer type: still another value
 
 
 def _edit_value(name: str, rng: np.random.Generator, reseal: bool) -> Callable[[h5py.File], None]:
