@@ -1,9 +1,9 @@
 """Files: the HDF5 layout, reading and writing, atomic writes, validation, export, preview.
 
 The names most users need (``read``, ``write``, ``read_result``, ``write_result``, ...)
-are re-exported here from :mod:`scenegen.io.hdf5`; ``scenegen.io.atomic``,
-``scenegen.io.validate``, ``scenegen.io.export`` and ``scenegen.io.preview`` are imported
-on demand.
+are re-exported here from :mod:`scenegen.io.hdf5` and :mod:`scenegen.io.results`;
+``scenegen.io.schema`` (the layout), ``scenegen.io.atomic``, ``scenegen.io.validate``,
+``scenegen.io.export`` and ``scenegen.io.preview`` are imported on demand.
 """
 
 from scenegen.io.hdf5 import (
@@ -12,7 +12,6 @@ from scenegen.io.hdf5 import (
     LIBVER,
     SCHEMA,
     LazyArray,
-    TrackerResult,
     atomic_path,
     clean_temp_files,
     describe_open_error,
@@ -22,14 +21,13 @@ from scenegen.io.hdf5 import (
     frames_per_block,
     open_checked,
     read,
-    read_result,
     sequence_names,
     temp_file_owner,
     temp_prefix,
     write,
-    write_result,
     write_scenario,
 )
+from scenegen.io.results import TrackerResult, read_result, write_result
 
 __all__ = [
     "BLOCK_BYTES",

@@ -177,7 +177,7 @@ RESULT_FIELDS: tuple[Field, ...] = (
 ATTRIBUTES: tuple[Attribute, ...] = (
     Attribute("/", "schema", "str", f'"{SCHEMA}"'),
     Attribute("/", "generator_version", "str", "scenegen version that wrote the file"),
-    Attribute("/", "conventions", "str", "the conventions below, one per line (optional)"),
+    Attribute("/", "conventions", "str", "the conventions above, one per line (optional)"),
     Attribute("/sequences/<name>/", "seed", "int", "the generation seed"),
     Attribute("/sequences/<name>/", "config", "str", "JSON of the fully resolved config"),
     Attribute("/sequences/<name>/", "preset", "str", 'the preset name, "" if none'),
@@ -221,13 +221,15 @@ def dataset_attrs(f: Field) -> dict[str, str]:
     return {"description": f.description, "units": f.units}
 
 
+def _cell(text: str) -> str:
+    return text.replace("|", "\\|")  # a literal bar inside a Markdown table cell
+
+
 def _table(fields: tuple[Field, ...]) -> list[str]:
     rows = ["| dataset | dtype | shape | units | description |", "|---|---|---|---|---|"]
     for f in fields:
-        note = " Optional." if f.optional else ""
-        rows.append(
-            f"| `{f.path}` | {f.dtype} | {f.shape_text} | {f.units} | {f.description}{note} |"
-        )
+        text = _cell(f.description + (" Optional." if f.optional else ""))
+        rows.append(f"| `{f.path}` | {f.dtype} | {f.shape_text} | {_cell(f.units)} | {text} |")
     return rows
 
 

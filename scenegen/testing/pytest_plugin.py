@@ -77,6 +77,7 @@ FIXTURE_NAMES = ("scenegen_sequence", "scenegen_fixture", "scenegen_expect")
 _GENERATOR_MODULES = (
     "config.py",
     "io/hdf5.py",
+    "io/schema.py",
     "presets.py",
     "render/compose.py",
     "render/draw.py",

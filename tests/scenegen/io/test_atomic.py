@@ -172,7 +172,7 @@ sys.exit(main(sys.argv[3:]))
     ("verb", "module", "name"),
     [
         ("generate", "scenegen.io.hdf5", "_write_templates"),  # frames and gt on disk
-        ("track", "scenegen.io.hdf5", "_write_header"),  # the result file just created
+        ("track", "scenegen.io.results", "_write_header"),  # the result file just created
         ("export", "scenegen.io.export", "_replace_dir"),  # every frame written, not swapped
     ],
 )

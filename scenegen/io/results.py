@@ -1,0 +1,147 @@
+"""Tracker result files (schema ``scenegen/1``, ``/results/<tracker>/``; the layout is
+:data:`scenegen.io.schema.RESULT_FIELDS`, described in ``docs/format.md``).
+
+Written atomically like sequence files, with ``description`` and ``units`` on every
+dataset; read through the same checks (:func:`scenegen.io.hdf5.open_checked`).
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import h5py
+import numpy as np
+from numpy.typing import NDArray
+
+from scenegen.errors import ConfigError, DataError
+from scenegen.io import guard
+from scenegen.io.atomic import atomic_path
+from scenegen.io.hdf5 import (
+    _WRITE_OPTIONS,
+    _dataset,
+    _members,
+    _seal,
+    _write_header,
+    describe_read_error,
+    open_checked,
+)
+from scenegen.io.integrity import as_text, put_attrs_digest, put_text
+from scenegen.io.schema import field
+
+__all__ = ["TrackerResult", "read_result", "write_result"]
+
+
+@dataclass
+class TrackerResult:
+    """One tracker's result in a result file.
+
+    Attributes
+    ----------
+    tracker : str
+    params : dict
+    seed : int
+    sequence : str
+        The name of the sequence tracked.
+    target_ids : ndarray of shape (M,), int32
+    boxes : ndarray of shape (T, M, 4), float32
+    orderings : ndarray of shape (L, M), int16, or None
+        SHM trackers only: target positions nearest first, one row per ordering.
+    order_prob : ndarray of shape (T, L), float32, or None
+    """
+
+    tracker: str
+    params: dict[str, Any]
+    seed: int
+    sequence: str
+    target_ids: NDArray[np.int32]
+    boxes: NDArray[np.float32]
+    orderings: NDArray[np.int16] | None = None
+    order_prob: NDArray[np.float32] | None = None
+
+
+def write_result(path: str | Path, *results: TrackerResult) -> None:
+    """Write tracker results to a result file (atomically), one group per tracker.
+
+    Parameters
+    ----------
+    path : str or Path
+    *results : TrackerResult
+        At least one; at most one per tracker name.
+
+    Raises
+    ------
+    ConfigError
+        No result, two results of one tracker, or a missing folder.
+    """
+    if not results:
+        raise ConfigError("write_result needs at least one result")
+    with atomic_path(path) as tmp, h5py.File(tmp, "w", **_WRITE_OPTIONS) as f:
+        _write_header(f)
+        root = f.create_group("results")
+        for r in results:
+            if r.tracker in root:
+                raise ConfigError(f"two results for tracker {r.tracker!r} in one file")
+            g = root.create_group(r.tracker)
+            put_text(g, "tracker", r.tracker)
+            put_text(g, "params", json.dumps(r.params, sort_keys=True, default=str))
+            g.attrs["seed"] = int(r.seed)
+            put_text(g, "sequence", r.sequence)
+            put_attrs_digest(g)
+            arrays = {"target_ids": r.target_ids, "boxes": r.boxes}
+            if r.orderings is not None and r.order_prob is not None:
+                arrays |= {"orderings": r.orderings, "order_prob": r.order_prob}
+            for key, arr in arrays.items():
+                spec = field(f"results/{key}")
+                _dataset(g, spec, name=key, data=np.asarray(arr, dtype=spec.dtype))
+        _seal(f)
+    guard.trust(path)
+
+
+def read_result(path: str | Path, tracker: str | None = None) -> TrackerResult:
+    """Read one tracker's result (the only one if ``tracker`` is None).
+
+    Parameters
+    ----------
+    path : str or Path
+    tracker : str, optional
+
+    Returns
+    -------
+    TrackerResult
+
+    Raises
+    ------
+    DataError
+        If the file is not a result file, is damaged, or has no (or several, unnamed)
+        results.
+    """
+    p = Path(path)
+    with open_checked(p) as f:
+        names = _members(p, f, "results")
+        if not names:
+            raise DataError(f"{p}: holds no tracker results")
+        if tracker is None:
+            if len(names) > 1:
+                raise DataError(f"{p}: holds results of {', '.join(names)}; name one")
+            tracker = names[0]
+        if tracker not in names:
+            raise DataError(f"{p}: no result for tracker {tracker!r}; it holds {', '.join(names)}")
+        try:
+            g = f[f"results/{tracker}"]
+            return TrackerResult(
+                tracker=as_text(g.attrs["tracker"]),
+                params=json.loads(g.attrs["params"]),
+                seed=int(g.attrs["seed"]),
+                sequence=as_text(g.attrs["sequence"]),
+                target_ids=g["target_ids"][()].astype(np.int32),
+                boxes=g["boxes"][()].astype(np.float32),
+                orderings=g["orderings"][()] if "orderings" in g else None,
+                order_prob=g["order_prob"][()] if "order_prob" in g else None,
+            )
+        except (KeyError, ValueError, TypeError, OSError, RuntimeError) as err:
+            raise DataError(
+                f"{p}: result {tracker!r} is damaged: {describe_read_error(err)}"
+            ) from None
