@@ -634,7 +634,7 @@ def sequence_names(path: str | Path) -> list[str]:
     list of str
     """
     with open_checked(path) as f:
-        return list(f.get("sequences", {}).keys())
+        return _members(Path(path), f, "sequences")
 
 
 def _str_array(ds: h5py.Dataset) -> NDArray[np.str_]:
