@@ -22,6 +22,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+import reprlib
 import types
 import typing
 from dataclasses import dataclass, field
@@ -93,7 +94,7 @@ def _fail(path: str, msg: str) -> typing.NoReturn:
 
 def _check_color(path: str, c: Color) -> None:
     if len(c) != 3 or any(not 0 <= v <= 255 for v in c):
-        _fail(path, f"colour must be three integers in 0..255, got {list(c)}")
+        _fail(path, f"colour must be three integers in 0..255, got {_short(list(c))}")
 
 
 SKIMAGE_NAMES = (
@@ -122,11 +123,11 @@ def check_source(source: str) -> None:
     name = source[len("skimage:") :]
     if name.startswith("lfw_subset[") and name.endswith("]") and name[11:-1].isdigit():
         if int(name[11:-1]) >= N_FACES:
-            raise ConfigError(f"lfw_subset has faces 0..{N_FACES - 1}, got {source!r}")
+            raise ConfigError(f"lfw_subset has faces 0..{N_FACES - 1}, got {_short(source)}")
         return
     if name not in SKIMAGE_NAMES:
         raise ConfigError(
-            f"unknown image {source!r}; known: {', '.join(SKIMAGE_NAMES)}, lfw_subset[0..199]"
+            f"unknown image {_short(source)}; known: {', '.join(SKIMAGE_NAMES)}, lfw_subset[0..199]"
         )
 
 
@@ -161,9 +162,9 @@ class AR2:
 
     def __post_init__(self) -> None:
         if self.sigma < 0:
-            _fail("sigma", f"must be >= 0, got {self.sigma}")
+            _fail("sigma", f"must be >= 0, got {_short(self.sigma)}")
         if self.margin < 0:
-            _fail("margin", f"must be >= 0, got {self.margin}")
+            _fail("margin", f"must be >= 0, got {_short(self.margin)}")
 
 
 @dataclass(frozen=True)
@@ -213,19 +214,19 @@ class Appearance:
     def __post_init__(self) -> None:
         self._check_image()
         if self.size[0] < 1 or self.size[1] < 1:
-            _fail("size", f"width and height must be >= 1, got {list(self.size)}")
+            _fail("size", f"width and height must be >= 1, got {_short(list(self.size))}")
         if max(self.size) > MAX_SIDE:
-            _fail("size", f"width and height must be <= {MAX_SIDE}, got {list(self.size)}")
+            _fail("size", f"width and height must be <= {MAX_SIDE}, got {_short(list(self.size))}")
         if len(self.colors) < 1:
             _fail("colors", "needs at least one colour")
         for i, c in enumerate(self.colors):
             _check_color(f"colors[{i}]", c)
         if self.stripe_width < 1:
-            _fail("stripe_width", f"must be >= 1, got {self.stripe_width}")
+            _fail("stripe_width", f"must be >= 1, got {_short(self.stripe_width)}")
         if self.texture_sigma < 0:
-            _fail("texture_sigma", f"must be >= 0, got {self.texture_sigma}")
+            _fail("texture_sigma", f"must be >= 0, got {_short(self.texture_sigma)}")
         if not 1 <= self.noise_scale <= MAX_SIDE:
-            _fail("noise_scale", f"must be in 1..{MAX_SIDE}, got {self.noise_scale}")
+            _fail("noise_scale", f"must be in 1..{MAX_SIDE}, got {_short(self.noise_scale)}")
 
     def _check_image(self) -> None:
         if self.pattern == "image" and self.source is None:
@@ -239,7 +240,7 @@ class Appearance:
                 _fail("source", str(err))
         if self.crop is not None:
             if self.crop[0] < 0 or self.crop[1] < 0 or self.crop[2] < 1 or self.crop[3] < 1:
-                _fail("crop", f"needs x, y >= 0 and w, h >= 1, got {list(self.crop)}")
+                _fail("crop", f"needs x, y >= 0 and w, h >= 1, got {_short(list(self.crop))}")
         if self.tint is not None:
             _check_color("tint", self.tint)
 
@@ -259,9 +260,9 @@ class Variation:
 
     def __post_init__(self) -> None:
         if self.period <= 0:
-            _fail("period", f"must be > 0, got {self.period}")
+            _fail("period", f"must be > 0, got {_short(self.period)}")
         if not 0 <= self.shading < 1:
-            _fail("shading", f"must be in [0, 1), got {self.shading}")
+            _fail("shading", f"must be in [0, 1), got {_short(self.shading)}")
 
 
 @dataclass(frozen=True)
@@ -311,27 +312,29 @@ class EntitySpec:
     variation: Variation | None = None
 
     def __post_init__(self) -> None:
-        if not self.name:
-            _fail("name", "must not be empty")
+        _check_name("name", self.name)
         if self.position_noise < 0:
-            _fail("position_noise", f"must be >= 0, got {self.position_noise}")
+            _fail("position_noise", f"must be >= 0, got {_short(self.position_noise)}")
         if self.appear < 0:
-            _fail("appear", f"must be >= 0, got {self.appear}")
+            _fail("appear", f"must be >= 0, got {_short(self.appear)}")
         if self.disappear is not None and self.disappear <= self.appear:
-            _fail("disappear", f"must be > appear ({self.appear}), got {self.disappear}")
+            _fail(
+                "disappear",
+                f"must be > appear ({_short(self.appear)}), got {_short(self.disappear)}",
+            )
         if not self.depth:
             _fail("depth", "needs at least one (frame, depth) keyframe")
         frames = [f for f, _ in self.depth]
         if frames[0] != 0:
-            _fail("depth", f"the first keyframe must be at frame 0, got {frames[0]}")
+            _fail("depth", f"the first keyframe must be at frame 0, got {_short(frames[0])}")
         if any(b <= a for a, b in zip(frames, frames[1:], strict=False)):
-            _fail("depth", f"keyframe frames must increase, got {frames}")
+            _fail("depth", f"keyframe frames must increase, got {_short(frames)}")
         if any(d < 0 for _, d in self.depth):
-            _fail("depth", f"depths must be >= 0, got {[d for _, d in self.depth]}")
+            _fail("depth", f"depths must be >= 0, got {_short([d for _, d in self.depth])}")
         if self.position is None and self.mimic is None:
             _fail("position", "is required unless the entity mimics a target")
         if self.color_jitter < 0:
-            _fail("color_jitter", f"must be >= 0, got {self.color_jitter}")
+            _fail("color_jitter", f"must be >= 0, got {_short(self.color_jitter)}")
 
     def depth_at(self, t: int) -> int:
         """Depth value at frame ``t`` (the last keyframe at or before ``t``)."""
@@ -362,18 +365,22 @@ class ClutterSpec:
     name: str = "clutter"
 
     def __post_init__(self) -> None:
+        _check_name("name", self.name)
         if self.count < 0:
-            _fail("count", f"must be >= 0, got {self.count}")
+            _fail("count", f"must be >= 0, got {_short(self.count)}")
         if not self.palette:
             _fail("palette", "needs at least one colour")
         for i, c in enumerate(self.palette):
             _check_color(f"palette[{i}]", c)
         if not 1 <= self.n_colors <= MAX_COLORS:
-            _fail("n_colors", f"must be in 1..{MAX_COLORS}, got {self.n_colors}")
+            _fail("n_colors", f"must be in 1..{MAX_COLORS}, got {_short(self.n_colors)}")
         if self.min_size < 0 or self.min_size > min(self.appearance.size):
-            _fail("min_size", f"must be in 0..{min(self.appearance.size)}, got {self.min_size}")
+            _fail(
+                "min_size",
+                f"must be in 0..{min(self.appearance.size)}, got {_short(self.min_size)}",
+            )
         if self.region is not None and (self.region[2] <= 0 or self.region[3] <= 0):
-            _fail("region", f"width and height must be > 0, got {list(self.region)}")
+            _fail("region", f"width and height must be > 0, got {_short(list(self.region))}")
 
 
 @dataclass(frozen=True)
@@ -410,15 +417,15 @@ class Background:
         if not 0 <= self.low <= self.high <= 255:
             _fail("low", f"need 0 <= low <= high <= 255, got low={self.low} high={self.high}")
         if not 0 < self.scale <= MAX_BLUR:
-            _fail("scale", f"must be in (0, {MAX_BLUR:g}], got {self.scale}")
+            _fail("scale", f"must be in (0, {MAX_BLUR:g}], got {_short(self.scale)}")
 
 
 def _check_keyframes(name: str, keys: tuple[tuple[int, float, float], ...]) -> None:
     frames = [k[0] for k in keys]
     if frames and frames[0] < 0:
-        _fail(name, f"frames must be >= 0, got {frames}")
+        _fail(name, f"frames must be >= 0, got {_short(frames)}")
     if any(b <= a for a, b in zip(frames, frames[1:], strict=False)):
-        _fail(name, f"keyframe frames must increase, got {frames}")
+        _fail(name, f"keyframe frames must increase, got {_short(frames)}")
 
 
 @dataclass(frozen=True)
@@ -451,7 +458,7 @@ class Camera:
 
     def __post_init__(self) -> None:
         if not (0 <= self.extent[0] <= MAX_SIDE and 0 <= self.extent[1] <= MAX_SIDE):
-            _fail("extent", f"must be in 0..{MAX_SIDE}, got {list(self.extent)}")
+            _fail("extent", f"must be in 0..{MAX_SIDE}, got {_short(list(self.extent))}")
         if self.keyframes and (self.x is not None or self.y is not None):
             _fail("keyframes", "cannot be combined with x or y motion")
         _check_keyframes("keyframes", self.keyframes)
@@ -496,9 +503,12 @@ class Photometric:
         if any(k[1] < 0 for k in self.keyframes):
             _fail("keyframes", "gains must be >= 0")
         if not 0 <= self.motion_blur <= MAX_MOTION_BLUR:
-            _fail("motion_blur", f"must be in [0, {MAX_MOTION_BLUR:g}], got {self.motion_blur}")
+            _fail(
+                "motion_blur",
+                f"must be in [0, {MAX_MOTION_BLUR:g}], got {_short(self.motion_blur)}",
+            )
         if self.jpeg_quality is not None and not 1 <= self.jpeg_quality <= 100:
-            _fail("jpeg_quality", f"must be in 1..100, got {self.jpeg_quality}")
+            _fail("jpeg_quality", f"must be in 1..100, got {_short(self.jpeg_quality)}")
 
 
 @dataclass(frozen=True)
@@ -541,32 +551,31 @@ class SceneConfig:
         for f in ("width", "height", "n_frames"):
             v = getattr(self, f)
             if v < 1:
-                _fail(f, f"must be >= 1, got {v}")
+                _fail(f, f"must be >= 1, got {_short(v)}")
         if self.sensor_noise < 0:
-            _fail("sensor_noise", f"must be >= 0, got {self.sensor_noise}")
-        if not self.name or "/" in self.name:
-            _fail("name", f"must be a non-empty name without '/', got {self.name!r}")
+            _fail("sensor_noise", f"must be >= 0, got {_short(self.sensor_noise)}")
+        _check_name("name", self.name)
         names: dict[str, int] = {}
         for i, e in enumerate(self.entities):
             if e.name in names:
-                _fail(f"entities[{i}].name", f"duplicate name {e.name!r}")
+                _fail(f"entities[{i}].name", f"duplicate name {_short(e.name)}")
             names[e.name] = i
         for i, e in enumerate(self.entities):
             if e.mimic is not None:
                 if e.mimic not in names:
-                    _fail(f"entities[{i}].mimic", f"no entity named {e.mimic!r}")
+                    _fail(f"entities[{i}].mimic", f"no entity named {_short(e.mimic)}")
                 if self.entities[names[e.mimic]].mimic is not None:
-                    _fail(f"entities[{i}].mimic", f"{e.mimic!r} itself mimics another entity")
+                    _fail(f"entities[{i}].mimic", f"{_short(e.mimic)} itself mimics another entity")
         cnames = [c.name for c in self.clutter]
         for j, c in enumerate(self.clutter):
             if c.name in names or cnames.index(c.name) != j:
-                _fail(f"clutter[{j}].name", f"duplicate name {c.name!r}")
+                _fail(f"clutter[{j}].name", f"duplicate name {_short(c.name)}")
         n_total = len(self.entities) + sum(c.count for c in self.clutter)
         if n_total > _MAX_ENTITIES:
-            _fail("entities", f"at most {_MAX_ENTITIES} entities in all, got {n_total}")
+            _fail("entities", f"at most {_MAX_ENTITIES} entities in all, got {_short(n_total)}")
         for f, limit in (("width", MAX_SIDE), ("height", MAX_SIDE), ("n_frames", MAX_FRAMES)):
             if getattr(self, f) > limit:
-                _fail(f, f"must be <= {limit}, got {getattr(self, f)}")
+                _fail(f, f"must be <= {limit}, got {_short(getattr(self, f))}")
         if self.n_frames * n_total > MAX_FRAME_ENTITIES:
             _fail(
                 "n_frames",
@@ -602,18 +611,31 @@ class SceneConfig:
         p.text(repr(self))
 
     def _check_depth_ties(self) -> None:
-        keyframes = sorted({f for e in self.entities for f, _ in e.depth if f < self.n_frames})
-        for t in keyframes:
-            seen: dict[int, int] = {}
-            for i, e in enumerate(self.entities):
-                d = e.depth_at(t)
-                if d in seen:
-                    other = self.entities[seen[d]].name
-                    _fail(
-                        f"entities[{i}].depth",
-                        f"depth tie: {e.name!r} and {other!r} both have depth {d} at frame {t}",
-                    )
-                seen[d] = i
+        """No two entities share a depth at any frame: a sweep over the keyframes (a tie
+        can only start where some entity's depth changes), O(keyframes log keyframes)."""
+        changes: dict[int, list[tuple[int, int]]] = {}
+        for i, e in enumerate(self.entities):
+            for f, d in e.depth:
+                if f < self.n_frames:
+                    changes.setdefault(f, []).append((i, d))
+        current: dict[int, int] = {}  # entity index -> depth
+        holders: dict[int, set[int]] = {}  # depth -> entity indices
+        for t in sorted(changes):
+            for i, d in changes[t]:
+                if i in current:
+                    holders[current[i]].discard(i)
+                current[i] = d
+                holders.setdefault(d, set()).add(i)
+            clashes = [sorted(holders[d]) for d in {d for _, d in changes[t]}]
+            clashes = [c for c in clashes if len(c) > 1]
+            if clashes:  # report as a scan in id order would: the first repeated depth
+                first, i = min((c[1], c[0]) for c in clashes)[::-1]
+                e, other, d = self.entities[i], self.entities[first].name, current[i]
+                _fail(
+                    f"entities[{i}].depth",
+                    f"depth tie: {_short(e.name)} and {_short(other)} both have depth {d} "
+                    f"at frame {t}",
+                )
 
 
 # --------------------------------------------------------------------------------------
@@ -633,9 +655,67 @@ def _check_magnitudes(obj: Any, path: str) -> None:
             _fail(path, f"must be at most {MAX_MAGNITUDE:g} in magnitude, got {_short(obj)}")
 
 
+_REPR = reprlib.Repr()
+_REPR.maxlevel, _REPR.maxstring, _REPR.maxlong, _REPR.maxother = 2, 30, 30, 30
+_REPR.maxlist = _REPR.maxtuple = _REPR.maxdict = _REPR.maxset = 4
+SHORT = 60
+"""Most characters of a value echoed in an error message (:func:`_short`)."""
+
+
 def _short(value: Any) -> str:
-    text = repr(value)
-    return text if len(text) <= 24 else f"{text[:20]}... ({len(text)} characters)"
+    """A short, escaped, one-line excerpt of ``value`` for error messages.
+
+    Never longer than :data:`SHORT` characters plus a length note, never more than one
+    line (``repr`` escapes newlines and other control characters), and cheap on huge or
+    deeply nested values (only the first few items of the first levels are looked at).
+    """
+    try:
+        text = _REPR.repr(value)
+    except Exception:  # a value whose repr fails or recurses without end
+        text = f"<{type(value).__name__}>"
+    text = text.encode("ascii", "backslashreplace").decode("ascii")
+    if len(text) > SHORT:
+        text = f"{text[: SHORT - 3]}..."
+    if isinstance(value, (str, bytes)) and len(value) > _REPR.maxstring:
+        text += f" ({len(value)} characters)"
+    elif isinstance(value, (list, tuple, dict, set)) and len(value) > _REPR.maxlist:
+        text += f" ({len(value)} items)"
+    return text
+
+
+def _excerpt(text: str, limit: int = 150) -> str:
+    """A message of a parser, escaped to one ASCII line and cut to ``limit`` characters."""
+    text = text.encode("ascii", "backslashreplace").decode("ascii")
+    return text if len(text) <= limit else f"{text[: limit - 3]}..."
+
+
+def _key(key: Any) -> str:
+    """A mapping key as it appears in a field path: plain when it is a simple name,
+    else a short escaped excerpt (a key may hold newlines, quotes or megabytes)."""
+    if isinstance(key, str) and key.isidentifier() and len(key) <= 40 and key.isascii():
+        return key
+    return _short(key)
+
+
+MAX_NAME = 256
+"""Longest sequence, entity or clutter name, in characters."""
+
+
+def _check_name(path: str, name: str) -> None:
+    """Names become HDF5 group names and fixed-length strings: no NUL, no '/', not '.'
+    or '..', not empty, at most :data:`MAX_NAME` characters."""
+    if not name:
+        _fail(path, "must not be empty")
+    if len(name) > MAX_NAME:
+        _fail(path, f"must be at most {MAX_NAME} characters, got {len(name)}: {_short(name)}")
+    if "\0" in name:
+        _fail(path, f"must not contain a NUL character, got {_short(name)}")
+    if "/" in name:
+        _fail(path, f"must not contain '/', got {_short(name)}")
+    if name in (".", ".."):
+        _fail(path, f"must not be '.' or '..', got {_short(name)}")
+    if not name.isprintable():
+        _fail(path, f"must be printable (no newline or control character), got {_short(name)}")
 
 
 def _type_name(tp: Any) -> str:
@@ -655,7 +735,7 @@ def _convert(value: Any, tp: Any, path: str) -> Any:
     if origin is Literal:
         choices = get_args(tp)
         if value not in choices:
-            _fail(path, f"must be one of {', '.join(map(str, choices))}; got {value!r}")
+            _fail(path, f"must be one of {', '.join(map(str, choices))}; got {_short(value)}")
         return value
     if dataclasses.is_dataclass(tp):
         if isinstance(value, tp):
@@ -664,36 +744,36 @@ def _convert(value: Any, tp: Any, path: str) -> Any:
     if origin is tuple:
         args = get_args(tp)
         if isinstance(value, (str, bytes, dict)) or not hasattr(value, "__iter__"):
-            _fail(path, f"must be a list, got {value!r}")
+            _fail(path, f"must be a list, got {_short(value)}")
         items = list(value)
         if len(args) == 2 and args[1] is Ellipsis:
             return tuple(_convert(v, args[0], f"{path}[{i}]") for i, v in enumerate(items))
         if len(items) != len(args):
-            _fail(path, f"must have {len(args)} items, got {items!r}")
+            _fail(path, f"must have {len(args)} items, got {_short(items)}")
         return tuple(
             _convert(v, a, f"{path}[{i}]") for i, (v, a) in enumerate(zip(items, args, strict=True))
         )
     if tp is bool:
         if not isinstance(value, bool):
-            _fail(path, f"must be true or false, got {value!r}")
+            _fail(path, f"must be true or false, got {_short(value)}")
         return value
     if tp is int:
         if isinstance(value, bool) or not isinstance(value, (int, float)):
-            _fail(path, f"must be an integer, got {value!r}")
+            _fail(path, f"must be an integer, got {_short(value)}")
         if isinstance(value, float) and not value.is_integer():
-            _fail(path, f"must be an integer, got {value!r}")
+            _fail(path, f"must be an integer, got {_short(value)}")
         return int(value)
     if tp is float:
         if isinstance(value, bool) or not isinstance(value, (int, float)):
-            _fail(path, f"must be a number, got {value!r}")
+            _fail(path, f"must be a number, got {_short(value)}")
         if isinstance(value, int) and abs(value) > MAX_MAGNITUDE:
             _fail(path, f"must be at most {MAX_MAGNITUDE:g} in magnitude, got {_short(value)}")
         if not math.isfinite(value):
-            _fail(path, f"must be finite, got {value!r}")
+            _fail(path, f"must be finite, got {_short(value)}")
         return float(value)
     if tp is str:
         if not isinstance(value, str):
-            _fail(path, f"must be a string, got {value!r}")
+            _fail(path, f"must be a string, got {_short(value)}")
         return value
     _fail(path, f"cannot read a value of type {_type_name(tp)}")
 
@@ -707,13 +787,13 @@ def _normalise_depth(value: Any) -> Any:
 
 def _build(cls: type, data: Any, path: str) -> Any:
     if not isinstance(data, dict):
-        _fail(path, f"must be a mapping, got {data!r}")
+        _fail(path, f"must be a mapping, got {_short(data)}")
     hints = typing.get_type_hints(cls)
     fields = {f.name: f for f in dataclasses.fields(cls)}
     for key in data:
         if key not in fields:
             _fail(
-                f"{path}.{key}" if path else str(key),
+                f"{path}.{_key(key)}" if path else _key(key),
                 f"unknown field; valid fields: {', '.join(fields)}",
             )
     kwargs = {}
@@ -762,6 +842,79 @@ def to_dict(config: SceneConfig) -> dict[str, Any]:
     return _plain(config)
 
 
+MAX_CONFIG_BYTES = 4 * 2**20
+"""Largest config file read, in bytes."""
+MAX_ALIASES = 1000
+"""Most YAML aliases (``*name``) in one config."""
+MAX_NODES = 100_000
+"""Most YAML nodes in a config once its aliases are expanded: a few hundred bytes of
+nested aliases ("billion laughs") would otherwise expand to billions of values."""
+
+
+def _load_yaml(text: str) -> Any:
+    """``yaml.safe_load`` with the alias count and the expanded size bounded."""
+    import yaml
+
+    class Loader(yaml.SafeLoader):
+        aliases = 0
+
+        def compose_node(self, parent: Any, index: Any) -> Any:
+            if self.check_event(yaml.AliasEvent):
+                Loader.aliases += 1
+                if Loader.aliases > MAX_ALIASES:
+                    raise ConfigError(f"more than {MAX_ALIASES} YAML aliases")
+            return super().compose_node(parent, index)
+
+    loader = Loader(text)
+    try:
+        node = loader.get_single_node()
+        if node is None:
+            return None
+        _expanded_size(node)
+        return loader.construct_document(node)
+    finally:
+        loader.dispose()
+
+
+def _expanded_size(root: Any) -> int:
+    """Nodes of a composed YAML document with every alias expanded (shared nodes counted
+    once per reference); raises ConfigError beyond MAX_NODES or on a recursive alias."""
+    import yaml
+
+    sizes: dict[int, int] = {}
+    active: set[int] = set()
+    stack: list[tuple[Any, bool]] = [(root, False)]
+    while stack:
+        node, done = stack.pop()
+        key = id(node)
+        if done:
+            active.discard(key)
+            if isinstance(node, yaml.MappingNode):
+                children = [c for pair in node.value for c in pair]
+            elif isinstance(node, yaml.SequenceNode):
+                children = node.value
+            else:
+                children = []
+            total = 1 + sum(sizes[id(c)] for c in children)
+            if total > MAX_NODES:
+                raise ConfigError(
+                    f"the YAML expands to more than {MAX_NODES:,} values (nested aliases)"
+                )
+            sizes[key] = total
+            continue
+        if key in sizes:
+            continue
+        if key in active:
+            raise ConfigError("a YAML alias refers to a node that contains it")
+        active.add(key)
+        stack.append((node, True))
+        if isinstance(node, yaml.MappingNode):
+            stack.extend((c, False) for pair in node.value for c in pair)
+        elif isinstance(node, yaml.SequenceNode):
+            stack.extend((c, False) for c in node.value)
+    return sizes[id(root)]
+
+
 def load_config(path: str | Path) -> SceneConfig:
     """Read a YAML (``.yaml``/``.yml``) or JSON (``.json``) config file and validate it.
 
@@ -773,23 +926,27 @@ def load_config(path: str | Path) -> SceneConfig:
     """
     p = Path(path)
     try:
+        if p.stat().st_size > MAX_CONFIG_BYTES:
+            raise ConfigError(
+                f"{p}: config is {p.stat().st_size:,} bytes, more than {MAX_CONFIG_BYTES:,}"
+            )
         text = p.read_text(encoding="utf-8")
     except OSError as err:
         raise ConfigError(f"{p}: cannot read config: {err.strerror or err}") from None
+    except UnicodeDecodeError as err:
+        raise ConfigError(f"{p}: config is not UTF-8 text ({err.reason})") from None
     try:
         if p.suffix.lower() in (".yaml", ".yml"):
-            import yaml
-
-            data = yaml.safe_load(text)
+            data = _load_yaml(text)
         elif p.suffix.lower() == ".json":
             data = json.loads(text)
         else:
-            raise ConfigError(f"{p}: config must be .yaml, .yml or .json, got {p.suffix!r}")
-    except ConfigError:
-        raise
+            raise ConfigError(f"{p}: config must be .yaml, .yml or .json, got {_short(p.suffix)}")
+    except ConfigError as err:
+        raise ConfigError(str(err) if str(err).startswith(f"{p}: ") else f"{p}: {err}") from None
     except Exception as err:  # parser errors of yaml/json: report as one line
-        first = str(err).splitlines()[0] if str(err) else type(err).__name__
-        raise ConfigError(f"{p}: not valid {p.suffix[1:].upper()}: {first}") from None
+        first = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
+        raise ConfigError(f"{p}: not valid {p.suffix[1:].upper()}: {_excerpt(first)}") from None
     try:
         return from_dict(data)
     except ConfigError as err:

@@ -37,6 +37,10 @@ def register(sub: argparse._SubParsersAction) -> None:
 
     p = sub.add_parser("validate", help="check a scenegen file; exit 1 on any problem")
     p.add_argument("file", type=Path)
+    p.add_argument(
+        "--deep", action="store_true",
+        help="also re-render each sequence from its config and seed and compare",
+    )  # fmt: skip
     p.set_defaults(func=cmd_validate)
 
     p = sub.add_parser("preview", help="PNG contact sheet, GIF or MP4 with ground truth drawn")
@@ -132,16 +136,25 @@ def cmd_generate(args: argparse.Namespace) -> int:
     return 0
 
 
-def _inspect(path: Path) -> dict[str, Any]:
-    from scenegen.io import open_checked
+_DAMAGE = (KeyError, OSError, RuntimeError, TypeError, ValueError)
 
-    out: dict[str, Any] = {"file": str(path)}
+
+def _inspect(path: str) -> dict[str, Any]:
+    """Summary of a file; runs in a guarded child (``cmd_inspect``)."""
+    from scenegen.io import open_checked
+    from scenegen.io.integrity import as_text
+
+    out: dict[str, Any] = {"file": path}
     with open_checked(path) as f:
-        out["schema"] = str(f.attrs["schema"])
-        out["generator_version"] = str(f.attrs.get("generator_version", ""))
+        try:
+            out["schema"] = as_text(f.attrs["schema"])
+            out["generator_version"] = as_text(f.attrs.get("generator_version", ""))
+        except _DAMAGE as err:
+            raise DataError(f"{path}: damaged file attributes: {_first_line(err)}") from None
         out["sequences"] = []
-        for name, g in f.get("sequences", {}).items():
+        for name in _keys(path, f, "sequences"):
             try:
+                g = f[f"sequences/{name}"]
                 roles = [
                     r.decode() if isinstance(r, bytes) else str(r) for r in g["entities/role"][()]
                 ]
@@ -149,7 +162,7 @@ def _inspect(path: Path) -> dict[str, Any]:
                 out["sequences"].append(
                     {
                         "name": name,
-                        "preset": str(g.attrs["preset"]),
+                        "preset": as_text(g.attrs["preset"]),
                         "seed": int(g.attrs["seed"]),
                         "n_frames": int(g.attrs["n_frames"]),
                         "height": int(g.attrs["height"]),
@@ -159,19 +172,39 @@ def _inspect(path: Path) -> dict[str, Any]:
                         "chunks": list(frames.chunks or ()),
                     }
                 )
-            except (KeyError, OSError) as err:
-                raise DataError(f"{path}: sequence {name!r} is damaged: {err}") from None
+            except _DAMAGE as err:
+                raise DataError(
+                    f"{path}: sequence {name!r} is damaged: {_first_line(err)}"
+                ) from None
         out["results"] = []
-        for name, g in f.get("results", {}).items():
-            out["results"].append(
-                {"tracker": name, "sequence": str(g.attrs.get("sequence", "")),
-                 "shape": list(g["boxes"].shape) if "boxes" in g else None}
-            )  # fmt: skip
+        for name in _keys(path, f, "results"):
+            try:
+                g = f[f"results/{name}"]
+                out["results"].append(
+                    {"tracker": name, "sequence": as_text(g.attrs.get("sequence", "")),
+                     "shape": list(g["boxes"].shape) if "boxes" in g else None}
+                )  # fmt: skip
+            except _DAMAGE as err:
+                raise DataError(f"{path}: result {name!r} is damaged: {_first_line(err)}") from None
     return out
 
 
+def _keys(path: str, f: Any, group: str) -> list[str]:
+    try:
+        return list(f[group].keys()) if group in f else []
+    except _DAMAGE as err:
+        raise DataError(f"{path}: /{group} is damaged: {_first_line(err)}") from None
+
+
+def _first_line(err: BaseException) -> str:
+    text = str(err).strip().splitlines()
+    return text[0][:200] if text else type(err).__name__
+
+
 def cmd_inspect(args: argparse.Namespace) -> int:
-    info = _inspect(args.file)
+    from scenegen.io import guard
+
+    info = guard.call(_inspect, str(args.file), label=str(args.file))
     if args.json:
         print(json.dumps(info, indent=2))
         return 0
@@ -197,7 +230,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
         return cmd_validate_dataset(args)
     from scenegen.io.validate import check_file
 
-    problems = check_file(args.file, isolate=True)
+    problems = check_file(args.file, isolate=True, deep=args.deep)
     if problems:
         for line in problems:
             print(line, file=sys.stderr)
@@ -208,7 +241,9 @@ def cmd_validate(args: argparse.Namespace) -> int:
 
 def _read(path: Path, name: str | None) -> Any:
     from scenegen.io import read
+    from scenegen.io.validate import require_valid
 
+    require_valid(path)  # no computing on a damaged or inconsistent file
     return read(path, name)
 
 
@@ -219,6 +254,9 @@ def cmd_preview(args: argparse.Namespace) -> int:
     seq = _read(args.file, args.sequence)
     boxes = None
     if args.result is not None:
+        from scenegen.io.validate import require_valid
+
+        require_valid(args.result)
         res = read_result(args.result)
         if res.boxes.shape[0] != seq.n_frames:
             raise DataError(

@@ -70,7 +70,9 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
     )
     from scenegen.io import read, read_result
     from scenegen.io.mot import read_mot_tracker
+    from scenegen.io.validate import require_valid
 
+    require_valid(args.file)  # no computing on a damaged or inconsistent file
     check_options(args.gt_mode, args.visibility_threshold, args.otb_average)
     seq = read(args.file, args.sequence)
     options = {
@@ -84,6 +86,7 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
         report = evaluate_tracks(seq, boxes, ids, tracker=result.stem, **options)
         print(report.to_json() if args.json else format_table(report))
         return 0
+    require_valid(result)
     res = read_result(result, args.tracker)
     if res.sequence and res.sequence != seq.name:
         raise DataError(

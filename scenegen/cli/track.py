@@ -74,12 +74,14 @@ def check_writable(path: str | Path) -> None:
 
 def cmd_track(args: argparse.Namespace) -> int:
     from scenegen.io import read, write_result
+    from scenegen.io.validate import require_valid
     from scenegen.lab.run import run_tracker, tracker_label
 
     if args.seed < 0:
         raise ConfigError(f"--seed must be >= 0, got {args.seed}")
     params = parse_params(args.param)
     check_writable(args.output)
+    require_valid(args.file)  # no computing on a damaged or inconsistent file
     seq = read(args.file, args.sequence)
     label = tracker_label(args.tracker)
     with bar(seq.n_frames - 1, f"track {label}", unit="frame") as pb:

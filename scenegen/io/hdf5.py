@@ -52,12 +52,23 @@ from numpy.typing import NDArray
 
 from scenegen.config import from_dict, to_dict
 from scenegen.errors import ConfigError, DataError
+from scenegen.io import guard
 from scenegen.io.atomic import (
     atomic_path,
     clean_temp_files,
     describe_temp_file,
     temp_file_owner,
     temp_prefix,
+)
+from scenegen.io.integrity import (
+    DIGEST,
+    INTEGRITY,
+    Hasher,
+    as_text,
+    digest,
+    put_attrs_digest,
+    put_text,
+    text_array,
 )
 from scenegen.io.schema import CONVENTIONS, GT_FIELDS, SCHEMA, Field, dataset_attrs, field
 from scenegen.sequence import Entities, GroundTruth, Sequence
@@ -97,7 +108,6 @@ their chunk index (a fixed array) stays small whatever the frame count, so writi
 # Writers write whole chunks once and never read them back, so the chunk cache (8 MiB per
 # dataset by default in HDF5 2) would only hold memory: it is switched off.
 _WRITE_OPTIONS: dict[str, Any] = {"libver": LIBVER, "rdcc_nbytes": 0}
-_STR = h5py.string_dtype("utf-8")
 _BLOCK = 64  # frames per write call, at most
 _READ_ATTEMPTS = 5  # reads of a path that atomic writers keep replacing
 
@@ -169,17 +179,56 @@ def frames_per_block(height: int, width: int, limit: int = _BLOCK) -> int:
 
 
 def _write_header(f: h5py.File) -> None:
-    f.attrs["schema"] = SCHEMA
-    f.attrs["generator_version"] = _version()
-    f.attrs["conventions"] = "\n".join(CONVENTIONS)
+    put_text(f, "schema", SCHEMA)
+    put_text(f, "generator_version", _version())
+    put_text(f, "conventions", "\n".join(CONVENTIONS))
+    put_text(f, INTEGRITY, DIGEST)
+
+
+def _seal(f: h5py.File) -> None:
+    """Last step of every write: the digest of the root's attributes."""
+    put_attrs_digest(f)
 
 
 def _dataset(g: h5py.Group, f: Field, *, name: str | None = None, **kwargs: Any) -> h5py.Dataset:
     """Create the dataset of ``f`` in ``g`` (at ``name``, default its path) with its
-    ``description`` and ``units`` attributes; ``kwargs`` go to ``create_dataset``."""
+    ``description`` and ``units`` attributes; ``kwargs`` go to ``create_dataset``. Given
+    ``data``, the dataset is checksummed (chunked, Fletcher-32) and digested at once;
+    else the caller fills it and calls :func:`_digest` with the values written."""
+    data = kwargs.get("data")
+    if data is not None:
+        data = kwargs["data"] = np.asarray(data, dtype=kwargs.pop("dtype", None))
+        if data.size and "chunks" not in kwargs:
+            kwargs.update(chunks=data.shape, fletcher32=True)
     ds = g.create_dataset(f.path if name is None else name, **kwargs)
-    ds.attrs.update(dataset_attrs(f))
+    for key, value in dataset_attrs(f).items():
+        put_text(ds, key, value)
+    if data is not None:
+        _digest(ds, digest(data))
     return ds
+
+
+def _digest(ds: h5py.Dataset, hexdigest: str) -> None:
+    put_text(ds, DIGEST, hexdigest)
+    put_attrs_digest(ds)
+
+
+def _hashers(*datasets: h5py.Dataset) -> dict[str, Hasher]:
+    return {ds.name: Hasher() for ds in datasets}
+
+
+def _fill(ds: h5py.Dataset, start: int, values: Any, hashers: dict[str, Hasher]) -> None:
+    """Write rows ``start:`` of ``ds`` (converted to its dtype first, so the digest is of
+    the values stored) and feed them to its hasher; rows come in order."""
+    arr = np.asarray(values, dtype=ds.dtype)
+    if ds.size:
+        ds[start : start + arr.shape[0]] = arr
+    hashers[ds.name].update(arr)
+
+
+def _close_hashers(f: h5py.File, hashers: dict[str, Hasher]) -> None:
+    for name, h in hashers.items():
+        _digest(f[name], h.hexdigest())
 
 
 def _create_sequence_group(
@@ -191,11 +240,12 @@ def _create_sequence_group(
     g = f.require_group("sequences").create_group(name)
     t, h, w = seq_meta["n_frames"], seq_meta["height"], seq_meta["width"]
     g.attrs["seed"] = int(seq_meta["seed"])
-    g.attrs["config"] = json.dumps(seq_meta["config"], sort_keys=True)
-    g.attrs["preset"] = seq_meta["preset"]
+    put_text(g, "config", json.dumps(seq_meta["config"], sort_keys=True))
+    put_text(g, "preset", str(seq_meta["preset"]))
     g.attrs["n_frames"] = t
     g.attrs["height"] = h
     g.attrs["width"] = w
+    put_attrs_digest(g)
     filt = filter_options(compression)
     pixels = []
     for f in (field("frames"), field("labels")):
@@ -203,8 +253,9 @@ def _create_sequence_group(
         pixels.append(_dataset(g, f, shape=shape, dtype=f.dtype, chunks=(1, *shape[1:]), **filt))
     g.create_group("entities")
     _dataset(g, field("entities/id"), data=entities.id.astype(np.int32))
-    _dataset(g, field("entities/role"), data=entities.role.astype(object), dtype=_STR)
-    _dataset(g, field("entities/name"), data=entities.name.astype(object), dtype=_STR)
+    # Fixed-length strings: out of the global heap (see scenegen.io.integrity).
+    _dataset(g, field("entities/role"), data=text_array(entities.role))
+    _dataset(g, field("entities/name"), data=text_array(entities.name))
     return g, pixels[0], pixels[1]
 
 
@@ -226,8 +277,10 @@ def _create_gt(g: h5py.Group, t: int, k: int, rows: int) -> dict[str, h5py.Datas
 def _write_gt(g: h5py.Group, gt: dict[str, NDArray[Any]]) -> None:
     t, k = np.shape(gt["present"])[:2]
     for key, ds in _create_gt(g, t, k, _BLOCK).items():
+        arr = np.asarray(gt[key], dtype=GT_FIELDS[key])
         if ds.size:
-            ds[...] = np.asarray(gt[key], dtype=GT_FIELDS[key])
+            ds[...] = arr
+        _digest(ds, digest(arr.astype(ds.dtype)))
 
 
 def _write_templates(g: h5py.Group, templates: dict[int, NDArray[np.uint8]]) -> None:
@@ -236,10 +289,7 @@ def _write_templates(g: h5py.Group, templates: dict[int, NDArray[np.uint8]]) -> 
     for eid, tpl in templates.items():
         arr = np.asarray(tpl, dtype=np.uint8)
         name = f"templates/{int(eid)}"
-        if arr.size:
-            _dataset(g, f, name=name, data=arr, chunks=arr.shape, fletcher32=True)
-        else:
-            _dataset(g, f, name=name, data=arr)
+        _dataset(g, f, name=name, data=arr)
 
 
 def _meta(seq: Sequence) -> dict[str, Any]:
@@ -278,14 +328,18 @@ def write(path: str | Path, *sequences: Sequence, compression: str = "gzip") -> 
         _write_header(f)
         for seq in sequences:
             g, frames, labels = _create_sequence_group(f, _meta(seq), seq.entities, compression)
+            hashers = _hashers(frames, labels)
             # Blocks of whole chunks: bounded memory for lazy inputs, few h5py calls.
             block = frames_per_block(seq.height, seq.width)
             for t in range(0, seq.n_frames, block):
                 stop = min(t + block, seq.n_frames)
-                frames[t:stop] = np.asarray(seq.frames[t:stop])
-                labels[t:stop] = np.asarray(seq.labels[t:stop])
+                _fill(frames, t, seq.frames[t:stop], hashers)
+                _fill(labels, t, seq.labels[t:stop], hashers)
+            _close_hashers(f, hashers)
             _write_gt(g, seq.gt.as_dict())
             _write_templates(g, seq.templates)
+        _seal(f)
+    guard.trust(path)
 
 
 def write_scenario(
@@ -328,18 +382,21 @@ def write_scenario(
         _write_header(f)
         g, frames, labels = _create_sequence_group(f, meta, scenario.entities(), compression)
         gt = _create_gt(g, cfg.n_frames, scenario.n_entities, block)
+        hashers = _hashers(frames, labels, *gt.values())
         for c in scenario.chunks(block):
             stop = c.start + c.frames.shape[0]
             # Chunk-aligned writes: h5py writes whole chunks without reading them back.
-            frames[c.start : stop] = c.frames
-            labels[c.start : stop] = c.labels
+            _fill(frames, c.start, c.frames, hashers)
+            _fill(labels, c.start, c.labels, hashers)
             for key, ds in gt.items():
-                if ds.size:
-                    ds[c.start : stop] = c.gt[key]
+                _fill(ds, c.start, c.gt[key], hashers)
             if progress is not None:
                 progress(stop)
             del c  # else this block stays alive while the next one renders: twice the memory
+        _close_hashers(f, hashers)
         _write_templates(g, scenario.template_images())
+        _seal(f)
+    guard.trust(path)
 
 
 # ---------------------------------------------------------------------------------------
@@ -460,6 +517,8 @@ class LazyArray:
         if self._file is None or not self._file.id.valid:
             if not os.path.exists(self.path):
                 raise DataError(f"{self.path}: no longer exists")
+            if self._stamp is None:  # not opened through read(): a file not yet checked
+                guard.preflight(self.path)
             try:
                 f = h5py.File(self.path, "r")
             except OSError as err:
@@ -531,7 +590,9 @@ def open_checked(path: str | Path) -> h5py.File:
     ------
     DataError
         If the file is missing, a folder, a temporary file of an unfinished write, not
-        HDF5, truncated, being written by another process, or of another schema.
+        HDF5, truncated, being written by another process, or of another schema; or if
+        its metadata is damaged or cannot be read within the deadline
+        (:func:`scenegen.io.guard.preflight`).
     """
     p = Path(path)
     if not p.exists():
@@ -541,6 +602,7 @@ def open_checked(path: str | Path) -> h5py.File:
     temp = describe_temp_file(p)
     if temp is not None:  # incomplete by construction, even when HDF5 could open it
         raise DataError(temp)
+    guard.preflight(p)  # metadata read in a child under a deadline, once per version
     try:
         f = h5py.File(p, "r")
     except OSError as err:
@@ -572,7 +634,7 @@ def sequence_names(path: str | Path) -> list[str]:
     list of str
     """
     with open_checked(path) as f:
-        return list(f.get("sequences", {}).keys())
+        return _members(Path(path), f, "sequences")
 
 
 def _str_array(ds: h5py.Dataset) -> NDArray[np.str_]:
@@ -623,10 +685,18 @@ def read(path: str | Path, name: str | None = None) -> Sequence:
     return _read_once(Path(path), name)
 
 
+def _members(p: Path, f: h5py.File, group: str) -> list[str]:
+    """Names in ``/group`` (none if absent); a damaged group is a DataError."""
+    try:
+        return list(f[group].keys()) if group in f else []
+    except (KeyError, ValueError, TypeError, OSError, RuntimeError) as err:
+        raise DataError(f"{p}: /{group} is damaged: {describe_read_error(err)}") from None
+
+
 def _read_once(p: Path, name: str | None) -> Sequence:
     with open_checked(p) as f:
         stamp = _stamp(f)
-        seqs = list(f.get("sequences", {}).keys())
+        seqs = _members(p, f, "sequences")
         if not seqs:
             raise DataError(f"{p}: holds no sequences")
         if name is None:
@@ -635,8 +705,8 @@ def _read_once(p: Path, name: str | None) -> Sequence:
             name = seqs[0]
         if name not in seqs:
             raise DataError(f"{p}: no sequence {name!r}; it holds {', '.join(seqs)}")
-        g = f[f"sequences/{name}"]
         try:
+            g = f[f"sequences/{name}"]
             config = from_dict(json.loads(g.attrs["config"]))
             entities = Entities(
                 id=g["entities/id"][()].astype(np.int32),
@@ -645,7 +715,7 @@ def _read_once(p: Path, name: str | None) -> Sequence:
             )
             gt = _read_gt(g)
             templates = {int(k): v[()] for k, v in g["templates"].items()}
-            seed, preset = int(g.attrs["seed"]), str(g.attrs["preset"])
+            seed, preset = int(g.attrs["seed"]), as_text(g.attrs["preset"])
             frames = LazyArray(p, f"sequences/{name}/frames", stamp=stamp)
             labels = LazyArray(p, f"sequences/{name}/labels", stamp=stamp)
         except _Replaced:

@@ -17,14 +17,18 @@ import numpy as np
 from numpy.typing import NDArray
 
 from scenegen.errors import ConfigError, DataError
+from scenegen.io import guard
 from scenegen.io.atomic import atomic_path
 from scenegen.io.hdf5 import (
     _WRITE_OPTIONS,
     _dataset,
+    _members,
+    _seal,
     _write_header,
     describe_read_error,
     open_checked,
 )
+from scenegen.io.integrity import as_text, put_attrs_digest, put_text
 from scenegen.io.schema import field
 
 __all__ = ["TrackerResult", "read_result", "write_result"]
@@ -81,16 +85,19 @@ def write_result(path: str | Path, *results: TrackerResult) -> None:
             if r.tracker in root:
                 raise ConfigError(f"two results for tracker {r.tracker!r} in one file")
             g = root.create_group(r.tracker)
-            g.attrs["tracker"] = r.tracker
-            g.attrs["params"] = json.dumps(r.params, sort_keys=True, default=str)
+            put_text(g, "tracker", r.tracker)
+            put_text(g, "params", json.dumps(r.params, sort_keys=True, default=str))
             g.attrs["seed"] = int(r.seed)
-            g.attrs["sequence"] = r.sequence
+            put_text(g, "sequence", r.sequence)
+            put_attrs_digest(g)
             arrays = {"target_ids": r.target_ids, "boxes": r.boxes}
             if r.orderings is not None and r.order_prob is not None:
                 arrays |= {"orderings": r.orderings, "order_prob": r.order_prob}
             for key, arr in arrays.items():
-                f = field(f"results/{key}")
-                _dataset(g, f, name=key, data=np.asarray(arr, dtype=f.dtype))
+                spec = field(f"results/{key}")
+                _dataset(g, spec, name=key, data=np.asarray(arr, dtype=spec.dtype))
+        _seal(f)
+    guard.trust(path)
 
 
 def read_result(path: str | Path, tracker: str | None = None) -> TrackerResult:
@@ -113,22 +120,22 @@ def read_result(path: str | Path, tracker: str | None = None) -> TrackerResult:
     """
     p = Path(path)
     with open_checked(p) as f:
-        if "results" not in f or not len(f["results"]):
+        names = _members(p, f, "results")
+        if not names:
             raise DataError(f"{p}: holds no tracker results")
-        names = list(f["results"].keys())
         if tracker is None:
             if len(names) > 1:
                 raise DataError(f"{p}: holds results of {', '.join(names)}; name one")
             tracker = names[0]
         if tracker not in names:
             raise DataError(f"{p}: no result for tracker {tracker!r}; it holds {', '.join(names)}")
-        g = f[f"results/{tracker}"]
         try:
+            g = f[f"results/{tracker}"]
             return TrackerResult(
-                tracker=str(g.attrs["tracker"]),
+                tracker=as_text(g.attrs["tracker"]),
                 params=json.loads(g.attrs["params"]),
                 seed=int(g.attrs["seed"]),
-                sequence=str(g.attrs["sequence"]),
+                sequence=as_text(g.attrs["sequence"]),
                 target_ids=g["target_ids"][()].astype(np.int32),
                 boxes=g["boxes"][()].astype(np.float32),
                 orderings=g["orderings"][()] if "orderings" in g else None,

@@ -50,7 +50,8 @@ ROLES: tuple[str, ...] = tuple(get_args(Role))
 plus ``clutter``)."""
 
 STRING = "string"
-"""The dtype of variable-length UTF-8 string datasets."""
+"""The dtype of string datasets: fixed-length UTF-8 (read as bytes; files written before
+scenegen stored strings that way hold variable-length UTF-8, which reads as str)."""
 
 CONVENTIONS: tuple[str, ...] = (
     "x = column, y = row; pixel (row r, column c) covers [c, c+1) x [r, r+1).",
@@ -75,7 +76,7 @@ class Field:
         Path inside its group (``/sequences/<name>/`` or ``/results/<tracker>/``);
         ``<id>`` stands for each entity id.
     dtype : str
-        A numpy dtype name, or ``"string"`` (variable-length UTF-8).
+        A numpy dtype name, or ``"string"`` (fixed-length UTF-8; see :data:`STRING`).
     shape : tuple of str or int
         Symbolic shape, e.g. ``("T", "K", 4)``.
     description : str
@@ -268,8 +269,16 @@ def render_markdown() -> str:
         "",
         *_table(SEQUENCE_FIELDS),
         "",
-        "Frames, labels, ground truth and templates are stored with the Fletcher-32 checksum "
-        "filter, so a damaged chunk fails to read instead of returning wrong values.",
+        "Every dataset is stored with the Fletcher-32 checksum filter, so a damaged chunk "
+        "fails to read instead of returning wrong values, and carries `sha256`, the SHA-256 "
+        "of its values as stored (C order, stored dtype); the root and each sequence or "
+        "result group carry `attrs_sha256`, a digest of their other attributes, and the root "
+        '`integrity = "sha256"` says every dataset has a digest (`scenegen validate` checks '
+        "them all; files of older versions lack them and stay valid).",
+        "",
+        "Strings (attributes and `entities/role`, `entities/name`) are fixed-length UTF-8, "
+        "outside HDF5's unchecksummed global heap; h5py reads them as `bytes` "
+        "(`.decode()`). Files of older versions hold variable-length strings (read as `str`).",
         "",
         "## Tracker result datasets (`/results/<tracker>/`)",
         "",
@@ -290,7 +299,7 @@ def render_markdown() -> str:
         '    boxes = g["gt/box"][()]              # (T, K, 4) float32, NaN where absent',
         '    ids = g["entities/id"][()]           # entity k has id ids[k]',
         '    roles = g["entities/role"].asstr()[()]',
-        '    print(g["gt/box"].attrs["description"], g["gt/box"].attrs["units"])',
+        '    print(g["gt/box"].attrs["description"].decode())',
         "```",
         "",
     ]

@@ -18,11 +18,8 @@ file's length; ground truth (T x K) is read whole. Nothing here raises on a dama
 
 from __future__ import annotations
 
-import faulthandler
 import json
-import multiprocessing
-import signal
-from multiprocessing.connection import Connection
+import re
 from pathlib import Path
 from typing import Any
 
@@ -32,11 +29,14 @@ from numpy.typing import NDArray
 from scipy import ndimage
 
 from scenegen.config import from_dict
-from scenegen.errors import ConfigError
+from scenegen.errors import ConfigError, DataError
 from scenegen.io import describe_open_error, describe_read_error, describe_temp_file
+from scenegen.io.guard import beat, call
+from scenegen.io.guard import timeout as guard_timeout
+from scenegen.io.integrity import ATTRS_DIGEST, DIGEST, INTEGRITY, Hasher, as_text, attrs_digest
 from scenegen.io.schema import GT_FIELDS, RESULT_FIELDS, ROLES, SCHEMA, SEQUENCE_FIELDS
 
-__all__ = ["check_file"]
+__all__ = ["check_file", "require_valid"]
 
 _MAX_PER_KIND = 5  # frames listed per kind of problem
 _READ_ERRORS = (OSError, RuntimeError, KeyError, ValueError, TypeError)
@@ -46,7 +46,9 @@ _RESULT_DTYPE = {f.path: f.numpy_dtype for f in RESULT_FIELDS}
 _ATTRS = ("seed", "config", "preset", "n_frames", "height", "width")
 
 
-def check_file(path: str | Path, *, check_pixels: bool = True, isolate: bool = False) -> list[str]:
+def check_file(
+    path: str | Path, *, check_pixels: bool = True, isolate: bool = False, deep: bool = False
+) -> list[str]:
     """Validate a scenegen file; return one line per problem found.
 
     Parameters
@@ -57,9 +59,15 @@ def check_file(path: str | Path, *, check_pixels: bool = True, isolate: bool = F
         Also read every frame (checksums) and re-derive visible boxes and visibility
         from ``labels`` frame by frame.
     isolate : bool
-        Run the check in a child process. The HDF5 library can crash (segmentation
-        fault) on some corrupted metadata; isolated, such a crash becomes one problem
-        line instead of killing the caller. ``scenegen validate`` always isolates.
+        Run the check in a guarded child process (:func:`scenegen.io.guard.call`). The
+        HDF5 library can crash (segmentation fault) or loop forever on some corrupted
+        metadata; isolated, a crash or a stall (no progress within the deadline) becomes
+        one problem line instead of killing or hanging the caller. ``scenegen validate``
+        always isolates.
+    deep : bool
+        Also re-render every sequence from its stored config and seed (rendering is
+        deterministic) and name every dataset whose values differ: catches edits that
+        were written with valid checksums and digests.
 
     Returns
     -------
@@ -73,7 +81,7 @@ def check_file(path: str | Path, *, check_pixels: bool = True, isolate: bool = F
     """
     p = Path(path)
     if isolate:
-        return _check_in_child(p, check_pixels)
+        return _check_in_child(p, check_pixels, deep)
     if not p.exists():
         return [f"{p}: no such file"]
     if p.is_dir():
@@ -87,43 +95,65 @@ def check_file(path: str | Path, *, check_pixels: bool = True, isolate: bool = F
         return [describe_open_error(p, err)]
     try:
         with f:
-            return _check_open_file(p, f, check_pixels)
+            problems = _check_open_file(p, f, check_pixels)
+            if deep and "sequences" in f:
+                problems += _check_deep(p, f)
+            return problems
     except _READ_ERRORS as err:
         return [f"{p}: damaged HDF5 metadata ({_one_line(err)})"]
 
 
-def _child(path: str, check_pixels: bool, conn: Connection) -> None:
-    faulthandler.disable()  # a crash is reported by the parent, in one line
+def require_valid(path: str | Path) -> None:
+    """Refuse a file that :func:`check_file` (without the pixel pass) finds problems in.
+
+    The check verbs run before they compute on a file (``track``, ``evaluate``,
+    ``export``, ``preview``): layout, shapes, dtypes, NaN patterns against ``present``,
+    ids, roles and the digests of everything but frames and labels (whose chunks are
+    checksummed and fail when read). It runs in a guarded child, so it is also the
+    metadata preflight of :func:`scenegen.io.read`: a file that passes is not surveyed
+    again.
+
+    Parameters
+    ----------
+    path : str or Path
+
+    Raises
+    ------
+    DataError
+        The first problem line, with the count of the others: one line.
+    """
+    from scenegen.io import guard
+
+    p = Path(path)
     try:
-        problems = check_file(path, check_pixels=check_pixels)
-    except Exception as err:  # whatever else a damaged file provokes: one line, no traceback
-        problems = [f"{path}: could not be checked ({type(err).__name__}: {_one_line(err)})"]
-    conn.send(problems)
-    conn.close()
+        version = guard._version_key(p)
+    except OSError:
+        version = None
+    problems = check_file(p, check_pixels=False, isolate=True)
+    if problems:
+        more = len(problems) - 1
+        note = f" (and {more} more problem{'s' if more > 1 else ''}: run scenegen validate)"
+        raise DataError(problems[0] + (note if more else ""))
+    if version is not None:
+        guard._remember(version)
 
 
-def _check_in_child(p: Path, check_pixels: bool) -> list[str]:
-    methods = multiprocessing.get_all_start_methods()
-    ctx = multiprocessing.get_context("fork" if "fork" in methods else "spawn")
-    recv, send = ctx.Pipe(duplex=False)
-    proc = ctx.Process(target=_child, args=(str(p), check_pixels, send), daemon=True)
-    proc.start()
-    send.close()
+def _checked(path: str, check_pixels: bool, deep: bool) -> list[str]:
+    return check_file(path, check_pixels=check_pixels, deep=deep)
+
+
+def _check_in_child(p: Path, check_pixels: bool, deep: bool) -> list[str]:
+    """:func:`check_file` in a guarded child (:mod:`scenegen.io.guard`): a crash or a
+    stall of the HDF5 library (no progress within the deadline) is one problem line."""
     try:
-        problems: list[str] | None = recv.recv()
-    except EOFError:
-        problems = None
-    finally:
-        recv.close()
-        proc.join()
-    if problems is not None:
-        return problems
-    code = proc.exitcode or 0
-    try:
-        how = signal.Signals(-code).name if code < 0 else f"exit status {code}"
-    except ValueError:
-        how = f"signal {-code}"
-    return [f"{p}: damaged HDF5 file: the HDF5 library crashed reading it ({how})"]
+        # Planning a long scene for --deep may take a while before the first beat.
+        seconds = guard_timeout() * (10 if deep else 1)
+        problems: list[str] = call(
+            _checked, str(p), check_pixels, deep, label=str(p), seconds=seconds
+        )
+    except DataError as err:
+        return [str(err)]
+    return problems
 
 
 def _check_open_file(p: Path, f: h5py.File, check_pixels: bool) -> list[str]:
@@ -151,7 +181,7 @@ def _check_open_file(p: Path, f: h5py.File, check_pixels: bool) -> list[str]:
         problems += _check_results(p, f["results"])
     if "sequences" not in f and "results" not in f:
         problems.append(f"{p}: holds neither /sequences nor /results")
-    return problems
+    return problems + _check_digests(p, f, check_pixels, problems)
 
 
 def _one_line(err: BaseException) -> str:
@@ -238,6 +268,7 @@ def _layout(where: str, g: h5py.Group) -> tuple[list[str], tuple[int, int, int, 
 def _read_small(where: str, g: h5py.Group, keys: list[str]) -> tuple[dict[str, Any], list[str]]:
     out, problems = {}, []
     for key in keys:
+        beat()
         try:
             out[key] = g[key][()]
         except _READ_ERRORS as err:
@@ -293,6 +324,7 @@ def _check_templates(where: str, grp: h5py.Group, ids: NDArray[Any]) -> list[str
 
 
 def _check_gt(where: str, gt: dict[str, NDArray[Any]]) -> list[str]:
+    beat()
     problems = []
     present = gt["present"].astype(bool)
     for key in ("box", "center", "path_center"):
@@ -337,6 +369,7 @@ def _check_gt(where: str, gt: dict[str, NDArray[Any]]) -> list[str]:
 def _check_frames(where: str, frames: h5py.Dataset) -> list[str]:
     bad, reason = [], ""
     for t in range(frames.shape[0]):
+        beat()
         try:
             frames[t]
         except _READ_ERRORS as err:
@@ -358,6 +391,7 @@ def _check_labels(
     reason = ""
     vbox, vis, present = gt["visible_box"], gt["visibility"], gt["present"]
     for t in range(labels.shape[0]):
+        beat()
         try:
             lab = labels[t]
         except _READ_ERRORS as err:
@@ -455,4 +489,183 @@ def _check_results(p: Path, root: h5py.Group) -> list[str]:
             and (orderings.min() < 0 or orderings.max() >= m)
         ):
             problems.append(f"{where}: orderings name positions outside 0..{m - 1}")
+    return problems
+
+
+# ---------------------------------------------------------------------------------------
+# Digests (scenegen.io.integrity) and the deep check
+
+
+def _named(problems: list[str], where: str, key: str) -> bool:
+    """Whether a problem line of ``where`` already names ``key`` (then a digest mismatch
+    of the same dataset is the same problem: not reported twice)."""
+    return any(
+        line.startswith(f"{where}: ") and re.search(rf"(^|[\s/]){re.escape(key)}(\s|\[|$)",
+                                                     line[len(where) + 2 :])
+        for line in problems
+    )  # fmt: skip
+
+
+def _values_digest(ds: h5py.Dataset) -> str:
+    """SHA-256 of a dataset's stored values, read a chunk row at a time."""
+    h = Hasher()
+    if ds.shape == () or ds.size == 0:
+        h.update(np.asarray(ds[()]))
+        return h.hexdigest()
+    step = ds.chunks[0] if ds.chunks else ds.shape[0]
+    for start in range(0, ds.shape[0], step):
+        beat()
+        h.update(ds[start : start + step])
+    return h.hexdigest()
+
+
+def _check_digests(p: Path, f: h5py.File, check_pixels: bool, found: list[str]) -> list[str]:
+    """Every dataset against its ``sha256``, every sealed group against ``attrs_sha256``.
+
+    Files written before digests existed (no root ``integrity``) are checked only where a
+    digest is present; files that declare ``integrity`` must carry all of them.
+    """
+    required = as_text(f.attrs.get(INTEGRITY, "")) == DIGEST
+    sealed = any(ATTRS_DIGEST in obj.attrs for obj in _groups(f))
+    if not required and sealed:
+        return [f"{p}: the root attribute {INTEGRITY} is missing (the file carries digests)"]
+    problems: list[str] = []
+    groups = [(f"{p}", f, "root")] + [(where, g, "") for where, g in _groups_named(p, f)]
+    for where, g, what in groups:
+        if ATTRS_DIGEST in g.attrs:
+            if as_text(g.attrs[ATTRS_DIGEST]) != attrs_digest(g.attrs) and not any(
+                line.startswith(f"{where}: ") and "attribute" in line for line in found
+            ):
+                problems.append(
+                    f"{where}: {what + ' ' if what else ''}attributes do not match their "
+                    "digest (changed after writing)"
+                )
+        elif required:
+            problems.append(f"{where}: missing attribute {ATTRS_DIGEST}")
+    for where, g in _groups_named(p, f):
+        if required and where.startswith(f"{p}: sequence "):  # written by this version
+            problems += [f"{where}: missing dataset {key}" for key in sorted(_OPTIONAL)
+                         if key not in g and not _named(found, where, key)]  # fmt: skip
+        for key, ds in _datasets(g):
+            beat()
+            if _named(found, where, key):
+                continue
+            if DIGEST not in ds.attrs:
+                if required:
+                    problems.append(f"{where}: {key} has no digest ({DIGEST} attribute)")
+                continue
+            if key in ("frames", "labels") and not check_pixels:
+                continue
+            try:
+                same = _values_digest(ds) == as_text(ds.attrs[DIGEST])
+                attrs_same = (ATTRS_DIGEST not in ds.attrs and not required) or (
+                    ATTRS_DIGEST in ds.attrs
+                    and as_text(ds.attrs[ATTRS_DIGEST]) == attrs_digest(ds.attrs)
+                )
+            except _READ_ERRORS as err:
+                problems.append(f"{where}: {key} is unreadable ({describe_read_error(err)})")
+                continue
+            if not same:
+                problems.append(
+                    f"{where}: {key} does not match its digest (values changed after writing)"
+                )
+            elif not attrs_same:
+                problems.append(f"{where}: {key} attributes do not match their digest")
+    return problems
+
+
+def _datasets(g: h5py.Group) -> list[tuple[str, h5py.Dataset]]:
+    out: list[tuple[str, h5py.Dataset]] = []
+
+    def visit(key: str, obj: Any) -> None:
+        if isinstance(obj, h5py.Dataset):
+            out.append((key, obj))
+
+    g.visititems(visit)
+    return out
+
+
+def _groups_named(p: Path, f: h5py.File) -> list[tuple[str, h5py.Group]]:
+    out = []
+    for top, label in (("sequences", "sequence"), ("results", "result")):
+        if isinstance(f.get(top), h5py.Group):
+            for name, g in f[top].items():
+                if isinstance(g, h5py.Group):
+                    out.append((f"{p}: {label} {name!r}", g))
+    return out
+
+
+def _groups(f: h5py.File) -> list[Any]:
+    return [f] + [g for _, g in _groups_named(Path(""), f)]
+
+
+def _rows_differ(stored: NDArray[Any], fresh: NDArray[Any]) -> NDArray[np.bool_]:
+    """Per leading row: do the stored bytes differ from the re-rendered ones?"""
+    fresh = np.asarray(fresh).astype(stored.dtype, copy=False)
+    if stored.shape != fresh.shape:
+        return np.ones(max(len(stored), 1), dtype=bool)
+    n = stored.shape[0] if stored.ndim else 1
+    a = np.ascontiguousarray(stored).reshape(n, -1).view(np.uint8)
+    b = np.ascontiguousarray(fresh).reshape(n, -1).view(np.uint8)
+    return (a != b).any(axis=1)
+
+
+def _compare(
+    g: h5py.Group, changed: dict[str, list[int]], key: str, fresh: Any, start: int | None = None
+) -> None:
+    """Record in ``changed`` whether ``g[key]`` (rows ``start:``, or all) differs from
+    ``fresh``; an unreadable dataset is left to the other checks."""
+    try:
+        ds = g[key]
+        stored = ds[()] if start is None else ds[start : start + len(fresh)]
+    except _READ_ERRORS:
+        return
+    rows = np.flatnonzero(_rows_differ(stored, fresh))
+    if rows.size:
+        frames = [] if start is None else [start + int(r) for r in rows]
+        changed.setdefault(key, []).extend(frames)
+
+
+def _check_deep(p: Path, f: h5py.File) -> list[str]:
+    """Re-render each sequence from its config and seed; one line per dataset whose
+    values differ (naming the first frames where they do)."""
+    from scenegen.io.hdf5 import frames_per_block
+    from scenegen.render.plan import plan
+
+    problems: list[str] = []
+    for where, g in _groups_named(p, f):
+        if not where.startswith(f"{p}: sequence "):
+            continue
+        try:
+            cfg = from_dict(json.loads(as_text(g.attrs["config"])))
+            scn = plan(cfg, int(g.attrs["seed"]), preset=as_text(g.attrs["preset"]))
+        except (*_READ_ERRORS, ConfigError) as err:
+            problems.append(
+                f"{where}: cannot re-render (no usable config and seed: {_one_line(err)})"
+            )
+            continue
+        changed: dict[str, list[int]] = {}  # dataset -> frames (empty: not per frame)
+
+        for c in scn.chunks(frames_per_block(cfg.height, cfg.width)):
+            beat()
+            _compare(g, changed, "frames", c.frames, c.start)
+            _compare(g, changed, "labels", c.labels, c.start)
+            for key, values in c.gt.items():
+                if f"gt/{key}" in g:
+                    _compare(g, changed, f"gt/{key}", values, c.start)
+        ents = scn.entities()
+        _compare(g, changed, "entities/id", np.asarray(ents.id, np.int32))
+        for key, values in (("entities/role", ents.role), ("entities/name", ents.name)):
+            try:
+                stored = [as_text(v) for v in g[key][()]]
+            except _READ_ERRORS:
+                continue
+            if stored != [str(v) for v in values]:
+                changed.setdefault(key, [])
+        for eid, tpl in scn.template_images().items():
+            if f"templates/{int(eid)}" in g:
+                _compare(g, changed, f"templates/{int(eid)}", np.asarray(tpl, np.uint8))
+        for key, frames in changed.items():
+            at = f" at frames {_frames(sorted(set(frames)))}" if frames else ""
+            problems.append(f"{where}: {key} differs from a re-render of its config and seed{at}")
     return problems

@@ -9,6 +9,7 @@ import pytest
 import scenegen
 from scenegen.cli import main
 from scenegen.io import read_result
+from scenegen.io.integrity import as_text
 
 
 @pytest.fixture(scope="module")
@@ -30,8 +31,8 @@ def test_track_writes_result_with_orderings(crossing, tmp_path, capsys):
     seq = scenegen.read(crossing)
     np.testing.assert_array_equal(res.boxes[0], seq.gt.box[0, :2])
     with h5py.File(out) as f:
-        assert f.attrs["schema"] == "scenegen/1"
-        assert f["results/shm-fast"].attrs["tracker"] == "shm-fast"
+        assert as_text(f.attrs["schema"]) == "scenegen/1"
+        assert as_text(f["results/shm-fast"].attrs["tracker"]) == "shm-fast"
 
 
 def test_track_params_are_parsed_and_recorded(crossing, tmp_path, capsys):

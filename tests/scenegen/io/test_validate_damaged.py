@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import os
 import shutil
-import signal
 
 import h5py
 import numpy as np
@@ -19,7 +18,7 @@ import pytest
 from scenegen.cli import main
 from scenegen.config import from_dict
 from scenegen.errors import DataError
-from scenegen.io import TrackerResult, read, validate, write_result, write_scenario
+from scenegen.io import TrackerResult, integrity, read, validate, write_result, write_scenario
 from scenegen.io.validate import check_file
 from scenegen.render.plan import plan
 
@@ -291,6 +290,7 @@ def test_damage_without_checksums_is_still_caught(copy):
     and zlib's own checksum catches changes to gzip-compressed frames."""
 
     def strip(g, f):
+        integrity.strip(f)
         replace(g, "labels", g["labels"][()], chunks=(1, 40, 48))
         replace(g, "frames", g["frames"][()], chunks=(1, 40, 48, 3), compression="gzip")
 
@@ -372,26 +372,27 @@ def test_other_verbs_on_a_damaged_chunk_exit_1_with_one_line(copy, tmp_path, cap
 
 def test_a_crash_of_the_hdf5_library_becomes_one_line(copy, monkeypatch):
     """Some corrupted metadata crashes libhdf5 itself (segmentation fault); the isolated
-    check reports that instead of dying. Simulated: the forked child kills itself."""
-
-    def crash(*args, **kwargs):
-        os.kill(os.getpid(), signal.SIGSEGV)
-
-    monkeypatch.setattr(validate, "_check_open_file", crash)
+    check reports that instead of dying. Simulated: the guarded child aborts."""
+    monkeypatch.setattr(validate, "_checked", _abort)
     p = copy()
     assert check_file(p, isolate=True) == [
-        f"{p}: damaged HDF5 file: the HDF5 library crashed reading it (SIGSEGV)"
+        f"{p}: metadata unreadable: the HDF5 library crashed reading it (SIGABRT)"
     ]
 
 
-def test_an_unexpected_error_in_the_isolated_check_is_one_line(copy, monkeypatch, capfd):
-    def fail(*args, **kwargs):
-        raise MemoryError("simulated")
+def _abort(*args):
+    os.abort()
 
-    monkeypatch.setattr(validate, "_check_open_file", fail)
+
+def test_an_unexpected_error_in_the_isolated_check_is_one_line(copy, monkeypatch, capfd):
+    monkeypatch.setattr(validate, "_checked", _memory_error)
     p = copy()
-    assert check_file(p, isolate=True) == [f"{p}: could not be checked (MemoryError: simulated)"]
+    assert check_file(p, isolate=True) == [f"{p}: could not be read (MemoryError: simulated)"]
     assert "Traceback" not in capfd.readouterr().err
+
+
+def _memory_error(*args):
+    raise MemoryError("simulated")
 
 
 def test_random_byte_damage_never_raises(copy):
@@ -409,3 +410,107 @@ def test_random_byte_damage_never_raises(copy):
         problems = check_file(p, isolate=True)
         assert all(isinstance(line, str) and line.startswith(f"{p}: ") for line in problems)
         assert all("\n" not in line for line in problems)
+
+
+def _nan_where_present(g, f):
+    box = g["gt/box"][()]
+    box[2, 0] = np.nan
+    g["gt/box"][...] = box
+
+
+@pytest.mark.parametrize(
+    ("verb", "damage", "needle"),
+    [
+        ("track", _nan_where_present, "gt/box NaN pattern disagrees with gt/present at frames 2"),
+        ("export", lambda g, f: replace(g, "gt/present", g["gt/present"][()].astype(np.int8)),
+         "gt/present has dtype int8, expected bool"),
+        ("preview", lambda g, f: replace(g, "gt/box", g["gt/box"][:5]),
+         "gt/box has shape (5, 3, 4), expected (8, 3, 4)"),
+        ("evaluate", lambda g, f: g["gt/depth"].__setitem__((1, 0), 9),
+         "gt/depth does not match its digest"),
+    ],
+)  # fmt: skip
+def test_verbs_refuse_bad_input_with_one_line(copy, tmp_path, capsys, verb, damage, needle):
+    p = edit(copy(), damage)
+    out = tmp_path / "out"
+    argv = {
+        "track": ["track", str(p), "--tracker", "kalman", "-o", str(out)],
+        "export": ["export", str(p), "--format", "mot", "-o", str(out)],
+        "preview": ["preview", str(p), "-o", str(out) + ".png"],
+        "evaluate": ["evaluate", str(p), str(p)],
+    }[verb]
+    assert main(argv) == 1
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and needle in err[0], err
+    assert not out.exists()
+
+
+def test_a_result_file_with_a_wrong_dtype_is_refused_by_evaluate(originals, tmp_path, capsys):
+    res = TrackerResult(
+        tracker="kalman", params={}, seed=0, sequence="small",
+        target_ids=np.array([1], np.int32), boxes=np.zeros((8, 1, 4), np.float32),
+    )  # fmt: skip
+    r = tmp_path / "r.h5"
+    write_result(r, res)
+    with h5py.File(r, "r+") as f:
+        del f["results/kalman/boxes"]
+        f["results/kalman/boxes"] = np.zeros((8, 1, 4), np.float64)
+    assert main(["evaluate", str(originals["gzip"]), str(r)]) == 1
+    (line,) = capsys.readouterr().err.splitlines()
+    assert "boxes has dtype float64, expected float32" in line
+
+
+def test_edits_with_valid_digests_are_caught_by_deep(copy):
+    def rewrite(g, f):
+        frame = g["frames"][3]
+        frame[0, 0] ^= 1
+        g["frames"][3] = frame
+        g["gt/depth"][...] = 9
+        for key in ("frames", "gt/depth"):
+            integrity.put_text(g[key], integrity.DIGEST, integrity.digest(g[key][()]))
+
+    p = edit(copy(), rewrite)
+    assert check_file(p) == []
+    assert check_file(p, deep=True) == [
+        f"{p}: {SEQ}: frames differs from a re-render of its config and seed at frames 3",
+        f"{p}: {SEQ}: gt/depth differs from a re-render of its config and seed at frames "
+        "0, 1, 2, 3, 4 (+3 more)",
+    ]
+    assert check_file(copy(), deep=True) == []
+
+
+def test_zeroed_chunks_and_renamed_entities_are_caught(copy):
+    p = copy("none")
+    with h5py.File(p) as f:
+        g = f["sequences/small"]
+        infos = {k: g[k].id.get_chunk_info(0) for k in ("gt/depth", "templates/1")}
+        names = g["entities/name"].id.get_chunk_info(0)
+    data = bytearray(p.read_bytes())
+    for info in infos.values():  # the data and its Fletcher-32 word: all zeros
+        data[info.byte_offset : info.byte_offset + info.size] = bytes(info.size)
+    at = data.index(b"wall", names.byte_offset)
+    data[at : at + 4] = b"wXll"
+    p.write_bytes(bytes(data))
+    problems = check_file(p)
+    for key in ("gt/depth", "templates/1"):
+        assert any(f"{SEQ}: {key} " in line for line in problems), problems
+    assert any("entities/name" in line for line in problems), problems
+
+
+def test_old_files_with_variable_length_strings_stay_readable_and_valid(copy):
+    p = copy()
+    with h5py.File(p, "r+") as f:
+        integrity.strip(f)
+        for obj in (f, f["sequences/small"]):
+            for key in list(obj.attrs):
+                value = obj.attrs[key]
+                if isinstance(value, bytes):
+                    obj.attrs[key] = value.decode()  # variable-length, as older writers did
+        g = f["sequences/small/entities"]
+        for key in ("role", "name"):
+            values = [v.decode() for v in g[key][()]]
+            del g[key]
+            g.create_dataset(key, data=values, dtype=h5py.string_dtype("utf-8"))
+    assert check_file(p) == []
+    seq = read(p)
+    assert list(seq.entities.name) == ["a", "b", "wall"] and seq.preset == ""

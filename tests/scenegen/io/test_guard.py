@@ -1,0 +1,185 @@
+"""The guard of reads of unknown files (:mod:`scenegen.io.guard`): a stall or a crash of
+the HDF5 library in the child becomes one line; the child dies with its parent; every
+verb that opens an input file answers on a file whose global heap is zeroed (the HDF5
+library loops forever reading its strings)."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+import pytest
+from damage import old_format
+
+import scenegen
+from scenegen.cli import main
+from scenegen.errors import ConfigError, DataError
+from scenegen.io import guard, read, read_result
+from scenegen.io.validate import check_file
+
+FIXTURE = os.path.join(os.path.dirname(__file__), "..", "..", "..", "fixtures",
+                       "dps-synthetic-small.h5")  # fmt: skip
+
+
+def heap_zeroed(src: str, dst) -> None:
+    """``src`` in the old format (strings on the global heap) with the body of its first
+    global heap collection zeroed (the collection header kept): libhdf5 then loops
+    reading the strings stored there."""
+    old = dst.with_name("old.h5")
+    old_format(Path(src), old)
+    data = bytearray(old.read_bytes())
+    at = data.find(b"GCOL")
+    assert at > 0, "no variable-length strings in the old-format copy"
+    data[at + 16 : at + 4096] = bytes(4096 - 16)
+    dst.write_bytes(bytes(data))
+
+
+@pytest.fixture
+def looping(tmp_path, monkeypatch):
+    monkeypatch.setenv("SCENEGEN_READ_TIMEOUT", "1")
+    path = tmp_path / "heap.h5"
+    heap_zeroed(FIXTURE, path)
+    return path
+
+
+def test_new_files_have_no_global_heap(tmp_path):
+    """Strings are fixed-length: nothing for a damaged heap to corrupt or loop on."""
+    path = tmp_path / "new.h5"
+    scenegen.write(path, scenegen.read(FIXTURE))
+    assert b"GCOL" not in path.read_bytes()
+
+
+def test_results_and_errors_come_back():
+    assert guard.call(int, "12", label="x") == 12
+    with pytest.raises(DataError, match=r"^x: could not be read \(ValueError: invalid literal"):
+        guard.call(int, "twelve", label="x")
+    with pytest.raises(ConfigError, match="^bad$"):
+        guard.call(_config_error, label="x")
+
+
+def _config_error():
+    raise ConfigError("bad")
+
+
+def test_a_crash_is_one_line():
+    with pytest.raises(guard.Unreadable) as err:
+        guard.call(os.abort, label="f.h5")
+    assert (
+        str(err.value) == "f.h5: metadata unreadable: the HDF5 library crashed reading it (SIGABRT)"
+    )
+
+
+def test_a_stall_is_killed_at_the_deadline():
+    with pytest.raises(guard.Unreadable) as err:
+        guard.call(time.sleep, 600, label="f.h5", seconds=0.5)
+    assert str(err.value) == (
+        "f.h5: metadata unreadable: no answer from the HDF5 library within 0.5 s (damaged file)"
+    )
+
+
+def test_the_deadline_comes_from_the_environment(monkeypatch):
+    monkeypatch.setenv("SCENEGEN_READ_TIMEOUT", "2.5")
+    assert guard.timeout() == 2.5
+    for bad in ("", "soon", "-1", "nan", "inf"):
+        monkeypatch.setenv("SCENEGEN_READ_TIMEOUT", bad)
+        assert guard.timeout() == guard.TIMEOUT
+
+
+def test_the_survey_reads_a_sound_file_and_is_cached():
+    guard.clear_cache()
+    assert guard.call(guard.survey, FIXTURE, label="f") > 10
+    guard.preflight(FIXTURE)
+    assert len(guard._cache) == 1
+    guard.preflight(FIXTURE)  # a second read of the same version: no child
+    assert len(guard._cache) == 1
+
+
+def test_every_reader_answers_on_a_looping_file(looping, tmp_path, capsys):
+    line = f"{looping}: metadata unreadable: no answer from the HDF5 library within 1 s"
+    assert check_file(looping, isolate=True)[0].startswith(line)
+    for fn in (read, read_result):
+        with pytest.raises(DataError, match="metadata unreadable"):
+            fn(looping)
+    out = tmp_path / "out"
+    verbs = [
+        ["validate", str(looping)],
+        ["inspect", str(looping)],
+        ["track", str(looping), "--tracker", "kalman", "-o", str(out / "r.h5")],
+        ["preview", str(looping), "-o", str(out / "p.png")],
+        ["export", str(looping), "--format", "mot", "-o", str(out / "mot")],
+        ["evaluate", str(looping), str(looping)],
+    ]
+    for argv in verbs:
+        assert main(argv) == 1, argv
+        err = capsys.readouterr().err.splitlines()
+        assert len(err) == 1 and "metadata unreadable" in err[0], (argv, err)
+    assert not out.exists()
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+def test_no_child_outlives_its_parent(looping):
+    """A parent killed while its guarded child loops inside libhdf5 (holding the GIL):
+    the child dies too (PR_SET_PDEATHSIG once the fork server exits; else its alarm)."""
+    code = textwrap.dedent(f"""
+        import os, sys
+        from scenegen.io import guard
+        print(os.getpid(), flush=True)
+        guard.call(guard.survey, {str(looping)!r}, label="x", seconds=300)
+    """)
+    parent = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True)
+    try:
+        pid = int(parent.stdout.readline())
+        kids = []
+        for _ in range(600):  # the forkserver, then its child that loops
+            kids = _descendants(pid)
+            if len(kids) >= 3:
+                break
+            time.sleep(0.05)
+        assert kids
+    finally:
+        parent.kill()
+        parent.wait()
+    for _ in range(400):
+        alive = [k for k in kids if _alive(k)]
+        if not alive:
+            break
+        time.sleep(0.05)
+    assert alive == []
+
+
+def _descendants(pid: int) -> list[int]:
+    out = []
+    for entry in os.listdir("/proc"):
+        if entry.isdigit():
+            try:
+                with open(f"/proc/{entry}/stat") as fh:
+                    ppid = int(fh.read().rsplit(")", 1)[1].split()[1])
+            except (OSError, IndexError, ValueError):
+                continue
+            if ppid == pid:
+                out.append(int(entry))
+    return out + [g for k in out for g in _descendants(k)]
+
+
+def _alive(pid: int) -> bool:
+    try:
+        with open(f"/proc/{pid}/stat") as fh:
+            return fh.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
+def _guarded_int(text):
+    return guard.call(int, text, label="x")
+
+
+def test_a_pool_worker_can_start_a_guard():
+    """Workers of a multiprocessing pool are daemonic; the guard still runs there."""
+    import multiprocessing
+
+    with multiprocessing.get_context("spawn").Pool(1) as pool:
+        assert pool.apply(_guarded_int, ("5",)) == 5
