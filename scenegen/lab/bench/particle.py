@@ -233,6 +233,25 @@ def _step_rows(repeats: int) -> list[BenchRow]:
     return rows
 
 
+def _against_cv2(likelihood: list[BenchRow], steps: list[BenchRow]) -> list[BenchRow]:
+    """Each step as a fraction of the per-patch cv2 loop a user would write for the same
+    2,100 boxes of the trackers' own HSV model (the baseline of that group), measured in
+    this run: ``ratio`` = cv2 loop time / step time (goal: the step <= 0.1 of the loop)."""
+    base = next(r for r in likelihood if r.group.startswith("likelihood stage, HSV")
+                and not r.baseline)
+    group = "tracker step against the per-patch cv2 loop over the same boxes (HSV model)"
+    rows = [BenchRow(group, base.name, base.seconds, 1.0 / base.seconds, "loops/s")]
+    for r in steps:
+        share = r.seconds / base.seconds
+        rows.append(BenchRow(group, f"{r.name}: {share:.3f} of the loop's time", r.seconds,
+                             r.rate, r.unit, baseline=base.name, ratio=base.seconds / r.seconds,
+                             goal="step <= 0.1 of the loop" if r.name.startswith("dps") else "",
+                             met=(share <= 0.1) if r.name.startswith("dps") else None))
+    return rows
+
+
 def run(repeats: int = 5) -> list[BenchRow]:
     """All rows of this module; every figure is a median over ``repeats`` timings."""
-    return _likelihood_rows(repeats) + _step_rows(repeats)
+    likelihood = _likelihood_rows(repeats)
+    steps = _step_rows(repeats)
+    return likelihood + steps + _against_cv2(likelihood, steps)
