@@ -80,8 +80,8 @@ def cmd_track(args: argparse.Namespace) -> int:
     if args.seed < 0:
         raise ConfigError(f"--seed must be >= 0, got {args.seed}")
     params = parse_params(args.param)
-    check_writable(args.output)
     require_valid(args.file)  # no computing on a damaged or inconsistent file
+    check_writable(args.output)
     seq = read(args.file, args.sequence)
     label = tracker_label(args.tracker)
     with bar(seq.n_frames - 1, f"track {label}", unit="frame") as pb:
