@@ -9,19 +9,22 @@ layers m = M … 0 weight by w^β_m with β_M < … < β_0 = 1 (KAMS eq. 1–4).
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
-from trackers.base import Estimate, RngLike, Tracker
+from trackers.base import Estimate, Tracker
 from trackers.filters.resampling import RESAMPLERS, resample_groups
-from trackers.meanshift import ColourTargets, check_kernel_bins, keep_inside
+from trackers.meanshift import ColourParams, ColourTargets, keep_inside
 from trackers.models.observation import FrameObservation
+from trackers.params import check_choice, check_integer, check_number
 
 __all__ = [
     "ESTIMATES",
     "SCHEDULES",
     "AnnealedPF",
+    "AnnealedParams",
     "check_particles",
     "normalised_weights",
     "resample_targets",
@@ -129,6 +132,44 @@ def check_particles(n_particles: int, lam: float, resampler: str) -> None:
         raise ValueError(f"unknown resampler {resampler!r}; valid: {', '.join(RESAMPLERS)}")
 
 
+@dataclass(frozen=True)
+class AnnealedParams(ColourParams):
+    """Parameters of the annealed particle filter (documented on ``AnnealedPF``).
+
+    ``sigma`` is stored as a float, or as a tuple of ``n_layers`` floats.
+    """
+
+    n_particles: int = 100
+    n_layers: int = 3
+    lam: float = 1000.0
+    sigma: float | tuple[float, ...] = 12.0
+    sigma_decay: float = 0.5
+    schedule: str = "adaptive"
+    alpha: float = 0.5
+    beta_ratio: float = 0.5
+    estimate: str = "mean"
+    resampler: str = "systematic"
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        check_particles(self.n_particles, self.lam, self.resampler)
+        self._set("n_particles", int(self.n_particles))
+        self._set("lam", float(self.lam))
+        check_integer(self, "n_layers", low=1)
+        check_choice(self, "schedule", SCHEDULES)
+        check_choice(self, "estimate", ESTIMATES)
+        check_number(self, "alpha", low=0.0, high=1.0, low_open=True, high_open=True)
+        check_number(self, "beta_ratio", low=0.0, high=1.0, low_open=True)
+        check_number(self, "sigma_decay", low=0.0, high=1.0, low_open=True)
+        sigmas = _layer_sigmas(self.sigma, self.sigma_decay, self.n_layers)
+        self._set("sigma", float(self.sigma) if np.ndim(self.sigma) == 0
+                  else tuple(sigmas.tolist()))
+
+    def layer_sigmas(self) -> NDArray[np.float64]:
+        """Noise standard deviation (n_layers,) of each layer, first layer first."""
+        return _layer_sigmas(self.sigma, self.sigma_decay, self.n_layers)
+
+
 class AnnealedPF(Tracker):
     """Annealed particle filter on colour histograms, one particle set per target.
 
@@ -146,6 +187,8 @@ class AnnealedPF(Tracker):
     The estimate is the weighted mean of the last layer (β_0 = 1), or of its main mode
     (``estimate``). With one layer this is
     the bootstrap (SIR) filter with random-walk noise ``sigma``.
+
+    The parameters are the fields of ``AnnealedParams``, and ``rng``.
 
     Parameters
     ----------
@@ -212,40 +255,10 @@ class AnnealedPF(Tracker):
     """
 
     name = "annealed"
+    Params = AnnealedParams
 
-    def __init__(self, *, n_particles: int = 100, n_layers: int = 3, lam: float = 1000.0,
-                 sigma: float | Sequence[float] = 12.0, sigma_decay: float = 0.5,
-                 schedule: str = "adaptive", alpha: float = 0.5, beta_ratio: float = 0.5,
-                 estimate: str = "mean", resampler: str = "systematic", kernel: str = "cone",
-                 bins: int = 10, rng: RngLike = None) -> None:
-        super().__init__(rng=rng)
-        check_particles(n_particles, lam, resampler)
-        if int(n_layers) != n_layers or n_layers < 1:
-            raise ValueError(f"n_layers must be an integer >= 1, got {n_layers!r}")
-        if schedule not in SCHEDULES:
-            raise ValueError(f"unknown schedule {schedule!r}; valid schedules: "
-                             f"{', '.join(SCHEDULES)}")
-        if estimate not in ESTIMATES:
-            raise ValueError(f"unknown estimate {estimate!r}; valid estimates: "
-                             f"{', '.join(ESTIMATES)}")
-        if not 0.0 < alpha < 1.0:
-            raise ValueError(f"alpha must lie in (0, 1), got {alpha!r}")
-        if not 0.0 < beta_ratio <= 1.0:
-            raise ValueError(f"beta_ratio must lie in (0, 1], got {beta_ratio!r}")
-        if not 0.0 < sigma_decay <= 1.0:
-            raise ValueError(f"sigma_decay must lie in (0, 1], got {sigma_decay!r}")
-        check_kernel_bins(kernel, bins)
-        self.n_particles = int(n_particles)
-        self.n_layers = int(n_layers)
-        self.lam = float(lam)
-        self.sigmas = _layer_sigmas(sigma, sigma_decay, self.n_layers)
-        self.schedule = schedule
-        self.alpha = float(alpha)
-        self.beta_ratio = float(beta_ratio)
-        self.estimate = estimate
-        self.resampler = resampler
-        self.kernel = kernel
-        self.bins = int(bins)
+    def _configure(self, params: AnnealedParams) -> None:
+        self.sigmas = params.layer_sigmas()
 
     def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
         self.targets = ColourTargets(frame, boxes, kernel=self.kernel, bins=self.bins,

@@ -14,12 +14,15 @@ from the ``rng`` argument) and never touch global random state.
 
 from __future__ import annotations
 
+import inspect
 from abc import ABC, abstractmethod
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
+
+from trackers.params import TrackerParams
 
 __all__ = ["Estimate", "Tracker", "as_generator", "check_boxes", "check_frame"]
 
@@ -105,14 +108,74 @@ class Tracker(ABC):
 
     Subclasses set ``name`` and implement ``_init`` and ``_step``; this class validates
     frames and boxes so that every tracker rejects bad input the same way.
+
+    Parameters
+    ----------
+    params : TrackerParams, optional (positional only)
+        A ready instance of the class's ``Params``; keyword ``**kwargs`` then override
+        its fields (``dataclasses.replace``).
+    rng : numpy.random.Generator, int or None, optional
+        Source of randomness, kept as ``self.rng``.
+    **kwargs
+        The fields of ``Params`` (see the tracker's parameter dataclass).
+
+    A subclass with parameters sets ``Params`` to its frozen parameter dataclass
+    (``trackers.params``) and builds its parts from ``self.params`` in ``_configure``;
+    the class's signature (``help``, ``inspect.signature``) lists the fields with their
+    defaults. Fields can be read as attributes of the tracker (``tracker.n_particles``).
+
+    Raises
+    ------
+    TypeError
+        For a keyword that is not a field of ``Params``, naming it.
+    ValueError
+        From ``Params`` for a bad value, naming the parameter.
     """
 
     name: ClassVar[str] = ""
+    #: The parameter dataclass of the tracker family (None: no parameters but ``rng``).
+    Params: ClassVar[type[TrackerParams] | None] = None
 
-    def __init__(self, *, rng: RngLike = None) -> None:
+    def __init__(self, params: TrackerParams | None = None, /, *, rng: RngLike = None,
+                 **kwargs: Any) -> None:
         self.rng = as_generator(rng)
         self._frame_shape: tuple[int, ...] | None = None
         self.n_targets = 0
+        cls = type(self)
+        if cls.Params is None:
+            if params is not None or kwargs:
+                bad = next(iter(kwargs), "params")
+                raise TypeError(f"{cls.__name__} takes no parameter {bad!r}; only rng")
+            return
+        valid = cls.Params.names()
+        for key in kwargs:
+            if key not in valid:
+                raise TypeError(f"{cls.__name__}: unknown parameter {key!r}; valid: "
+                                f"{', '.join([*valid, 'rng'])}")
+        if params is None:
+            params = cls.Params(**kwargs)
+        elif not isinstance(params, cls.Params):
+            raise TypeError(f"{cls.__name__}: params must be a {cls.Params.__name__}, got "
+                            f"{type(params).__name__}")
+        elif kwargs:
+            params = params.replace(**kwargs)
+        self.params = params
+        self._configure(params)
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        if cls.Params is not None and "__init__" not in cls.__dict__:
+            cls.__signature__ = _signature(cls.Params)  # type: ignore[attr-defined]
+
+    def __getattr__(self, name: str) -> Any:
+        # Only called when normal lookup fails: expose the parameter fields.
+        params = self.__dict__.get("params")
+        if params is not None and name in params.__dataclass_fields__:
+            return getattr(params, name)
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+
+    def _configure(self, params: TrackerParams) -> None:  # noqa: B027 (optional hook)
+        """Build the tracker's parts from its validated ``params`` (called by ``__init__``)."""
 
     def init(self, frame: Any, boxes: Any) -> None:
         """Initialise on ``frame`` (H, W, 3) with one box per target, ``boxes`` (K, 4)."""
@@ -136,6 +199,14 @@ class Tracker(ABC):
 
     @abstractmethod
     def _step(self, frame: NDArray[np.uint8]) -> Estimate: ...
+
+
+def _signature(params: type[TrackerParams]) -> inspect.Signature:
+    """Constructor signature of a tracker with parameters ``params``: fields, then rng."""
+    fields = [inspect.Parameter(n, inspect.Parameter.KEYWORD_ONLY, default=d)
+              for n, d in params.defaults().items()]
+    rng = inspect.Parameter("rng", inspect.Parameter.KEYWORD_ONLY, default=None)
+    return inspect.Signature([*fields, rng])
 
 
 def clip_boxes(boxes: NDArray[np.float64], frame_shape: tuple[int, ...]) -> NDArray[np.float64]:

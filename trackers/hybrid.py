@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -11,10 +13,30 @@ from trackers.annealed import (
     resample_targets,
     weighted_estimate,
 )
-from trackers.base import Estimate, RngLike, Tracker
-from trackers.meanshift import ColourTargets, check_kernel_bins, check_mean_shift, keep_inside
+from trackers.base import Estimate, Tracker
+from trackers.meanshift import ColourTargets, MeanShiftParams, keep_inside
+from trackers.params import check_number
 
-__all__ = ["HybridPF"]
+__all__ = ["HybridPF", "HybridParams"]
+
+
+@dataclass(frozen=True)
+class HybridParams(MeanShiftParams):
+    """Parameters of the hybrid filter: ``MeanShiftParams`` (10 iterations by default) and
+    the particle set's (documented on ``HybridPF``)."""
+
+    max_iter: int = 10
+    n_particles: int = 100
+    lam: float = 1000.0
+    sigma: float = 8.0
+    resampler: str = "systematic"
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        check_particles(self.n_particles, self.lam, self.resampler)
+        self._set("n_particles", int(self.n_particles))
+        self._set("lam", float(self.lam))
+        check_number(self, "sigma", low=0.0)
 
 
 class HybridPF(Tracker):
@@ -28,6 +50,8 @@ class HybridPF(Tracker):
     **(open)** The velocity of a particle is its displacement over the last frame *after*
     mean shift, so the motion model adapts to where mean shift found the target (our
     reading of Maggio & Cavallaro's adaptive transition model); it starts at 0.
+
+    The parameters are the fields of ``HybridParams``, and ``rng``.
 
     Parameters
     ----------
@@ -73,24 +97,7 @@ class HybridPF(Tracker):
     """
 
     name = "hybrid"
-
-    def __init__(self, *, n_particles: int = 100, lam: float = 1000.0, sigma: float = 8.0,
-                 max_iter: int = 10, eps: float = 0.5, resampler: str = "systematic",
-                 kernel: str = "cone", bins: int = 10, rng: RngLike = None) -> None:
-        super().__init__(rng=rng)
-        check_particles(n_particles, lam, resampler)
-        if not sigma >= 0.0:
-            raise ValueError(f"sigma must be >= 0 (pixels), got {sigma!r}")
-        check_mean_shift(max_iter, eps)
-        check_kernel_bins(kernel, bins)
-        self.n_particles = int(n_particles)
-        self.lam = float(lam)
-        self.sigma = float(sigma)
-        self.max_iter = int(max_iter)
-        self.eps = float(eps)
-        self.resampler = resampler
-        self.kernel = kernel
-        self.bins = int(bins)
+    Params = HybridParams
 
     def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
         self.targets = ColourTargets(frame, boxes, kernel=self.kernel, bins=self.bins,

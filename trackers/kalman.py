@@ -19,14 +19,18 @@ Shared with the SHM trackers (``trackers.shm``):
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from typing import Any
+
 import numpy as np
 from numpy.typing import NDArray
 
-from trackers.base import Estimate, RngLike, Tracker
+from trackers.base import Estimate, Tracker
 from trackers.filters.kalman import KalmanFilter, MotionModel
 from trackers.models.layered import LayeredMatcher, check_matcher_params
+from trackers.params import TrackerParams, check_choice, check_number
 
-__all__ = ["MOTIONS", "KalmanTracker"]
+__all__ = ["MOTIONS", "KalmanParams", "KalmanTracker"]
 
 MOTIONS = ("cv", "ar2")
 
@@ -48,14 +52,6 @@ def motion_model(
     raise ValueError(f"unknown motion {motion!r}; valid: {', '.join(MOTIONS)}")
 
 
-def check_noise(r_gain: float, r_floor: float) -> None:
-    """Validate the measurement-noise parameters."""
-    if not (np.isfinite(r_gain) and r_gain >= 0):
-        raise ValueError(f"r_gain must be finite and >= 0, got {r_gain!r}")
-    if not (np.isfinite(r_floor) and r_floor > 0):
-        raise ValueError(f"r_floor must be finite and > 0, got {r_floor!r}")
-
-
 def measurement_cov(mse: NDArray[np.float64], r_gain: float, r_floor: float) -> NDArray[np.float64]:
     """``R = (r_floor + r_gain e) I₂`` for every match, shape (..., 2, 2) from (...,).
 
@@ -70,8 +66,50 @@ def boxes_at(centres: NDArray[np.float64], sizes: NDArray[np.float64]) -> NDArra
     return np.concatenate([centres - sizes / 2, sizes], axis=1)
 
 
+@dataclass(frozen=True)
+class KalmanParams(TrackerParams):
+    """Motion, measurement noise and matching: the parameters of the Kalman tracker and of
+    the SHM trackers (``trackers.shm``), documented on ``KalmanTracker``."""
+
+    motion: str = "cv"
+    process_std: float = 1.5
+    a1: float = 2.0
+    a2: float = -1.0
+    velocity_std: float = 5.0
+    r_gain: float = 0.01
+    r_floor: float = 0.5
+    search_radius: int = 12
+    step: int = 2
+    min_visible: float = 0.25
+    support: str = "ellipse"
+    blur: float = 2.0
+
+    def __post_init__(self) -> None:
+        check_choice(self, "motion", MOTIONS)
+        check_number(self, "process_std", low=0.0)
+        check_number(self, "a1")
+        check_number(self, "a2")
+        check_number(self, "velocity_std", low=0.0, low_open=True)
+        check_number(self, "r_gain", low=0.0)
+        check_number(self, "r_floor", low=0.0, low_open=True)
+        check_matcher_params(self.search_radius, self.step, self.min_visible, self.support,
+                             self.blur)
+
+    def motion_model(self) -> MotionModel:
+        """The per-object motion model these parameters name."""
+        return motion_model(self.motion, self.process_std, self.a1, self.a2,
+                            self.velocity_std)
+
+    def matcher_params(self) -> dict[str, Any]:
+        """Keyword arguments of ``LayeredMatcher``."""
+        return dict(search_radius=self.search_radius, step=self.step,
+                    min_visible=self.min_visible, support=self.support, blur=self.blur)
+
+
 class KalmanTracker(Tracker):
     """One Kalman filter per object on plain (unmasked) template-matching measurements.
+
+    The parameters are the fields of ``KalmanParams``, and ``rng``.
 
     Parameters
     ----------
@@ -111,37 +149,11 @@ class KalmanTracker(Tracker):
     """
 
     name = "kalman"
+    Params = KalmanParams
 
-    def __init__(
-        self,
-        *,
-        motion: str = "cv",
-        process_std: float = 1.5,
-        a1: float = 2.0,
-        a2: float = -1.0,
-        velocity_std: float = 5.0,
-        r_gain: float = 0.01,
-        r_floor: float = 0.5,
-        search_radius: int = 12,
-        step: int = 2,
-        min_visible: float = 0.25,
-        support: str = "ellipse",
-        blur: float = 2.0,
-        rng: RngLike = None,
-    ) -> None:
-        super().__init__(rng=rng)
-        self.model = motion_model(motion, process_std, a1, a2, velocity_std)
-        check_noise(r_gain, r_floor)
-        check_matcher_params(search_radius, step, min_visible, support, blur)
-        self.r_gain = float(r_gain)
-        self.r_floor = float(r_floor)
-        self._matcher_params = dict(
-            search_radius=search_radius,
-            step=step,
-            min_visible=min_visible,
-            support=support,
-            blur=blur,
-        )
+    def _configure(self, params: KalmanParams) -> None:
+        self.model = params.motion_model()
+        self._matcher_params = params.matcher_params()
 
     def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
         self.matcher = LayeredMatcher(frame, boxes, **self._matcher_params)

@@ -2,17 +2,36 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
-from trackers.annealed import AnnealedPF
-from trackers.base import RngLike
+from trackers.annealed import AnnealedParams, AnnealedPF
 from trackers.meanshift import check_mean_shift
 from trackers.models.observation import FrameObservation
 
-__all__ = ["KAMS"]
+__all__ = ["KAMS", "KamsParams"]
+
+
+@dataclass(frozen=True)
+class KamsParams(AnnealedParams):
+    """Parameters of KAMS: ``AnnealedParams`` with KAMS defaults, and the mean-shift loop.
+
+    Documented on ``KAMS``.
+    """
+
+    n_particles: int = 40
+    sigma: float | tuple[float, ...] = 30.0
+    alpha: float = 0.8
+    max_iter: int = 20
+    eps: float = 0.5
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        check_mean_shift(self.max_iter, self.eps)
+        self._set("max_iter", int(self.max_iter))
+        self._set("eps", float(self.eps))
 
 
 class KAMS(AnnealedPF):
@@ -23,6 +42,8 @@ class KAMS(AnnealedPF):
     kernel mean shift (KAMS Fig. 1, step 3c), all particles of all targets in one compiled
     call; the particles are weighted at the converged positions. No motion model.
     With ``max_iter=0`` this is exactly ``AnnealedPF`` for the same seed.
+
+    The parameters are the fields of ``KamsParams``, and ``rng``.
 
     Parameters
     ----------
@@ -66,20 +87,7 @@ class KAMS(AnnealedPF):
     """
 
     name = "kams"
-
-    def __init__(self, *, n_particles: int = 40, n_layers: int = 3, lam: float = 1000.0,
-                 sigma: float | Sequence[float] = 30.0, sigma_decay: float = 0.5,
-                 schedule: str = "adaptive", alpha: float = 0.8, beta_ratio: float = 0.5,
-                 estimate: str = "mean", max_iter: int = 20, eps: float = 0.5,
-                 resampler: str = "systematic", kernel: str = "cone", bins: int = 10,
-                 rng: RngLike = None) -> None:
-        super().__init__(n_particles=n_particles, n_layers=n_layers, lam=lam, sigma=sigma,
-                         sigma_decay=sigma_decay, schedule=schedule, alpha=alpha,
-                         beta_ratio=beta_ratio, estimate=estimate, resampler=resampler,
-                         kernel=kernel, bins=bins, rng=rng)
-        check_mean_shift(max_iter, eps)
-        self.max_iter = int(max_iter)
-        self.eps = float(eps)
+    Params = KamsParams
 
     def _move(self, obs: FrameObservation, particles: NDArray[np.float64]) -> None:
         particles[...] = self.targets.shift(obs, particles, max_iter=self.max_iter,

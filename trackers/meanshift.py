@@ -8,16 +8,21 @@ tracks its centre only: box sizes stay those of ``init``.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from numpy.typing import NDArray
 
-from trackers.base import Estimate, RngLike, Tracker
+from trackers.base import Estimate, Tracker
 from trackers.kernels.histogram import KERNELS
 from trackers.kernels.meanshift import MEAN_SHIFT_KERNELS, MeanShiftResult, mean_shift
 from trackers.models.observation import ColourModel, FrameObservation
+from trackers.params import TrackerParams
 
 __all__ = [
+    "ColourParams",
     "ColourTargets",
+    "MeanShiftParams",
     "MeanShiftTracker",
     "check_kernel_bins",
     "check_mean_shift",
@@ -124,6 +129,48 @@ def keep_inside(centres: NDArray[np.float64], frame_shape: tuple[int, ...]) -> N
     np.clip(centres[..., 1], 0.0, frame_shape[0], out=centres[..., 1])
 
 
+@dataclass(frozen=True)
+class ColourParams(TrackerParams):
+    """The colour model's parameters, shared by every tracker of the KAMS family.
+
+    Parameters
+    ----------
+    kernel : {"cone", "epanechnikov"}, optional
+        Histogram kernel: ``"cone"`` (KAMS linear kernel) or ``"epanechnikov"``.
+    bins : int, optional
+        Bins per RGB channel, in [1, 32] (KAMS: 10).
+    """
+
+    kernel: str = "cone"
+    bins: int = 10
+
+    def __post_init__(self) -> None:
+        check_kernel_bins(self.kernel, self.bins)
+        self._set("bins", int(self.bins))
+
+
+@dataclass(frozen=True)
+class MeanShiftParams(ColourParams):
+    """Parameters of the mean-shift tracker: ``ColourParams`` and the mean-shift loop.
+
+    Parameters
+    ----------
+    max_iter : int, optional
+        Maximum mean-shift iterations per start point and frame (Comaniciu et al. use 20).
+    eps : float, optional
+        Stop when a shift moves the window by less than ``eps`` pixels (>= 0).
+    """
+
+    max_iter: int = 20
+    eps: float = 0.5
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        check_mean_shift(self.max_iter, self.eps)
+        self._set("max_iter", int(self.max_iter))
+        self._set("eps", float(self.eps))
+
+
 class MeanShiftTracker(Tracker):
     """Kernel mean-shift tracker: one window per target climbs the Bhattacharyya coefficient.
 
@@ -132,18 +179,8 @@ class MeanShiftTracker(Tracker):
     all targets run in one compiled call. Deterministic: ``rng`` is accepted for the common
     protocol and not used.
 
-    Parameters
-    ----------
-    max_iter : int, optional
-        Maximum mean-shift iterations per frame (Comaniciu et al. use 20).
-    eps : float, optional
-        Stop when a shift moves the window by less than ``eps`` pixels.
-    kernel : str, optional
-        ``"cone"`` (KAMS linear kernel, default) or ``"epanechnikov"``.
-    bins : int, optional
-        Bins per RGB channel (KAMS: 10).
-    rng : Generator, int or None, optional
-        Unused (the tracker is deterministic).
+    Parameters: ``MeanShiftParams`` (kernel, bins, max_iter, eps) as keywords, and
+    ``rng`` (unused: the tracker is deterministic).
 
     Notes
     -----
@@ -157,16 +194,7 @@ class MeanShiftTracker(Tracker):
     """
 
     name = "meanshift"
-
-    def __init__(self, *, max_iter: int = 20, eps: float = 0.5, kernel: str = "cone",
-                 bins: int = 10, rng: RngLike = None) -> None:
-        super().__init__(rng=rng)
-        check_mean_shift(max_iter, eps)
-        check_kernel_bins(kernel, bins)
-        self.max_iter = int(max_iter)
-        self.eps = float(eps)
-        self.kernel = kernel
-        self.bins = int(bins)
+    Params = MeanShiftParams
 
     def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
         self.targets = ColourTargets(frame, boxes, kernel=self.kernel, bins=self.bins)

@@ -37,22 +37,32 @@ True
 from __future__ import annotations
 
 from abc import abstractmethod
-from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
-from trackers.base import Estimate, RngLike, Tracker
+from trackers.base import Estimate, Tracker
 from trackers.filters.diagnostics import effective_dynamics, uniqueness
 from trackers.filters.resampling import RESAMPLERS, resample, weighted_resample_groups
+from trackers.kernels.histogram import KERNELS
 from trackers.models.dynamics import AR2, boxes_from_states, states_from_boxes
-from trackers.models.observation import ColourModel, FrameObservation
+from trackers.models.observation import (
+    MODELS,
+    ColourModel,
+    FrameLikelihood,
+    ObservationModel,
+)
+from trackers.params import TrackerParams, check_choice, check_integer, check_number
 
 __all__ = [
     "ASSIGNMENTS",
     "Condensation",
+    "DPSParams",
     "DistributedPartitionedSampling",
     "JointPF",
+    "PSParams",
+    "ParticleParams",
     "PartitionedSampling",
     "circular_shift",
 ]
@@ -79,19 +89,20 @@ def _group_log_sum_exp(x: NDArray[np.float64], starts: NDArray[np.int64],
     return m + np.log(np.add.reduceat(np.exp(x - np.repeat(m, sizes)), starts))
 
 
-class _ParticleTracker(Tracker):
-    """Shared parameters, initialisation, estimate and diagnostics of the four filters.
+@dataclass(frozen=True)
+class ParticleParams(TrackerParams):
+    """Parameters of the four particle filters (condensation, joint-pf; PS and DPS add theirs).
 
     Parameters
     ----------
     n_particles : int, optional
         N, particles of the whole set (DPS: 300 synthetic, 200 real).
     lam : float, optional
-        λ of the likelihood exp(−λ d²).
+        λ of the likelihood exp(−λ d²), > 0.
     model : {"hsv", "rgb"}, optional
-        Observation model (``trackers.models.observation``).
+        Colour-histogram observation model (``trackers.models.observation``).
     bins : int, optional
-        Histogram bins per colour channel.
+        Histogram bins per colour channel, in [1, 256].
     n_parts : int or None, optional
         Spatial components (horizontal bands) of a region; None: the model's default.
     kernel : {"uniform", "epanechnikov", "cone"} or None, optional
@@ -102,34 +113,130 @@ class _ParticleTracker(Tracker):
         AR2 coefficients (2, −1: constant velocity).
     resampler : {"systematic", "multinomial", "stratified", "residual"}, optional
         Resampling scheme of every (weighted) resampling step.
-    rng : numpy.random.Generator, int or None, optional
-        Source of randomness; the same seed gives the same track.
+    observation : ObservationModel or None, optional
+        The observation model, replacing the colour-histogram model built from ``lam``,
+        ``model``, ``bins``, ``n_parts`` and ``kernel`` (which are then unused): any object
+        with ``set_references(frame, boxes)`` and ``observe(frame)`` returning per-box
+        log-likelihoods (the protocol ``trackers.models.observation.ObservationModel``).
     """
 
-    def __init__(
-        self,
-        *,
-        n_particles: int = 300,
-        lam: float = 20.0,
-        model: str = "hsv",
-        bins: int = 10,
-        n_parts: int | None = None,
-        kernel: str | None = None,
-        sigma: Sequence[float] = (2.0, 2.0, 0.001),
-        a1: float = 2.0,
-        a2: float = -1.0,
-        resampler: str = "systematic",
-        rng: RngLike = None,
-    ) -> None:
-        super().__init__(rng=rng)
-        if isinstance(n_particles, bool) or int(n_particles) != n_particles or n_particles < 1:
-            raise ValueError(f"n_particles must be a positive integer, got {n_particles!r}")
-        if resampler not in RESAMPLERS:
-            raise ValueError(f"unknown resampler {resampler!r}; valid: {', '.join(RESAMPLERS)}")
-        self.n_particles = int(n_particles)
-        self.resampler = resampler
-        self.model = ColourModel(model, bins=bins, n_parts=n_parts, kernel=kernel, lam=lam)
-        self.dynamics = AR2(sigma=tuple(float(s) for s in sigma), a1=float(a1), a2=float(a2))
+    n_particles: int = 300
+    lam: float = 20.0
+    model: str = "hsv"
+    bins: int = 10
+    n_parts: int | None = None
+    kernel: str | None = None
+    sigma: tuple[float, float, float] = (2.0, 2.0, 0.001)
+    a1: float = 2.0
+    a2: float = -1.0
+    resampler: str = "systematic"
+    observation: ObservationModel | None = None
+
+    def __post_init__(self) -> None:
+        check_integer(self, "n_particles", low=1)
+        check_number(self, "lam", low=0.0, low_open=True)
+        check_choice(self, "model", MODELS, what="observation model")
+        check_integer(self, "bins", low=1, high=256)
+        check_integer(self, "n_parts", low=1, optional=True)
+        if self.kernel is not None:
+            check_choice(self, "kernel", KERNELS)
+        check_sigma3(self, "sigma")
+        check_number(self, "a1")
+        check_number(self, "a2")
+        check_choice(self, "resampler", RESAMPLERS, what="resampler")
+        check_observation(self, "observation")
+
+
+@dataclass(frozen=True)
+class PSParams(ParticleParams):
+    """Parameters of partitioned sampling: ``ParticleParams`` and ``ordering``.
+
+    Parameters
+    ----------
+    ordering : int or tuple of int, optional
+        The order in which objects are sampled: an int k is the k-th circular shift
+        (k, k+1, …, K−1, 0, …, k−1) of the targets (0 ≤ k < K; the paper's orderings),
+        a sequence is an explicit permutation of 0…K−1 (stored as a tuple).
+    """
+
+    ordering: int | tuple[int, ...] = 0
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        order = self.ordering
+        if isinstance(order, (int, np.integer)) and not isinstance(order, bool):
+            if order < 0:
+                raise ValueError(f"ordering must be a circular shift >= 0 or a permutation, "
+                                 f"got {order!r}")
+            self._set("ordering", int(order))
+            return
+        try:
+            self._set("ordering", tuple(int(o) for o in order))
+        except (TypeError, ValueError):
+            raise ValueError(f"ordering must be an int (circular shift) or a sequence of "
+                             f"target indices, got {order!r}") from None
+
+
+@dataclass(frozen=True)
+class DPSParams(ParticleParams):
+    """Parameters of distributed partitioned sampling: ``ParticleParams`` and the groups.
+
+    Parameters
+    ----------
+    n_groups : int or None, optional
+        C, the number of mixture components, in [1, n_particles]; None: one per target
+        (the paper's C = M).
+    assignment : {"random", "interleaved"}, optional
+        How particles are assigned to components (``DistributedPartitionedSampling``).
+    """
+
+    n_groups: int | None = None
+    assignment: str = "random"
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        check_integer(self, "n_groups", low=1, high=self.n_particles, optional=True)
+        check_choice(self, "assignment", ASSIGNMENTS)
+
+
+def check_sigma3(params: TrackerParams, name: str) -> None:
+    """Field ``name``: three finite numbers >= 0 (σ_u, σ_v, σ_a), stored as a tuple."""
+    value = getattr(params, name)
+    try:
+        sig = tuple(float(v) for v in value)
+    except (TypeError, ValueError):
+        sig = ()
+    if len(sig) != 3 or not all(np.isfinite(v) and v >= 0 for v in sig):
+        raise ValueError(f"{name} must be 3 finite non-negative numbers (u, v, a), got "
+                         f"{value!r}")
+    params._set(name, sig)
+
+
+def check_observation(params: TrackerParams, name: str) -> None:
+    """Field ``name``: None or an object with ``set_references`` and ``observe``."""
+    value = getattr(params, name)
+    if value is not None and not isinstance(value, ObservationModel):
+        raise ValueError(f"{name} must be None or an observation model with methods "
+                         f"set_references(frame, boxes) and observe(frame), got "
+                         f"{type(value).__name__}")
+
+
+class _ParticleTracker(Tracker):
+    """Shared initialisation, estimate and diagnostics of the four filters.
+
+    Parameters: ``ParticleParams`` (fields as keywords), and ``rng``: the source of
+    randomness; the same seed gives the same track.
+    """
+
+    Params = ParticleParams
+
+    def _configure(self, params: ParticleParams) -> None:
+        if params.observation is not None:
+            self.model = params.observation
+        else:
+            self.model = ColourModel(params.model, bins=params.bins, n_parts=params.n_parts,
+                                     kernel=params.kernel, lam=params.lam)
+        self.dynamics = AR2(sigma=params.sigma, a1=params.a1, a2=params.a2)
         self.particles = np.empty((0, 0, 3))
         self.weights = np.empty(0)
 
@@ -166,7 +273,7 @@ class Condensation(_ParticleTracker):
     With one target it is PS with one object, draw for draw.
 
     After a step ``weights`` has shape (N, K): column k weights target k's filter.
-    Parameters: see ``_ParticleTracker``.
+    Parameters: ``ParticleParams`` as keywords, and ``rng``.
     """
 
     name = "condensation"
@@ -198,7 +305,7 @@ class JointPF(_ParticleTracker):
 
     Resample the joint set, propagate every object, weight by Π_i p(Z | X_i). The
     likelihoods of all N × K candidate boxes come from one kernel call.
-    Parameters: see ``_ParticleTracker``.
+    Parameters: ``ParticleParams`` as keywords, and ``rng``.
     """
 
     name = "joint-pf"
@@ -229,7 +336,7 @@ class _Partitioned(_ParticleTracker):
         are contiguous, the group sizes (C,) and each group's ordering (C, M)."""
 
     def _partitioned_step(self, frame: NDArray[np.uint8]) -> tuple[Estimate, NDArray]:
-        obs: FrameObservation = self.model.observe(frame)
+        obs: FrameLikelihood = self.model.observe(frame)
         n, m = self.n_particles, self.n_targets
         idx = resample(self.weights, method=self.resampler, rng=self.rng)
         x, prev, sizes, orderings = self._groups(self.particles[idx], self._prev[idx])
@@ -294,56 +401,19 @@ class _Partitioned(_ParticleTracker):
 class PartitionedSampling(_Partitioned):
     """Partitioned sampling (MacCormick & Blake 2000; ALGORITHMS.md §3.3).
 
-    Parameters
-    ----------
-    ordering : int or sequence of int, optional
-        The order in which objects are sampled: an int k is the k-th circular shift
-        (k, k+1, …, K−1, 0, …, k−1) of the targets (0 ≤ k < K; the paper's orderings),
-        a sequence is an explicit permutation of 0…K−1.
-    **params
-        See ``_ParticleTracker`` (n_particles, lam, model, bins, n_parts, kernel, sigma,
-        a1, a2, resampler, rng).
+    Parameters: ``PSParams`` (``ordering`` and the ``ParticleParams``) as keywords, and
+    ``rng``.
     """
 
     name = "ps"
-
-    def __init__(
-        self,
-        *,
-        ordering: int | Sequence[int] = 0,
-        n_particles: int = 300,
-        lam: float = 20.0,
-        model: str = "hsv",
-        bins: int = 10,
-        n_parts: int | None = None,
-        kernel: str | None = None,
-        sigma: Sequence[float] = (2.0, 2.0, 0.001),
-        a1: float = 2.0,
-        a2: float = -1.0,
-        resampler: str = "systematic",
-        rng: RngLike = None,
-    ) -> None:
-        super().__init__(n_particles=n_particles, lam=lam, model=model, bins=bins,
-                         n_parts=n_parts, kernel=kernel, sigma=sigma, a1=a1, a2=a2,
-                         resampler=resampler, rng=rng)
-        if isinstance(ordering, (int, np.integer)) and not isinstance(ordering, bool):
-            if ordering < 0:
-                raise ValueError(f"ordering must be a circular shift >= 0 or a permutation, "
-                                 f"got {ordering!r}")
-        else:
-            try:
-                ordering = [int(o) for o in ordering]
-            except (TypeError, ValueError):
-                raise ValueError(f"ordering must be an int (circular shift) or a sequence of "
-                                 f"target indices, got {ordering!r}") from None
-        self.ordering = ordering
+    Params = PSParams
 
     def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
         k = boxes.shape[0]
-        if isinstance(self.ordering, list):
+        if isinstance(self.ordering, tuple):
             order = np.asarray(self.ordering, dtype=np.int64)
             if sorted(order.tolist()) != list(range(k)):
-                raise ValueError(f"ordering {self.ordering} is not a permutation of the "
+                raise ValueError(f"ordering {list(self.ordering)} is not a permutation of the "
                                  f"{k} targets 0..{k - 1}")
         else:
             if self.ordering >= k:
@@ -370,53 +440,17 @@ class DistributedPartitionedSampling(_Partitioned):
     mixture weights π_c,t ∝ π_c,t−1 Σ_{n∈c} w̃_n. All components of a sampling stage are
     scored in one kernel call. ``Estimate.extras["mixture_weights"]`` is (C,).
 
-    Parameters
-    ----------
-    n_groups : int or None, optional
-        C, the number of mixture components; None: one per target (the paper's C = M).
-        1 gives PS with the identity ordering, draw for draw.
-    assignment : {"random", "interleaved"}, optional
-        **(open)** How particles are assigned to components. "random" (the paper): a
-        uniformly random partition, drawn each step. "interleaved": particle n of the
-        resampled set goes to component n mod C; systematic resampling leaves copies of
-        one ancestor next to each other, so this spreads them over the components
-        (stratified assignment) and uses no randomness.
-    **params
-        See ``_ParticleTracker`` (n_particles, lam, model, bins, n_parts, kernel, sigma,
-        a1, a2, resampler, rng).
+    Parameters: ``DPSParams`` (``n_groups``, ``assignment`` and the ``ParticleParams``)
+    as keywords, and ``rng``. ``n_groups=1`` gives PS with the identity ordering, draw
+    for draw. **(open)** ``assignment``: "random" (the paper) draws a uniformly random
+    partition each step; "interleaved" sends particle n of the resampled set to
+    component n mod C: systematic resampling leaves copies of one ancestor next to each
+    other, so this spreads them over the components (stratified assignment) and uses no
+    randomness.
     """
 
     name = "dps"
-
-    def __init__(
-        self,
-        *,
-        n_groups: int | None = None,
-        assignment: str = "random",
-        n_particles: int = 300,
-        lam: float = 20.0,
-        model: str = "hsv",
-        bins: int = 10,
-        n_parts: int | None = None,
-        kernel: str | None = None,
-        sigma: Sequence[float] = (2.0, 2.0, 0.001),
-        a1: float = 2.0,
-        a2: float = -1.0,
-        resampler: str = "systematic",
-        rng: RngLike = None,
-    ) -> None:
-        super().__init__(n_particles=n_particles, lam=lam, model=model, bins=bins,
-                         n_parts=n_parts, kernel=kernel, sigma=sigma, a1=a1, a2=a2,
-                         resampler=resampler, rng=rng)
-        if n_groups is not None and (isinstance(n_groups, bool) or int(n_groups) != n_groups
-                                     or not 1 <= n_groups <= self.n_particles):
-            raise ValueError(f"n_groups must be an integer in [1, n_particles = "
-                             f"{self.n_particles}] or None, got {n_groups!r}")
-        if assignment not in ASSIGNMENTS:
-            raise ValueError(f"unknown assignment {assignment!r}; valid: "
-                             f"{', '.join(ASSIGNMENTS)}")
-        self.n_groups = None if n_groups is None else int(n_groups)
-        self.assignment = assignment
+    Params = DPSParams
 
     def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
         k = boxes.shape[0]

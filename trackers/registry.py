@@ -8,7 +8,7 @@ from typing import Any
 
 from trackers.base import Tracker
 
-__all__ = ["get_class", "make", "names"]
+__all__ = ["defaults", "get_class", "make", "names", "parameters"]
 
 # name -> "module:Class"; modules are imported on first use.
 _REGISTRY: dict[str, str] = {
@@ -46,10 +46,23 @@ def get_class(name: str) -> type[Tracker]:
     return getattr(importlib.import_module(module), cls)
 
 
+def defaults(name: str) -> dict[str, Any]:
+    """Keyword parameters of tracker ``name`` and their defaults (``rng`` last, None).
+
+    Read from the fields of the tracker's parameter dataclass (``cls.Params``); a
+    registered class without one is read from its constructor's signature.
+    """
+    cls = get_class(name)
+    if cls.Params is not None:
+        return {**cls.Params.defaults(), "rng": None}
+    sig = inspect.signature(cls.__init__)
+    return {p.name: p.default for p in sig.parameters.values()
+            if p.name != "self" and p.kind is p.KEYWORD_ONLY}
+
+
 def parameters(name: str) -> list[str]:
-    """Keyword parameters accepted by tracker ``name`` (``rng`` included)."""
-    sig = inspect.signature(get_class(name).__init__)
-    return [p for p in sig.parameters if p != "self"]
+    """Keyword parameters accepted by tracker ``name`` (``rng`` included, last)."""
+    return list(defaults(name))
 
 
 def make(name: str, **params: Any) -> Tracker:

@@ -67,20 +67,25 @@ objects (two crossing, 30x30 px) about 12 ms per frame for ``shm-fast`` and 70 m
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from numpy.typing import NDArray
 
-from trackers.base import Estimate, RngLike, Tracker
+from trackers.base import Estimate, Tracker
 from trackers.filters.kalman import KalmanFilter
-from trackers.kalman import (
-    boxes_at,
-    check_noise,
-    measurement_cov,
-    motion_model,
-)
-from trackers.models.layered import LayeredMatcher, check_matcher_params, orderings
+from trackers.kalman import KalmanParams, boxes_at, measurement_cov
+from trackers.models.layered import LayeredMatcher, orderings
+from trackers.params import check_choice, check_number
 
-__all__ = ["EVIDENCES", "FastSHMTracker", "SHMTracker", "transition_matrix"]
+__all__ = [
+    "EVIDENCES",
+    "FastSHMTracker",
+    "FastShmParams",
+    "SHMTracker",
+    "ShmParams",
+    "transition_matrix",
+]
 
 
 def transition_matrix(n_orderings: int, p_stay: float) -> NDArray[np.float64]:
@@ -142,62 +147,43 @@ class _OrderingEvidence:
         return out
 
 
-def _check_shm(
-    p_stay: float, lam: float, mse_rate: float, mse_floor: float, evidence: str
-) -> None:
-    if evidence not in EVIDENCES:
-        raise ValueError(f"unknown evidence {evidence!r}; valid: {', '.join(EVIDENCES)}")
-    if not (np.isfinite(p_stay) and 0 < p_stay <= 1):
-        raise ValueError(f"p_stay must be in (0, 1], got {p_stay!r}")
-    if not (np.isfinite(lam) and lam >= 0):
-        raise ValueError(f"lam must be finite and >= 0, got {lam!r}")
-    if not (np.isfinite(mse_rate) and 0 < mse_rate <= 1):
-        raise ValueError(f"mse_rate must be in (0, 1], got {mse_rate!r}")
-    if not (np.isfinite(mse_floor) and mse_floor > 0):
-        raise ValueError(f"mse_floor must be finite and > 0, got {mse_floor!r}")
+@dataclass(frozen=True)
+class FastShmParams(KalmanParams):
+    """Parameters of "shm-fast": ``KalmanParams`` and the ordering evidence's (documented on
+    ``SHMTracker``)."""
+
+    p_stay: float = 0.8
+    lam: float = 1.0
+    mse_rate: float = 0.1
+    mse_floor: float = 25.0
+    evidence: str = "union"
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        check_choice(self, "evidence", EVIDENCES)
+        check_number(self, "p_stay", low=0.0, high=1.0, low_open=True)
+        check_number(self, "lam", low=0.0)
+        check_number(self, "mse_rate", low=0.0, high=1.0, low_open=True)
+        check_number(self, "mse_floor", low=0.0, low_open=True)
+
+
+@dataclass(frozen=True)
+class ShmParams(FastShmParams):
+    """Parameters of "shm": ``FastShmParams`` and ``use_mse`` (documented on ``SHMTracker``)."""
+
+    use_mse: bool = True
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        self._set("use_mse", bool(self.use_mse))
 
 
 class _SHMBase(Tracker):
     """Parameter handling and measurement shared by the two SHM trackers."""
 
-    def _configure(
-        self,
-        motion: str,
-        process_std: float,
-        a1: float,
-        a2: float,
-        velocity_std: float,
-        r_gain: float,
-        r_floor: float,
-        search_radius: int,
-        step: int,
-        min_visible: float,
-        support: str,
-        blur: float,
-        p_stay: float,
-        lam: float,
-        mse_rate: float,
-        mse_floor: float,
-        evidence: str,
-    ) -> None:
-        self.model = motion_model(motion, process_std, a1, a2, velocity_std)
-        check_noise(r_gain, r_floor)
-        check_matcher_params(search_radius, step, min_visible, support, blur)
-        _check_shm(p_stay, lam, mse_rate, mse_floor, evidence)
-        self.evidence = evidence
-        self.r_gain = float(r_gain)
-        self.r_floor = float(r_floor)
-        self.p_stay = float(p_stay)
-        self.lam = float(lam)
-        self.mse_rate = float(mse_rate)
-        self.mse_floor = float(mse_floor)
-        self._matcher_params = dict(
-            search_radius=search_radius,
-            step=step,
-            min_visible=min_visible,
-            support=support,
-            blur=blur,
-        )
+    def _configure(self, params: FastShmParams) -> None:
+        self.model = params.motion_model()
+        self._matcher_params = params.matcher_params()
 
     def _init_common(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
         # orderings() refuses more than 4 objects with a message saying what to do.
@@ -216,6 +202,8 @@ class _SHMBase(Tracker):
 
 class SHMTracker(_SHMBase):
     """SHM filter (§3.2): Gaussian sum over depth orderings with GPB2 collapsing.
+
+    The parameters are the fields of ``ShmParams``, and ``rng``.
 
     Parameters
     ----------
@@ -257,36 +245,7 @@ min_visible, support, blur
     """
 
     name = "shm"
-
-    def __init__(
-        self,
-        *,
-        motion: str = "cv",
-        process_std: float = 1.5,
-        a1: float = 2.0,
-        a2: float = -1.0,
-        velocity_std: float = 5.0,
-        r_gain: float = 0.01,
-        r_floor: float = 0.5,
-        search_radius: int = 12,
-        step: int = 2,
-        min_visible: float = 0.25,
-        support: str = "ellipse",
-        blur: float = 2.0,
-        p_stay: float = 0.8,
-        lam: float = 1.0,
-        mse_rate: float = 0.1,
-        mse_floor: float = 25.0,
-        evidence: str = "union",
-        use_mse: bool = True,
-        rng: RngLike = None,
-    ) -> None:
-        super().__init__(rng=rng)
-        self._configure(
-            motion, process_std, a1, a2, velocity_std, r_gain, r_floor, search_radius, step,
-            min_visible, support, blur, p_stay, lam, mse_rate, mse_floor, evidence,
-        )
-        self.use_mse = bool(use_mse)
+    Params = ShmParams
 
     def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
         self._init_common(frame, boxes)
@@ -353,6 +312,8 @@ min_visible, support, blur
 class FastSHMTracker(_SHMBase):
     """Fast SHM filter (§3.3): ordering posterior from the matches, one Kalman filter.
 
+    The parameters are the fields of ``FastShmParams``, and ``rng``.
+
     Parameters
     ----------
     motion, process_std, a1, a2, velocity_std, r_gain, r_floor, search_radius, step, \
@@ -375,34 +336,7 @@ min_visible, support, blur, p_stay, lam, mse_rate, mse_floor, evidence
     """
 
     name = "shm-fast"
-
-    def __init__(
-        self,
-        *,
-        motion: str = "cv",
-        process_std: float = 1.5,
-        a1: float = 2.0,
-        a2: float = -1.0,
-        velocity_std: float = 5.0,
-        r_gain: float = 0.01,
-        r_floor: float = 0.5,
-        search_radius: int = 12,
-        step: int = 2,
-        min_visible: float = 0.25,
-        support: str = "ellipse",
-        blur: float = 2.0,
-        p_stay: float = 0.8,
-        lam: float = 1.0,
-        mse_rate: float = 0.1,
-        mse_floor: float = 25.0,
-        evidence: str = "union",
-        rng: RngLike = None,
-    ) -> None:
-        super().__init__(rng=rng)
-        self._configure(
-            motion, process_std, a1, a2, velocity_std, r_gain, r_floor, search_radius, step,
-            min_visible, support, blur, p_stay, lam, mse_rate, mse_floor, evidence,
-        )
+    Params = FastShmParams
 
     def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
         self._init_common(frame, boxes)

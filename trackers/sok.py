@@ -2,13 +2,16 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from numpy.typing import NDArray
 
-from trackers.base import Estimate, RngLike, Tracker
-from trackers.meanshift import ColourTargets, check_kernel_bins, check_mean_shift, keep_inside
+from trackers.base import Estimate, Tracker
+from trackers.meanshift import ColourTargets, MeanShiftParams, keep_inside
+from trackers.params import check_number
 
-__all__ = ["SOK"]
+__all__ = ["SOK", "SokParams"]
 
 # Confidences closer than this are equal: their difference is rounding.
 _TIE = 1e-9
@@ -16,6 +19,19 @@ _TIE = 1e-9
 # The 8 cells around the centre of a 3x3 grid, in units of the target's box size.
 _OCTAL = np.array([(-1, -1), (0, -1), (1, -1), (-1, 0), (1, 0), (-1, 1), (0, 1), (1, 1)],
                   dtype=np.float64)
+
+
+@dataclass(frozen=True)
+class SokParams(MeanShiftParams):
+    """Parameters of SOK: ``MeanShiftParams``, ``threshold`` and ``spacing`` (see ``SOK``)."""
+
+    threshold: float = 0.9
+    spacing: float = 0.5
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        check_number(self, "threshold", low=0.0, high=1.0)
+        check_number(self, "spacing", low=0.0, low_open=True)
 
 
 class SOK(Tracker):
@@ -27,7 +43,7 @@ class SOK(Tracker):
     spacing ``spacing`` times the target's box size; KAMS Fig. 2), all in one call; the
     most confident of the nine results is kept (of confidences equal to 1e-9, the one
     nearest the primary estimate). Deterministic: ``rng`` is accepted for the
-    common protocol.
+    common protocol. The parameters are the fields of ``SokParams``, and ``rng``.
 
     Parameters
     ----------
@@ -42,14 +58,8 @@ class SOK(Tracker):
         default to 0.5 (about four times), because jumps on the kams presets stay within
         about one radius and the outer cells mostly meet clutter (sok on kams-a, seeds
         0–9: 8/10 runs tracked to the end at 0.5, 5/10 at 1).
-    max_iter : int, optional
-        Mean-shift iterations per tracker and frame.
-    eps : float, optional
-        Mean-shift stopping shift, in pixels.
-    kernel : str, optional
-        ``"cone"`` (KAMS) or ``"epanechnikov"``.
-    bins : int, optional
-        Bins per RGB channel.
+    max_iter, eps, kernel, bins
+        As for ``MeanShiftTracker`` (``MeanShiftParams``): per tracker and frame.
     rng : Generator, int or None, optional
         Unused (the tracker is deterministic).
 
@@ -65,23 +75,7 @@ class SOK(Tracker):
     """
 
     name = "sok"
-
-    def __init__(self, *, threshold: float = 0.9, spacing: float = 0.5, max_iter: int = 20,
-                 eps: float = 0.5, kernel: str = "cone", bins: int = 10,
-                 rng: RngLike = None) -> None:
-        super().__init__(rng=rng)
-        if not 0.0 <= threshold <= 1.0:
-            raise ValueError(f"threshold must lie in [0, 1], got {threshold!r}")
-        if not spacing > 0.0:
-            raise ValueError(f"spacing must be > 0, got {spacing!r}")
-        check_mean_shift(max_iter, eps)
-        check_kernel_bins(kernel, bins)
-        self.threshold = float(threshold)
-        self.spacing = float(spacing)
-        self.max_iter = int(max_iter)
-        self.eps = float(eps)
-        self.kernel = kernel
-        self.bins = int(bins)
+    Params = SokParams
 
     def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
         self.targets = ColourTargets(frame, boxes, kernel=self.kernel, bins=self.bins)

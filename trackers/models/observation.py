@@ -1,8 +1,47 @@
-"""Colour-histogram observation models and the likelihood exp(−λ d²) (ALGORITHMS.md §2).
+"""Observation models: the protocol the particle filters score boxes with, and its models.
 
-An observation model turns a frame into a bin-index image once (``ColourModel.observe``),
+The protocol (``ObservationModel``)
+-----------------------------------
+The particle filters (``condensation``, ``joint-pf``, ``ps``, ``dps``) take their
+observation model as the keyword ``observation`` (default None: the colour-histogram
+``ColourModel`` built from ``lam``, ``model``, ``bins``, ``n_parts``, ``kernel``). Any object
+with these two methods will do:
+
+``set_references(frame, boxes) -> None``
+    Called once by ``init`` with the first frame (H, W, 3) uint8 and the initial boxes
+    (K, 4) [x, y, w, h], float64, one per object, in the tracker's object order
+    (object k is row k). A model learns its templates here, or only resets itself.
+``observe(frame) -> FrameLikelihood``
+    Called exactly once per ``step``, in frame order (first for the frame after the
+    init frame), with that frame (H, W, 3) uint8, before any box of the frame is scored.
+    The returned object has one method:
+
+    ``log_likelihoods(boxes, objects) -> ndarray of shape (P,)``
+        ``boxes`` (P, 4) float64 candidate boxes [x, y, w, h] (any position, possibly
+        outside the frame; w, h > 0), ``objects`` (P,) int64 the object index k of each
+        box. Returns log p(Z_t | X_k = box), natural log, finite (use a large negative
+        number, not -inf, for "impossible"). Only differences matter: a constant that
+        depends on the frame and the object but not on the box cancels in every filter.
+        A filter calls it once per sampling stage with every candidate of that stage:
+        P = N K (all objects of all particles; condensation, joint-pf) or P = N (one
+        object per particle; each PS/DPS stage, where under DPS different particles
+        place different objects). For a set of shape (N, K, 4), pass
+        ``boxes.reshape(-1, 4)`` with ``objects = np.tile(np.arange(K), N)`` and reshape
+        the result to (N, K).
+
+It must be deterministic given the frames (the filters own all randomness). A Gaussian
+position likelihood p(Z_t | X_k) = N(c(X_k); z_{t,k}, R), with c the box centre and
+z_{t,k} a measured centre, is ``PositionModel``::
+
+    z = ...                                           # (T, K, 2) measured centres
+    tracker = trackers.make("dps", observation=PositionModel(z, np.eye(2) * 4.0))
+
+Colour-histogram models (``ColourModel``)
+-----------------------------------------
+A ``ColourModel`` turns a frame into a bin-index image once (``ColourModel.observe``),
 then scores any number of candidate boxes of any of the tracked objects in one compiled
-call (``FrameObservation.distances`` / ``log_likelihoods``)::
+call (``FrameObservation.distances`` / ``log_likelihoods``; the likelihood is exp(−λ d²),
+ALGORITHMS.md §2)::
 
     model = ColourModel("hsv", lam=20.0)
     model.set_references(frame0, boxes0)            # (K, 4): one template per object
@@ -25,6 +64,7 @@ Two models:
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Protocol, runtime_checkable
 
 import numpy as np
 from numpy.typing import NDArray
@@ -40,7 +80,37 @@ from trackers.kernels.histogram import (
     region_histograms,
 )
 
-__all__ = ["MODELS", "ColourModel", "FrameObservation"]
+__all__ = [
+    "MODELS",
+    "ColourModel",
+    "FrameLikelihood",
+    "FrameObservation",
+    "ObservationModel",
+    "PositionModel",
+]
+
+
+@runtime_checkable
+class FrameLikelihood(Protocol):
+    """One frame seen by an observation model (module docstring: the protocol)."""
+
+    def log_likelihoods(self, boxes: NDArray[np.floating], objects: NDArray[np.integer]
+                        ) -> NDArray[np.float64]:
+        """log p(Z | X) (P,) of boxes (P, 4) [x, y, w, h] for their objects (P,)."""
+        ...
+
+
+@runtime_checkable
+class ObservationModel(Protocol):
+    """What the particle filters' ``observation`` keyword takes (module docstring)."""
+
+    def set_references(self, frame: NDArray[np.uint8], boxes: NDArray[np.floating]) -> None:
+        """Initialise on the first frame (H, W, 3) with the objects' boxes (K, 4)."""
+        ...
+
+    def observe(self, frame: NDArray[np.uint8]) -> FrameLikelihood:
+        """See frame (H, W, 3) of the current step; score its boxes with the result."""
+        ...
 
 #: Observation model names and their default (n_parts, kernel).
 MODELS: dict[str, tuple[int, str]] = {
@@ -209,3 +279,84 @@ class FrameObservation:
         """log p(Z | X) = −λ d² of each box (P, 4) for its object (P,); shape (P,)."""
         d = self.distances(boxes, objects)
         return -self.model.lam * d * d
+
+
+class PositionModel:
+    """Gaussian position likelihood p(Z_t | X_k) = N(c(X_k); z_{t,k}, R) of measured centres.
+
+    c(X_k) is the centre (x + w/2, y + h/2) of object k's box; the frame's pixels are not
+    looked at. A model for testing the filters' sampling against known likelihoods, and
+    the example of a model that is not a colour histogram.
+
+    Parameters
+    ----------
+    measurements : array_like of shape (T, K, 2)
+        z_{t,k}, the measured centre (x, y) of object k at frame t, in pixels; frame 0 is
+        the init frame (not scored). NaN: no measurement (a constant log-likelihood).
+    cov : array_like of shape (2, 2)
+        R, the measurement covariance, px², symmetric positive definite.
+
+    Notes
+    -----
+    ``set_references`` resets the frame counter; each ``observe`` advances it by one, so
+    the t-th ``step`` after ``init`` scores against ``measurements[t]``. Observing more
+    than T − 1 frames raises ``ValueError``.
+
+    Example
+    -------
+    >>> z = np.array([[[10.0, 10.0]], [[12.0, 10.0]]])         # T = 2, K = 1
+    >>> model = PositionModel(z, np.eye(2))
+    >>> model.set_references(np.zeros((20, 20, 3), np.uint8), np.array([[8.0, 8, 4, 4]]))
+    >>> obs = model.observe(np.zeros((20, 20, 3), np.uint8))
+    >>> np.round(obs.log_likelihoods(np.array([[10.0, 8, 4, 4], [8, 8, 4, 4]]),
+    ...                              np.array([0, 0])), 3).tolist()
+    [-1.838, -3.838]
+    """
+
+    def __init__(self, measurements: NDArray[np.floating], cov: NDArray[np.floating]) -> None:
+        z = np.asarray(measurements, dtype=np.float64)
+        r = np.asarray(cov, dtype=np.float64)
+        if z.ndim != 3 or z.shape[2] != 2:
+            raise ValueError(f"measurements must have shape (T, K, 2), got {z.shape}")
+        if r.shape != (2, 2) or not np.allclose(r, r.T) or not np.all(np.isfinite(r)):
+            raise ValueError(f"cov must be a symmetric finite (2, 2) matrix, got {r.tolist()}")
+        try:
+            chol = np.linalg.cholesky(r)
+        except np.linalg.LinAlgError:
+            raise ValueError(f"cov must be positive definite, got {r.tolist()}") from None
+        self.measurements = z
+        self.cov = r
+        self._chol_inv = np.linalg.inv(chol)
+        self._log_norm = -np.log(2.0 * np.pi) - np.log(np.diag(chol)).sum()
+        self._t = 0
+
+    def set_references(self, frame: NDArray[np.uint8], boxes: NDArray[np.floating]) -> None:
+        """Reset to frame 0; ``boxes`` (K, 4) must match the measurements' K."""
+        k = np.shape(boxes)[0]
+        if k != self.measurements.shape[1]:
+            raise ValueError(f"PositionModel has measurements of {self.measurements.shape[1]} "
+                             f"objects, init got {k} boxes")
+        self._t = 0
+
+    def observe(self, frame: NDArray[np.uint8]) -> _PositionFrame:
+        """The next frame's measurements."""
+        self._t += 1
+        if self._t >= self.measurements.shape[0]:
+            raise ValueError(f"PositionModel: frame {self._t} observed, but measurements "
+                             f"hold {self.measurements.shape[0]} frames")
+        return _PositionFrame(self, self.measurements[self._t])
+
+
+@dataclass
+class _PositionFrame:
+    model: PositionModel
+    z: NDArray[np.float64]  # (K, 2)
+
+    def log_likelihoods(self, boxes: NDArray[np.floating], objects: NDArray[np.integer]
+                        ) -> NDArray[np.float64]:
+        """log N(c(box); z_k, R) (P,) of boxes (P, 4) of objects (P,)."""
+        b = np.asarray(boxes, dtype=np.float64)
+        centres = b[:, :2] + b[:, 2:4] / 2
+        dev = (centres - self.z[np.asarray(objects)]) @ self.model._chol_inv.T
+        ll = self.model._log_norm - 0.5 * np.einsum("pc,pc->p", dev, dev)
+        return np.where(np.isnan(ll), self.model._log_norm, ll)
