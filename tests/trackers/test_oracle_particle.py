@@ -197,3 +197,29 @@ def test_the_kalman_reference_is_the_closed_form_first_step():
     gain = SIGMA**2 / (SIGMA**2 + R_STD**2)
     np.testing.assert_allclose(var[0], gain * R_STD**2)
     np.testing.assert_allclose(mean[0], START + gain * (z[1] - START))
+
+
+@pytest.mark.parametrize("name", ["condensation", "joint-pf", "ps", "dps"])
+def test_the_initial_set_is_the_init_boxes_at_rest_with_uniform_weights(name):
+    z = measurements(0)
+    boxes0 = np.column_stack([z[0] - 5.0, np.full((K, 2), 10.0)])
+    tracker = trackers.make(name, n_particles=40, observation=PositionModel(z, np.eye(2)),
+                            rng=0)
+    tracker.init(np.zeros((T, 200, 200, 3), np.uint8)[0], boxes0)
+    w = np.asarray(tracker.weights)
+    assert w.shape == ((40, K) if name == "condensation" else (40,))
+    np.testing.assert_array_equal(w, 1.0 / 40)
+    np.testing.assert_array_equal(tracker.particles[:, :, :2], np.broadcast_to(z[0], (40, K, 2)))
+    np.testing.assert_array_equal(tracker.particles[:, :, 2], 0.0)
+
+
+def test_dps_takes_as_many_groups_as_particles():
+    # One particle per mixture component (C = N = K): the smallest valid set.
+    z = measurements(0)
+    boxes0 = np.column_stack([z[0] - 5.0, np.full((K, 2), 10.0)])
+    tracker = trackers.make("dps", n_particles=K, observation=PositionModel(z, np.eye(2)),
+                            rng=0)
+    tracker.init(np.zeros((200, 200, 3), np.uint8), boxes0)
+    est = tracker.step(np.zeros((200, 200, 3), np.uint8))
+    assert est.extras["mixture_weights"].shape == (K,)
+    np.testing.assert_allclose(est.extras["mixture_weights"].sum(), 1.0)
