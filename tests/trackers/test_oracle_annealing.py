@@ -166,3 +166,31 @@ def test_one_layer_with_beta_one_is_the_bootstrap_filter(resampler):
         np.testing.assert_array_equal(est.extras["beta"], 1.0)
         np.testing.assert_allclose(tracker.particles, x, rtol=0, atol=1e-12)
         np.testing.assert_allclose(tracker.weights, w, rtol=1e-12, atol=1e-300)
+
+
+def test_mode_estimate_and_confidence_are_computed_from_the_final_layer():
+    # Targets of different sizes: the mode radius is half of each target's own smaller
+    # side; the confidence is 1 - d of the estimated window, scored independently here.
+    frames, boxes0 = scene(n_frames=5)
+    boxes0 = boxes0.copy()
+    boxes0[1, 2:] = (36.0, 30.0)
+    tracker = trackers.make("annealed", n_particles=80, n_layers=2, sigma=10.0, lam=10.0,
+                            estimate="mode", rng=2)
+    tracker.init(frames[0], boxes0)
+    model = ColourModel("rgb", bins=10, kernel="cone", lam=10.0)
+    ring = 0.0
+    model.set_references(frames[0], boxes0)
+    for frame in frames[1:]:
+        est = tracker.step(frame)
+        x, w = tracker.particles, tracker.weights
+        for k, radius in enumerate((10.0, 15.0)):
+            best = x[k, np.argmax(w[k])]
+            r = np.hypot(*(x[k] - best).T)
+            near = r <= radius
+            ring += w[k, (r > radius - 5.0) & near].sum()
+            centre = (w[k, near, None] * x[k, near]).sum(axis=0) / w[k, near].sum()
+            np.testing.assert_allclose(est.boxes[k, :2] + est.boxes[k, 2:] / 2, centre,
+                                       rtol=0, atol=1e-9)
+        d = model.observe(frame).distances(est.boxes, np.arange(2))
+        np.testing.assert_allclose(est.extras["confidence"], 1.0 - d, rtol=0, atol=1e-9)
+    assert ring > 0.05  # the radius matters: weight lies near the edge of the mode
