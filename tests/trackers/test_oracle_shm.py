@@ -20,6 +20,7 @@ import numpy as np
 import pytest
 
 import trackers
+from trackers.models.layered import LayeredMatcher
 
 NAMES = ["shm", "shm-fast"]
 
@@ -141,3 +142,33 @@ def test_after_the_overlap_the_belief_fades_at_the_markov_rate(name):
         np.testing.assert_allclose(dev[1:], 0.6 * dev[:-1], rtol=1e-9, atol=1e-12)
     else:
         assert np.all(np.diff(dev) < 0) and np.all(dev > 0)
+
+
+@pytest.mark.parametrize("evidence", ["union", "objects"])
+@pytest.mark.parametrize("lam", [0.5, 2.0])
+def test_first_overlap_posterior_is_the_squared_difference_evidence(evidence, lam):
+    # Frame 0 apart, frame 1 object 0 jumps 10 px onto object 1 (in front). From rest the
+    # prediction is the initial centres, so the measurements are those of the matcher at
+    # the initial centres; with a uniform prior P(j) ∝ exp(-lam E_j / e_bar) (§3.3), e_bar
+    # the first frame's smallest mean (floored), per object for "objects".
+    xs = np.array([[40.0, 70.0], [50.0, 70.0]])
+    ys = np.array([[30.0, 34.0], [30.0, 34.0]])
+    frames, boxes0 = scene(5, xs, ys)
+    tracker = trackers.make("shm-fast", lam=lam, evidence=evidence, mse_floor=1.0)
+    tracker.init(frames[0], boxes0)
+    prob = tracker.step(frames[1]).extras["order_prob"]
+    matcher = LayeredMatcher(frames[0], boxes0, search_radius=12, step=2, min_visible=0.25,
+                             support="ellipse", blur=2.0)
+    centres0 = boxes0[:, :2] + boxes0[:, 2:] / 2
+    meas = matcher.measure(frames[1], centres0, tracker.orderings.astype(np.int64))
+    if evidence == "union":
+        e = (meas.mse * meas.counts).sum(axis=1) / meas.counts.sum(axis=1)  # (L,)
+        log_ev = -lam * e / max(e.min(), 1.0)
+    else:
+        e = meas.mse                                                         # (L, M)
+        scale = np.maximum(e.min(axis=0), 1.0)
+        log_ev = -lam * (e / scale).sum(axis=1)
+    expected = np.exp(log_ev - log_ev.max())
+    np.testing.assert_allclose(prob, expected / expected.sum(), rtol=1e-9)
+    assert prob[0] > prob[1]  # object 0 in front explains the overlap better
+
