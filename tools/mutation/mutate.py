@@ -195,7 +195,8 @@ def test_command(mod: Module) -> str:
 
 def write_config(name: str, mod: Module, timeout: float) -> Path:
     cfg = BUILD / f"{name}.toml"
-    env = "".join(f"{k}={v} " for k, v in mod.env.items())
+    # cosmic-ray splits the command itself (no shell): set variables through env(1).
+    env = ("env " + "".join(f"{k}={v} " for k, v in mod.env.items())) if mod.env else ""
     cmd = (env + test_command(mod)).replace("\\", "\\\\").replace('"', '\\"')
     cfg.write_text(
         "[cosmic-ray]\n"
@@ -305,12 +306,14 @@ def report(name: str, mod: Module, session: Path) -> tuple[int, int, int]:
 
 
 def reset_survivors(session: Path) -> None:
-    """Forget the results of the surviving mutants, so that exec runs them again."""
+    """Forget the results of the surviving (and incompetent) mutants, so that exec runs
+    them again."""
     import sqlite3
 
     con = sqlite3.connect(session)
     with con:
-        con.execute("DELETE FROM work_results WHERE test_outcome = 'SURVIVED'")
+        con.execute("DELETE FROM work_results WHERE test_outcome IN "
+                    "('SURVIVED', 'INCOMPETENT')")
     con.close()
 
 

@@ -14,6 +14,7 @@ from scenegen.evaluation.metrics import (
     mcnemar,
     ordering_index,
     overlap_fraction,
+    recovery_rate,
     success_rate,
 )
 
@@ -42,10 +43,11 @@ def test_idf1_with_a_single_detection_is_zero_and_with_none_nan():
     assert idf1(gt, est) == 0.0
 
 
-def test_success_rate_of_no_runs_is_nan_without_a_warning():
+def test_success_and_recovery_rates_of_no_runs_are_nan_without_a_warning():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         assert np.isnan(success_rate(np.zeros((0, 5), dtype=bool)))
+        assert np.isnan(recovery_rate(np.zeros((0, 5), dtype=bool)))
 
 
 def test_mcnemar_rejects_each_negative_count():
