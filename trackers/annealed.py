@@ -17,7 +17,15 @@ from numpy.typing import NDArray
 
 from trackers.base import Estimate, Tracker
 from trackers.filters.resampling import RESAMPLERS, resample_groups
-from trackers.meanshift import ColourParams, ColourTargets, keep_inside
+from trackers.filters.weights import normalised_weights
+from trackers.meanshift import (
+    ColourParams,
+    colour_model,
+    keep_inside,
+    set_distances,
+    set_log_likelihoods,
+    window_boxes,
+)
 from trackers.models.observation import FrameObservation
 from trackers.params import check_choice, check_integer, check_number
 
@@ -27,7 +35,6 @@ __all__ = [
     "AnnealedPF",
     "AnnealedParams",
     "check_particles",
-    "normalised_weights",
     "resample_targets",
     "survival_beta",
     "survival_rate",
@@ -39,12 +46,6 @@ SCHEDULES = ("adaptive", "geometric")
 
 #: Estimators of ``AnnealedPF``.
 ESTIMATES = ("mean", "mode")
-
-
-def normalised_weights(log_w: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Weights (K, N) proportional to exp(log_w), each row summing to 1."""
-    w = np.exp(log_w - log_w.max(axis=1, keepdims=True))
-    return w / w.sum(axis=1, keepdims=True)
 
 
 def survival_rate(log_w: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -248,10 +249,10 @@ class AnnealedPF(Tracker):
 
     Attributes
     ----------
-    particles : ndarray of shape (K, N, 2)
+    particles : ndarray of shape (N, K, 2)
         Particle centres after the last step.
-    weights : ndarray of shape (K, N)
-        Their normalised weights of the last layer.
+    weights : ndarray of shape (N, K)
+        Their normalised weights of the last layer (each column sums to 1).
 
     Notes
     -----
@@ -272,38 +273,51 @@ class AnnealedPF(Tracker):
     def _configure(self, params: AnnealedParams) -> None:
         self.sigmas = params.layer_sigmas()
 
-    def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
-        self.targets = ColourTargets(frame, boxes, kernel=self.kernel, bins=self.bins,
-                                     lam=self.lam)
-        centres = boxes[:, :2] + 0.5 * boxes[:, 2:4]
-        self.particles = np.repeat(centres[:, None, :], self.n_particles, axis=1)
-        self.weights = np.full((self.n_targets, self.n_particles), 1.0 / self.n_particles)
+    @property
+    def particles(self) -> NDArray[np.float64]:
+        """Particle centres (N, K, 2) after the last step (a view of the object-major sets)."""
+        return self._sets.swapaxes(0, 1)
 
-    def _move(self, obs: FrameObservation, particles: NDArray[np.float64]) -> None:
-        """Move the particles (K, N, 2) in place after a layer's noise; the annealed PF
-        does not."""
+    @property
+    def weights(self) -> NDArray[np.float64]:
+        """Normalised weights (N, K) of the last layer; each column sums to 1."""
+        return self._set_weights.swapaxes(0, 1)
+
+    def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
+        p = self.params
+        self.model = colour_model(frame, boxes, p, lam=p.lam)
+        self.sizes = boxes[:, 2:4].copy()
+        centres = boxes[:, :2] + 0.5 * boxes[:, 2:4]
+        # Object-major sets (K, N, 2) and weights (K, N) (``trackers.meanshift``).
+        self._sets = np.repeat(centres[:, None, :], p.n_particles, axis=1)
+        self._set_weights = np.full((self.n_targets, p.n_particles), 1.0 / p.n_particles)
+
+    def _move(self, obs: FrameObservation, sets: NDArray[np.float64]) -> None:
+        """Move the per-object sets (K, N, 2) in place after a layer's noise; the annealed
+        PF does not."""
 
     def _step(self, frame: NDArray[np.uint8]) -> Estimate:
-        obs = self.targets.observe(frame)
-        x, w = self.particles, self.weights
-        betas = np.empty((self.n_targets, self.n_layers))
-        survival = np.empty((self.n_targets, self.n_layers))
+        p = self.params
+        obs = self.model.observe(frame)
+        x, w = self._sets, self._set_weights
+        betas = np.empty((self.n_targets, p.n_layers))
+        survival = np.empty((self.n_targets, p.n_layers))
         floor = np.zeros(self.n_targets)
-        for j in range(self.n_layers):
-            m = self.n_layers - 1 - j
-            x = resample_targets(x, w, self.rng, self.resampler)
+        for j in range(p.n_layers):
+            m = p.n_layers - 1 - j
+            x = resample_targets(x, w, self.rng, p.resampler)
             x += self.sigmas[j] * self.rng.standard_normal(x.shape)
             keep_inside(x, frame.shape)
             self._move(obs, x)
-            log_lik = self.targets.log_likelihoods(obs, x)
+            log_lik = set_log_likelihoods(obs, x, self.sizes)
             betas[:, j] = floor = self._beta(log_lik, m, floor)
             w = normalised_weights(betas[:, j, None] * log_lik)
-            survival[:, j] = 1.0 / (self.n_particles * (w * w).sum(axis=1))
-        self.particles, self.weights = x, w
-        radius = 0.5 * self.targets.sizes.min(axis=1) if self.estimate == "mode" else None
+            survival[:, j] = 1.0 / (p.n_particles * (w * w).sum(axis=1))
+        self._sets, self._set_weights = x, w
+        radius = 0.5 * self.sizes.min(axis=1) if p.estimate == "mode" else None
         centres = weighted_estimate(x, w, radius)[:, None, :]
-        confidence = 1.0 - self.targets.distances(obs, centres)[:, 0]
-        return Estimate(self.targets.boxes(centres)[:, 0],
+        confidence = 1.0 - set_distances(obs, centres, self.sizes)[:, 0]
+        return Estimate(window_boxes(centres, self.sizes)[:, 0],
                         {"confidence": confidence, "beta": betas, "survival": survival})
 
     def _beta(self, log_lik: NDArray[np.float64], m: int,
@@ -313,9 +327,9 @@ class AnnealedPF(Tracker):
         k = log_lik.shape[0]
         if m == 0:
             return np.ones(k)
-        if self.schedule == "geometric":
-            return np.full(k, self.beta_ratio**m)
-        return np.maximum(survival_beta(log_lik, self.alpha), floor)
+        if self.params.schedule == "geometric":
+            return np.full(k, self.params.beta_ratio**m)
+        return np.maximum(survival_beta(log_lik, self.params.alpha), floor)
 
 
 def _layer_sigmas(sigma: float | Sequence[float], decay: float,

@@ -1,4 +1,4 @@
-"""The tracker protocol shared by every tracker, and input validation.
+"""The tracker protocol shared by every tracker, the particle-set convention, input validation.
 
 A tracker is constructed with keyword parameters (``trackers.make(name, **params)``),
 initialised on the first frame with one box per target, then stepped frame by frame::
@@ -9,7 +9,87 @@ initialised on the first frame with one box per target, then stepped frame by fr
         estimate = tracker.step(frame)       # estimate.boxes: (K, 4)
 
 Trackers keep their randomness in ``self.rng`` (a ``numpy.random.Generator`` made once
-from the ``rng`` argument) and never touch global random state.
+from the ``rng`` argument) and never touch global random state. Their parameters are one
+frozen dataclass per family (``Tracker.Params``, ``trackers.params``), validated on
+construction and kept as ``self.params``.
+
+Particle sets
+-------------
+Every particle tracker exposes its set after a step in one convention:
+
+``particles`` : ndarray of shape (N, K, D)
+    Particle n's state of object k: D = 3, (u, v, a) = centre and log scale, for the DPS
+    filters (``trackers.models.dynamics``); D = 2, the centre (x, y), for the KAMS family
+    (sizes stay those of ``init``). Pixels, x = column.
+``weights`` : ndarray of shape (N,) or (N, K), normalised, linear (not log)
+    (N,) for one joint set, whose particle n carries all K objects (``joint-pf``, ``ps``,
+    ``dps``): sums to 1. (N, K) for K independent per-object sets (``condensation``,
+    ``annealed``, ``hybrid``, ``kams``): each column sums to 1.
+
+Likelihoods are exchanged as natural logs (``trackers.models.observation``: the
+observation protocol scores boxes (P, 4), one object index per row, and returns (P,)
+log-likelihoods); log-weights become weights through the one normaliser,
+``trackers.filters.weights.normalised_weights`` (largest log-weight subtracted, so exp
+never overflows), which the SHM trackers also use for their ordering probabilities.
+Estimates are weighted means of ``particles`` by ``weights`` (of the main mode, where a
+tracker offers it).
+
+One boundary (named): the KAMS family computes on object-major arrays, sets (K, N, D) and
+weights (K, N), because its reductions over the particles (survival rate, β search,
+estimate) and its noise draws run in that memory order and re-laying them out would
+change the results' last bits. Its ``particles`` and ``weights`` are views of those arrays
+with the first two axes swapped, and ``trackers.meanshift.set_*`` flatten them to the
+observation model's rows.
+
+A tracker composes parts
+------------------------
+Observation (``trackers.models.observation``: ``ColourModel`` or any ``ObservationModel``),
+dynamics (``trackers.models.dynamics.AR2``, or noise on the centres), sampler
+(``trackers.filters.resampling`` by name, partitioned / annealed stages, mean shift
+``FrameObservation.mean_shift``) and the weight normaliser. A new tracker is a short
+file; a joint bootstrap filter over all targets, complete:
+
+>>> from dataclasses import dataclass
+>>> from trackers.filters.resampling import resample
+>>> from trackers.filters.weights import normalised_weights
+>>> from trackers.models.dynamics import AR2, boxes_from_states, states_from_boxes
+>>> from trackers.models.observation import ColourModel
+>>> from trackers.params import TrackerParams, check_integer
+>>> @dataclass(frozen=True)
+... class BootstrapParams(TrackerParams):
+...     n_particles: int = 100
+...     def __post_init__(self):
+...         check_integer(self, "n_particles", low=1)
+>>> class Bootstrap(Tracker):
+...     name = "bootstrap"
+...     Params = BootstrapParams
+...     def _configure(self, params):
+...         self.observation = ColourModel("hsv", lam=20.0)        # observation
+...         self.dynamics = AR2(sigma=(2.0, 2.0, 0.001))           # dynamics
+...     def _init(self, frame, boxes):
+...         self.observation.set_references(frame, boxes)
+...         self.start, self.sizes = states_from_boxes(boxes)     # (K, 3), (K, 2)
+...         n = self.params.n_particles
+...         self.particles = np.repeat(self.start[None], n, axis=0)  # (N, K, 3)
+...         self.previous = self.particles.copy()
+...         self.weights = np.full(n, 1.0 / n)                     # (N,): one joint set
+...     def _step(self, frame):
+...         obs = self.observation.observe(frame)
+...         idx = resample(self.weights, method="systematic", rng=self.rng)  # sampler
+...         x, prev = self.particles[idx], self.previous[idx]
+...         new = self.dynamics.propagate(x, prev, self.start, rng=self.rng)
+...         n, k = new.shape[:2]
+...         boxes = boxes_from_states(new, self.sizes).reshape(n * k, 4)
+...         ll = obs.log_likelihoods(boxes, np.tile(np.arange(k), n)).reshape(n, k)
+...         self.particles, self.previous = new, x
+...         self.weights = normalised_weights(ll.sum(axis=1))
+...         mean = np.einsum("n,nkd->kd", self.weights, new)
+...         return Estimate(boxes_from_states(mean, self.sizes))
+>>> frame = np.zeros((60, 80, 3), np.uint8); frame[20:40, 30:50] = (255, 40, 40)
+>>> tracker = Bootstrap(n_particles=50, rng=0)
+>>> tracker.init(frame, np.array([[30.0, 20.0, 20.0, 20.0]]))
+>>> bool(np.abs(tracker.step(frame).boxes - [30.0, 20.0, 20.0, 20.0]).max() < 3.0)
+True
 """
 
 from __future__ import annotations

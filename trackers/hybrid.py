@@ -7,14 +7,17 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from trackers.annealed import (
-    check_particles,
-    normalised_weights,
-    resample_targets,
-    weighted_estimate,
-)
+from trackers.annealed import check_particles, resample_targets, weighted_estimate
 from trackers.base import Estimate, Tracker
-from trackers.meanshift import ColourTargets, MeanShiftParams, keep_inside
+from trackers.filters.weights import normalised_weights
+from trackers.meanshift import (
+    MeanShiftParams,
+    colour_model,
+    keep_inside,
+    set_distances,
+    set_mean_shift,
+    window_boxes,
+)
 from trackers.params import check_number
 
 __all__ = ["HybridPF", "HybridParams"]
@@ -82,9 +85,10 @@ class HybridPF(Tracker):
 
     Attributes
     ----------
-    particles, velocities : ndarray of shape (K, N, 2)
+    particles, velocities : ndarray of shape (N, K, 2)
         Particle centres and velocities after the last step.
-    weights : ndarray of shape (K, N)
+    weights : ndarray of shape (N, K)
+        Normalised weights; each column sums to 1.
 
     Notes
     -----
@@ -99,25 +103,43 @@ class HybridPF(Tracker):
     name = "hybrid"
     Params = HybridParams
 
+    @property
+    def particles(self) -> NDArray[np.float64]:
+        """Particle centres (N, K, 2) (a view of the object-major sets)."""
+        return self._sets.swapaxes(0, 1)
+
+    @property
+    def velocities(self) -> NDArray[np.float64]:
+        """Particle velocities (N, K, 2), pixels per frame."""
+        return self._velocities.swapaxes(0, 1)
+
+    @property
+    def weights(self) -> NDArray[np.float64]:
+        """Normalised weights (N, K); each column sums to 1."""
+        return self._set_weights.swapaxes(0, 1)
+
     def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
-        self.targets = ColourTargets(frame, boxes, kernel=self.kernel, bins=self.bins,
-                                     lam=self.lam)
+        p = self.params
+        self.model = colour_model(frame, boxes, p, lam=p.lam)
+        self.sizes = boxes[:, 2:4].copy()
         centres = boxes[:, :2] + 0.5 * boxes[:, 2:4]
-        self.particles = np.repeat(centres[:, None, :], self.n_particles, axis=1)
-        self.velocities = np.zeros_like(self.particles)
-        self.weights = np.full((self.n_targets, self.n_particles), 1.0 / self.n_particles)
+        # Object-major sets (K, N, 2) and weights (K, N) (``trackers.meanshift``).
+        self._sets = np.repeat(centres[:, None, :], p.n_particles, axis=1)
+        self._velocities = np.zeros_like(self._sets)
+        self._set_weights = np.full((self.n_targets, p.n_particles), 1.0 / p.n_particles)
 
     def _step(self, frame: NDArray[np.uint8]) -> Estimate:
-        obs = self.targets.observe(frame)
-        state = resample_targets(np.concatenate([self.particles, self.velocities], axis=-1),
-                                 self.weights, self.rng, self.resampler)
+        p = self.params
+        obs = self.model.observe(frame)
+        state = resample_targets(np.concatenate([self._sets, self._velocities], axis=-1),
+                                 self._set_weights, self.rng, p.resampler)
         x, v = state[..., :2], state[..., 2:]
-        pred = x + v + self.sigma * self.rng.standard_normal(x.shape)
+        pred = x + v + p.sigma * self.rng.standard_normal(x.shape)
         keep_inside(pred, frame.shape)
-        res = self.targets.shift(obs, pred, max_iter=self.max_iter, eps=self.eps)
-        self.velocities = res.centres - x
-        self.particles = res.centres
-        self.weights = normalised_weights(-self.lam * res.distances**2)
-        centres = weighted_estimate(self.particles, self.weights)[:, None, :]
-        confidence = 1.0 - self.targets.distances(obs, centres)[:, 0]
-        return Estimate(self.targets.boxes(centres)[:, 0], {"confidence": confidence})
+        res = set_mean_shift(obs, pred, self.sizes, max_iter=p.max_iter, eps=p.eps)
+        self._velocities = res.centres - x
+        self._sets = res.centres
+        self._set_weights = normalised_weights(-p.lam * res.distances**2)
+        centres = weighted_estimate(self._sets, self._set_weights)[:, None, :]
+        confidence = 1.0 - set_distances(obs, centres, self.sizes)[:, 0]
+        return Estimate(window_boxes(centres, self.sizes)[:, 0], {"confidence": confidence})

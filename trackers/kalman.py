@@ -161,9 +161,10 @@ class KalmanTracker(Tracker):
         self._origin = boxes[:, :2] + boxes[:, 2:] / 2
         k = boxes.shape[0]
         m = self.model
-        # The state is the displacement from the first centre (the AR2 mean, §1.1).
+        # The state is the displacement from the first centre (the AR2 mean,
+        # docs/algorithms.md §1.1).
         self.kf = KalmanFilter(
-            np.zeros((k, m.dim)), m.P0, m.F, m.Q, m.H, np.eye(2) * self.r_floor
+            np.zeros((k, m.dim)), m.P0, m.F, m.Q, m.H, np.eye(2) * self.params.r_floor
         )
         self._identity = np.arange(k, dtype=np.int64)[None, :]
 
@@ -172,7 +173,7 @@ class KalmanTracker(Tracker):
         predicted = self._origin + self.kf.x[:, :2]
         meas = self.matcher.measure(frame, predicted, self._identity, masking=False)
         z = meas.centres[0] - self._origin
-        r = measurement_cov(meas.mse[0], self.r_gain, self.r_floor)
+        r = measurement_cov(meas.mse[0], self.params.r_gain, self.params.r_floor)
         self.kf.update(z, R=r)
         centres = self._origin + self.kf.x[:, :2]
         return Estimate(boxes=boxes_at(centres, self._sizes), extras={"mse": meas.mse[0].copy()})

@@ -8,7 +8,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from trackers.annealed import AnnealedParams, AnnealedPF
-from trackers.meanshift import check_mean_shift
+from trackers.meanshift import check_mean_shift, set_mean_shift
 from trackers.models.observation import FrameObservation
 
 __all__ = ["KAMS", "KamsParams"]
@@ -89,6 +89,6 @@ class KAMS(AnnealedPF):
     name = "kams"
     Params = KamsParams
 
-    def _move(self, obs: FrameObservation, particles: NDArray[np.float64]) -> None:
-        particles[...] = self.targets.shift(obs, particles, max_iter=self.max_iter,
-                                            eps=self.eps).centres
+    def _move(self, obs: FrameObservation, sets: NDArray[np.float64]) -> None:
+        sets[...] = set_mean_shift(obs, sets, self.sizes, max_iter=self.params.max_iter,
+                                   eps=self.params.eps).centres

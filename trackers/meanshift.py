@@ -3,7 +3,18 @@ with the KAMS family (``annealed``, ``hybrid``, ``sok``, ``kams``).
 
 Every tracker of the family describes a target by the kernel-weighted RGB histogram of its
 initial box (KAMS §2: 10x10x10 bins, linear cone kernel over the inscribed ellipse) and
-tracks its centre only: box sizes stay those of ``init``.
+tracks its centre only: box sizes stay those of ``init``. The colour model is the shared
+``trackers.models.observation.ColourModel`` ("rgb", one part; ``colour_model``), whose
+``FrameObservation`` scores windows and runs mean shift, as for the DPS filters.
+
+Per-object sets (the family's internal layout; ``trackers.base`` gives the convention):
+the samplers of the family run K independent sets of N particles and compute on
+object-major arrays, centres (K, N, 2) and weights (K, N), because their reductions over
+the particles (survival rate, β search, estimate) and their noise draws run in that
+memory order; the trackers' public ``particles`` (N, K, 2) and ``weights`` (N, K) are
+views of them with the axes swapped. The ``set_*`` functions are the boundary between the
+object-major sets and the observation model's flat rows (P = K N boxes, object index per
+row).
 """
 
 from __future__ import annotations
@@ -14,96 +25,72 @@ import numpy as np
 from numpy.typing import NDArray
 
 from trackers.base import Estimate, Tracker
-from trackers.kernels.histogram import KERNELS
-from trackers.kernels.meanshift import MEAN_SHIFT_KERNELS, MeanShiftResult, mean_shift
+from trackers.kernels.meanshift import MEAN_SHIFT_KERNELS, MeanShiftResult
 from trackers.models.observation import ColourModel, FrameObservation
 from trackers.params import TrackerParams
 
 __all__ = [
     "ColourParams",
-    "ColourTargets",
     "MeanShiftParams",
     "MeanShiftTracker",
     "check_kernel_bins",
     "check_mean_shift",
+    "colour_model",
     "keep_inside",
+    "set_distances",
+    "set_log_likelihoods",
+    "set_mean_shift",
+    "window_boxes",
 ]
 
 
-class ColourTargets:
-    """The targets' colour models (the shared ``ColourModel``, "rgb") plus their window
-    sizes, and the batched operations the trackers of the family compose.
+def colour_model(frame: NDArray[np.uint8], boxes: NDArray[np.float64],
+                 params: ColourParams, *, lam: float = 20.0) -> ColourModel:
+    """The family's colour model: ``ColourModel("rgb")`` of one part with the templates of
+    ``boxes`` (K, 4) in ``frame`` (H, W, 3)."""
+    model = ColourModel("rgb", bins=params.bins, n_parts=1, kernel=params.kernel, lam=lam)
+    model.set_references(frame, boxes)
+    return model
 
-    Parameters
-    ----------
-    frame : ndarray of shape (H, W, 3), uint8
-        The first frame.
-    boxes : ndarray of shape (K, 4)
-        Initial boxes [x, y, w, h]; their histograms become the target models.
-    kernel : str
-        ``"cone"`` (KAMS linear kernel) or ``"epanechnikov"``.
-    bins : int
-        Bins per RGB channel (``bins**3`` histogram bins).
-    lam : float, optional
-        λ of the likelihood exp(−λ d²).
 
-    Raises
-    ------
-    ValueError
-        For an unknown kernel name, a bin count outside [1, 32] or λ <= 0.
+def window_boxes(centres: NDArray[np.float64], sizes: NDArray[np.float64]
+                 ) -> NDArray[np.float64]:
+    """Boxes (K, N, 4) of per-object sets of centres (K, N, 2), sizes (K, 2) per object."""
+    size = np.broadcast_to(sizes[:, None, :], centres.shape)
+    return np.concatenate([centres - 0.5 * size, size], axis=-1)
+
+
+def set_log_likelihoods(obs: FrameObservation, centres: NDArray[np.float64],
+                        sizes: NDArray[np.float64]) -> NDArray[np.float64]:
+    """log w = −λ d² (K, N) of windows at per-object centres (K, N, 2), in one call."""
+    k, n = centres.shape[:2]
+    return obs.log_likelihoods(window_boxes(centres, sizes).reshape(k * n, 4),
+                               np.repeat(np.arange(k), n)).reshape(k, n)
+
+
+def set_distances(obs: FrameObservation, centres: NDArray[np.float64],
+                  sizes: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Bhattacharyya distances (K, N) of windows at per-object centres (K, N, 2)."""
+    k, n = centres.shape[:2]
+    return obs.distances(window_boxes(centres, sizes).reshape(k * n, 4),
+                         np.repeat(np.arange(k), n)).reshape(k, n)
+
+
+def set_mean_shift(obs: FrameObservation, centres: NDArray[np.float64],
+                   sizes: NDArray[np.float64], *, max_iter: int, eps: float,
+                   which: NDArray[np.integer] | None = None) -> MeanShiftResult:
+    """Mean shift from per-object starts (K', N, 2) in one call (``FrameObservation``).
+
+    ``which`` (K',) lists the objects the rows of ``centres`` belong to (default: all K,
+    in order); ``sizes`` (K, 2) are every object's window sizes. Returns the converged
+    centres (K', N, 2), their Bhattacharyya distances (K', N) and the shifts used (K', N).
     """
-
-    def __init__(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64], *,
-                 kernel: str, bins: int, lam: float = 20.0) -> None:
-        check_kernel_bins(kernel, bins)
-        self.model = ColourModel("rgb", bins=bins, n_parts=1, kernel=kernel, lam=lam)
-        self.model.set_references(frame, boxes)
-        self.sizes = np.array(boxes[:, 2:4], dtype=np.float64)
-
-    @property
-    def n_targets(self) -> int:
-        return self.sizes.shape[0]
-
-    def observe(self, frame: NDArray[np.uint8]) -> FrameObservation:
-        """The frame quantised once, for every later call on this frame."""
-        return self.model.observe(frame)
-
-    def boxes(self, centres: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Boxes (K, N, 4) of the targets' sizes at ``centres`` (K, N, 2)."""
-        size = np.broadcast_to(self.sizes[:, None, :], centres.shape)
-        return np.concatenate([centres - 0.5 * size, size], axis=-1)
-
-    def log_likelihoods(self, obs: FrameObservation,
-                        centres: NDArray[np.float64]) -> NDArray[np.float64]:
-        """log w = −λ d² (K, N) of windows at ``centres`` (K, N, 2), in one call."""
-        k, n = centres.shape[:2]
-        return obs.log_likelihoods(self.boxes(centres).reshape(k * n, 4),
-                                   np.repeat(np.arange(k), n)).reshape(k, n)
-
-    def distances(self, obs: FrameObservation,
-                  centres: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Bhattacharyya distances (K, N) of windows at ``centres`` (K, N, 2), one call."""
-        k, n = centres.shape[:2]
-        return obs.distances(self.boxes(centres).reshape(k * n, 4),
-                             np.repeat(np.arange(k), n)).reshape(k, n)
-
-    def shift(self, obs: FrameObservation, centres: NDArray[np.float64], *,
-              max_iter: int, eps: float,
-              which: NDArray[np.integer] | None = None) -> MeanShiftResult:
-        """Mean shift from every start (K', N, 2) in one call.
-
-        ``which`` (K',) lists the targets the rows of ``centres`` belong to (default: all
-        K, in order). Returns the converged centres (K', N, 2), their Bhattacharyya
-        distances (K', N) and the iterations used (K', N).
-        """
-        k, n = centres.shape[:2]
-        rows = np.arange(k) if which is None else np.asarray(which)
-        res = mean_shift(obs.bin_img, self.model.references, np.repeat(rows, n),
-                         centres.reshape(k * n, 2), np.repeat(self.sizes[rows], n, axis=0),
-                         kernel=KERNELS[self.model.kernel], max_iter=max_iter, eps=eps,
-                         check_bins=False)
-        return MeanShiftResult(res.centres.reshape(k, n, 2), res.distances.reshape(k, n),
-                               res.n_iter.reshape(k, n))
+    k, n = centres.shape[:2]
+    rows = np.arange(k) if which is None else np.asarray(which)
+    res = obs.mean_shift(centres.reshape(k * n, 2), np.repeat(sizes[rows], n, axis=0),
+                         np.repeat(rows, n), max_iter=max_iter, eps=eps)
+    return MeanShiftResult(res.centres.reshape(k, n, 2), res.distances.reshape(k, n),
+                           res.n_iter.reshape(k, n))
 
 
 def check_kernel_bins(kernel: str, bins: int) -> None:
@@ -197,13 +184,15 @@ class MeanShiftTracker(Tracker):
     Params = MeanShiftParams
 
     def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
-        self.targets = ColourTargets(frame, boxes, kernel=self.kernel, bins=self.bins)
+        self.model = colour_model(frame, boxes, self.params)
+        self.sizes = boxes[:, 2:4].copy()
         self.centres = boxes[:, :2] + 0.5 * boxes[:, 2:4]
 
     def _step(self, frame: NDArray[np.uint8]) -> Estimate:
-        res = self.targets.shift(self.targets.observe(frame), self.centres[:, None, :],
-                                 max_iter=self.max_iter, eps=self.eps)
+        p = self.params
+        res = set_mean_shift(self.model.observe(frame), self.centres[:, None, :], self.sizes,
+                             max_iter=p.max_iter, eps=p.eps)
         self.centres = res.centres[:, 0]
         keep_inside(self.centres, frame.shape)
-        return Estimate(self.targets.boxes(self.centres[:, None, :])[:, 0],
+        return Estimate(window_boxes(self.centres[:, None, :], self.sizes)[:, 0],
                         {"confidence": 1.0 - res.distances[:, 0], "n_iter": res.n_iter[:, 0]})

@@ -3,16 +3,21 @@
 All four share the observation model (``trackers.models.observation``: colour histograms, one
 compiled call per sampling stage for every particle of every object), the AR2 dynamics of
 (u, v, a) (``trackers.models.dynamics``) and the resamplers (``trackers.filters.resampling``); they
-differ only in how they sample the joint state (ALGORITHMS.md §3):
+differ only in how they sample the joint state (docs/algorithms.md §2):
 
 - ``Condensation`` ("condensation"): one independent single-object filter per target
-  (Isard & Blake 1998); the M = 1 case of §3.1, run side by side.
+  (Isard & Blake 1998); the one-object joint filter, run side by side.
 - ``JointPF`` ("joint-pf", the paper's "Non-PS"): one filter over the joint state;
   resample, propagate every object, weight by the joint likelihood Π_i p(Z | X_i).
-- ``PartitionedSampling`` ("ps", §3.3): objects one at a time in an ``ordering``;
+- ``PartitionedSampling`` ("ps", DPS §3): objects one at a time in an ``ordering``;
   weighted resampling by each object's likelihood before the next object moves.
-- ``DistributedPartitionedSampling`` ("dps", §3.4): the set split into ``n_groups``
+- ``DistributedPartitionedSampling`` ("dps", DPS §4): the set split into ``n_groups``
   mixture components, each running PS with its own circular-shift ordering.
+
+The observation model is swappable: the keyword ``observation`` takes any
+``trackers.models.observation.ObservationModel`` (e.g. ``PositionModel``, a Gaussian
+likelihood of the box centre around measured positions) in place of the colour model.
+Parameters are the fields of ``ParticleParams`` (``PSParams``, ``DPSParams``).
 
 Every step starts by resampling the set by the previous step's weights, so after a step
 ``self.particles`` (N, K, 3) and ``self.weights`` are the weighted set that represents
@@ -45,6 +50,7 @@ from numpy.typing import NDArray
 from trackers.base import Estimate, Tracker
 from trackers.filters.diagnostics import effective_dynamics, uniqueness
 from trackers.filters.resampling import RESAMPLERS, resample, weighted_resample_groups
+from trackers.filters.weights import log_sum_exp_groups, normalised_weights
 from trackers.kernels.histogram import KERNELS
 from trackers.models.dynamics import AR2, boxes_from_states, states_from_boxes
 from trackers.models.observation import (
@@ -74,19 +80,6 @@ ASSIGNMENTS: tuple[str, ...] = ("random", "interleaved")
 def circular_shift(n_objects: int, k: int) -> NDArray[np.int64]:
     """The k-th circular shift (k, k+1, …, M−1, 0, …, k−1) of the objects 0…M−1."""
     return (np.arange(n_objects) + k) % n_objects
-
-
-def _normalised_weights(logw: NDArray[np.float64]) -> NDArray[np.float64]:
-    """exp(logw) / Σ exp(logw), computed without overflow."""
-    w = np.exp(logw - logw.max())
-    return w / w.sum()
-
-
-def _group_log_sum_exp(x: NDArray[np.float64], starts: NDArray[np.int64],
-                       sizes: NDArray[np.int64]) -> NDArray[np.float64]:
-    """log Σ exp(x) over each contiguous group, shape (C,), without overflow."""
-    m = np.maximum.reduceat(x, starts)
-    return m + np.log(np.add.reduceat(np.exp(x - np.repeat(m, sizes)), starts))
 
 
 @dataclass(frozen=True)
@@ -244,7 +237,7 @@ class _ParticleTracker(Tracker):
         self.model.set_references(frame, boxes)
         states, self._sizes = states_from_boxes(boxes)
         self._mean = states
-        n = self.n_particles
+        n = self.params.n_particles
         self.particles = np.repeat(states[None], n, axis=0)
         self._prev = self.particles.copy()
         self.weights = np.full(n, 1.0 / n)
@@ -280,12 +273,13 @@ class Condensation(_ParticleTracker):
 
     def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
         super()._init(frame, boxes)
-        self.weights = np.full((self.n_particles, self.n_targets), 1.0 / self.n_particles)
+        n = self.params.n_particles
+        self.weights = np.full((n, self.n_targets), 1.0 / n)
 
     def _step(self, frame: NDArray[np.uint8]) -> Estimate:
         obs = self.model.observe(frame)
-        n, k = self.n_particles, self.n_targets
-        idx = np.column_stack([resample(self.weights[:, i], method=self.resampler,
+        n, k = self.params.n_particles, self.n_targets
+        idx = np.column_stack([resample(self.weights[:, i], method=self.params.resampler,
                                         rng=self.rng) for i in range(k)])
         cols = np.arange(k)
         x = self.particles[idx, cols]
@@ -296,12 +290,12 @@ class Condensation(_ParticleTracker):
         ll = ll.reshape(n, k)
         self._prev = x
         self.particles = new
-        self.weights = np.column_stack([_normalised_weights(ll[:, i]) for i in range(k)])
+        self.weights = np.column_stack([normalised_weights(ll[:, i]) for i in range(k)])
         return self._estimate(self.weights)
 
 
 class JointPF(_ParticleTracker):
-    """Joint particle filter over all targets ("Non-PS", ALGORITHMS.md §3.1).
+    """Joint particle filter over all targets ("Non-PS", docs/algorithms.md §2.3).
 
     Resample the joint set, propagate every object, weight by Π_i p(Z | X_i). The
     likelihoods of all N × K candidate boxes come from one kernel call.
@@ -312,8 +306,8 @@ class JointPF(_ParticleTracker):
 
     def _step(self, frame: NDArray[np.uint8]) -> Estimate:
         obs = self.model.observe(frame)
-        n, k = self.n_particles, self.n_targets
-        idx = resample(self.weights, method=self.resampler, rng=self.rng)
+        n, k = self.params.n_particles, self.n_targets
+        idx = resample(self.weights, method=self.params.resampler, rng=self.rng)
         x = self.particles[idx]
         prev = self._prev[idx]
         new = self.dynamics.propagate(x, prev, self._mean, rng=self.rng)
@@ -321,7 +315,7 @@ class JointPF(_ParticleTracker):
         ll = obs.log_likelihoods(self._boxes(new.reshape(-1, 3), objects), objects)
         self._prev = x
         self.particles = new
-        self.weights = _normalised_weights(ll.reshape(n, k).sum(axis=1))
+        self.weights = normalised_weights(ll.reshape(n, k).sum(axis=1))
         return self._estimate(np.repeat(self.weights[:, None], k, axis=1))
 
 
@@ -337,8 +331,8 @@ class _Partitioned(_ParticleTracker):
 
     def _partitioned_step(self, frame: NDArray[np.uint8]) -> tuple[Estimate, NDArray]:
         obs: FrameLikelihood = self.model.observe(frame)
-        n, m = self.n_particles, self.n_targets
-        idx = resample(self.weights, method=self.resampler, rng=self.rng)
+        n, m = self.params.n_particles, self.n_targets
+        idx = resample(self.weights, method=self.params.resampler, rng=self.rng)
         x, prev, sizes, orderings = self._groups(self.particles[idx], self._prev[idx])
         group = np.repeat(np.arange(sizes.size), sizes)
         rows = np.arange(n)
@@ -354,7 +348,7 @@ class _Partitioned(_ParticleTracker):
             stage = obs.log_likelihoods(self._boxes(new, obj), obj)
             ll[rows, obj] = stage
             if j < m - 1:
-                # §3.3 weighted resampling inside each group with the weighting function
+                # Weighted resampling (DPS §3) inside each group with the weighting function
                 # g_j = Π_{i<=j} p(Z | X_{o_i}) of the objects placed so far. The carried
                 # weights are π ∝ 1 / g_{j-1}, so ancestors are drawn ∝ p(Z | X_{o_j}) and
                 # the particles stay concentrated where every placed object is likely;
@@ -363,7 +357,7 @@ class _Partitioned(_ParticleTracker):
                 log_g += stage
                 k, w = weighted_resample_groups(
                     np.exp(logpi - logpi.max()), np.exp(log_g - log_g.max()), sizes,
-                    method=self.resampler, rng=self.rng)
+                    method=self.params.resampler, rng=self.rng)
                 x, prev, ll, log_g = x[k], prev[k], ll[k], log_g[k]
                 logpi = np.log(w)
         # The set {x, π'} still represents the predicted joint state (weighted resampling
@@ -379,7 +373,7 @@ class _Partitioned(_ParticleTracker):
     @staticmethod
     def _reassemble(logw: NDArray[np.float64], logpi: NDArray[np.float64],
                     sizes: NDArray[np.int64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Mixture reassembly (§3.4, after Vermaak, Doucet & Pérez 2003).
+        """Mixture reassembly (DPS §4, after Vermaak, Doucet & Pérez 2003).
 
         π_c,t ∝ π_c,t−1 Σ_{n∈c} w̃_n, and particle n of group c gets π_c,t w̃_n / Σ_c w̃,
         with w̃_n = π'_n Π_i p(Z | X_i) (log ``logw``) and π' the group's proposal weights
@@ -389,17 +383,17 @@ class _Partitioned(_ParticleTracker):
         plain normalisation. Returns the weights (N,) and the mixture weights (C,).
         """
         if sizes.size == 1:
-            return _normalised_weights(logw), np.ones(1)
+            return normalised_weights(logw), np.ones(1)
         starts = np.cumsum(sizes) - sizes
-        log_total = _group_log_sum_exp(logw, starts, sizes)
-        log_evidence = log_total - _group_log_sum_exp(logpi, starts, sizes)
-        mixture = _normalised_weights(np.log(sizes / sizes.sum()) + log_evidence)
+        log_total = log_sum_exp_groups(logw, starts, sizes)
+        log_evidence = log_total - log_sum_exp_groups(logpi, starts, sizes)
+        mixture = normalised_weights(np.log(sizes / sizes.sum()) + log_evidence)
         logw_final = logw + np.repeat(np.log(mixture) - log_total, sizes)
-        return _normalised_weights(logw_final), mixture
+        return normalised_weights(logw_final), mixture
 
 
 class PartitionedSampling(_Partitioned):
-    """Partitioned sampling (MacCormick & Blake 2000; ALGORITHMS.md §3.3).
+    """Partitioned sampling (MacCormick & Blake 2000; docs/algorithms.md §2.5).
 
     Parameters: ``PSParams`` (``ordering`` and the ``ParticleParams``) as keywords, and
     ``rng``.
@@ -410,21 +404,21 @@ class PartitionedSampling(_Partitioned):
 
     def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
         k = boxes.shape[0]
-        if isinstance(self.ordering, tuple):
-            order = np.asarray(self.ordering, dtype=np.int64)
+        if isinstance(self.params.ordering, tuple):
+            order = np.asarray(self.params.ordering, dtype=np.int64)
             if sorted(order.tolist()) != list(range(k)):
-                raise ValueError(f"ordering {list(self.ordering)} is not a permutation of the "
-                                 f"{k} targets 0..{k - 1}")
+                raise ValueError(f"ordering {list(self.params.ordering)} is not a permutation "
+                                 f"of the {k} targets 0..{k - 1}")
         else:
-            if self.ordering >= k:
+            if self.params.ordering >= k:
                 raise ValueError(f"ordering (circular shift) must lie in [0, {k}) for {k} "
-                                 f"targets, got {self.ordering}")
-            order = circular_shift(k, int(self.ordering))
+                                 f"targets, got {self.params.ordering}")
+            order = circular_shift(k, int(self.params.ordering))
         self._order = order[None, :]
         super()._init(frame, boxes)
 
     def _groups(self, x, prev):
-        return x, prev, np.array([self.n_particles]), self._order
+        return x, prev, np.array([self.params.n_particles]), self._order
 
     def _step(self, frame: NDArray[np.uint8]) -> Estimate:
         est, _ = self._partitioned_step(frame)
@@ -432,7 +426,7 @@ class PartitionedSampling(_Partitioned):
 
 
 class DistributedPartitionedSampling(_Partitioned):
-    """Distributed partitioned sampling (Smith & Gatica-Perez 2004; ALGORITHMS.md §3.4).
+    """Distributed partitioned sampling (Smith & Gatica-Perez 2004; docs/algorithms.md §2.6).
 
     Each step the resampled set is divided into ``n_groups`` mixture components of
     N / C particles (the remainder spread over the first groups); component c runs PS
@@ -454,21 +448,21 @@ class DistributedPartitionedSampling(_Partitioned):
 
     def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
         k = boxes.shape[0]
-        c = k if self.n_groups is None else self.n_groups
-        if c > self.n_particles:
+        c = k if self.params.n_groups is None else self.params.n_groups
+        if c > self.params.n_particles:
             raise ValueError(f"n_groups = {c} (one per target) exceeds n_particles = "
-                             f"{self.n_particles}")
-        n = self.n_particles
+                             f"{self.params.n_particles}")
+        n = self.params.n_particles
         self._sizes_c = np.array([n // c + (i < n % c) for i in range(c)], dtype=np.int64)
         self._orders = np.stack([circular_shift(k, i % k) for i in range(c)])
-        if self.assignment == "interleaved":
+        if self.params.assignment == "interleaved":
             self._interleave = np.concatenate([np.arange(i, n, c) for i in range(c)])
         super()._init(frame, boxes)
 
     def _groups(self, x, prev):
         if self._sizes_c.size > 1:
-            if self.assignment == "random":
-                order = self.rng.permutation(self.n_particles)
+            if self.params.assignment == "random":
+                order = self.rng.permutation(self.params.n_particles)
             else:
                 order = self._interleave
             x, prev = x[order], prev[order]

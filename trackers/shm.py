@@ -1,7 +1,7 @@
 """Switching hypothesized measurements (SHM) trackers: positions and depth order.
 
 Wang, Tan & Loe, "Switching hypothesized measurements: a dynamic model with applications
-to occlusion adaptive joint tracking" (IJCAI 2007); ALGORITHMS.md §5.
+to occlusion adaptive joint tracking" (IJCAI 2007); docs/algorithms.md §4.
 
 Model (§2.2). ``M`` objects, ``L = M!`` depth orderings ``s_t`` (``self.orderings``, each
 row nearest first). ``s_t`` is a first-order Markov chain (eq. 1) that stays with
@@ -74,6 +74,7 @@ from numpy.typing import NDArray
 
 from trackers.base import Estimate, Tracker
 from trackers.filters.kalman import KalmanFilter
+from trackers.filters.weights import normalised_weights
 from trackers.kalman import KalmanParams, boxes_at, measurement_cov
 from trackers.models.layered import LayeredMatcher, orderings
 from trackers.params import check_choice, check_number
@@ -95,11 +96,6 @@ def transition_matrix(n_orderings: int, p_stay: float) -> NDArray[np.float64]:
     pi = np.full((n_orderings, n_orderings), (1.0 - p_stay) / (n_orderings - 1))
     np.fill_diagonal(pi, p_stay)
     return pi
-
-
-def _softmax(logw: NDArray[np.float64], axis: int = -1) -> NDArray[np.float64]:
-    w = np.exp(logw - np.max(logw, axis=axis, keepdims=True))
-    return w / np.sum(w, axis=axis, keepdims=True)
 
 
 EVIDENCES = ("union", "objects")
@@ -175,6 +171,8 @@ class ShmParams(FastShmParams):
 
     def __post_init__(self) -> None:
         super().__post_init__()
+        if self.use_mse not in (True, False):  # bool, numpy bool, 0 or 1
+            raise ValueError(f"use_mse must be True or False, got {self.use_mse!r}")
         self._set("use_mse", bool(self.use_mse))
 
 
@@ -194,8 +192,9 @@ class _SHMBase(Tracker):
         self._origin = boxes[:, :2] + boxes[:, 2:] / 2
         n_order = self.orderings.shape[0]
         self.order_prob = np.full(n_order, 1.0 / n_order)
+        p = self.params
         self._evidence = _OrderingEvidence(
-            n_order, self.p_stay, self.lam, self.mse_rate, self.mse_floor, self.evidence
+            n_order, p.p_stay, p.lam, p.mse_rate, p.mse_floor, p.evidence
         )
         self._log_u = -np.log(float(frame.shape[0] * frame.shape[1]))
 
@@ -257,7 +256,7 @@ min_visible, support, blur
         # One Gaussian per ordering; the state is the displacement from the first centres.
         self.kf = KalmanFilter(
             np.zeros((n_order, self.joint.dim)), self.joint.P0, self.joint.F, self.joint.Q,
-            self.joint.H, np.eye(2 * n_obj) * self.r_floor,
+            self.joint.H, np.eye(2 * n_obj) * self.params.r_floor,
         )
         ii, jj = np.divmod(np.arange(n_order * n_order), n_order)
         self._ii, self._jj = ii, jj
@@ -270,7 +269,7 @@ min_visible, support, blur
         mean = self.order_prob @ kf.x
         meas = self.matcher.measure(frame, self._origin + mean[self._pos], self._rows)
         z = meas.centres - self._origin[None]
-        r = measurement_cov(meas.mse, self.r_gain, self.r_floor)
+        r = measurement_cov(meas.mse, self.params.r_gain, self.params.r_floor)
         ii, jj = self._ii, self._jj
         # Prediction i updated with measurement j, for every pair (i, j).
         pairs = KalmanFilter(kf.x[ii], kf.P[ii], kf.F, kf.Q, kf.H, kf.R[ii])
@@ -286,14 +285,14 @@ min_visible, support, blur
             + np.log(np.maximum(self.order_prob, 1e-300))[ii]
             + loglik
         )
-        if self.use_mse:
+        if self.params.use_mse:
             logw = logw + self._evidence.log_evidence(meas.mse, meas.counts)[jj]
         logw = logw.reshape(n_order, n_order)  # [i, j]
         top = logw.max()
         log_pj = top + np.log(np.exp(logw - top).sum(axis=0))
-        self.order_prob = _softmax(log_pj)
+        self.order_prob = normalised_weights(log_pj)
         # Collapse (moment matching) over the previous ordering i, per ordering j.
-        w = _softmax(logw, axis=0)  # P(i | j)
+        w = normalised_weights(logw, axis=0)  # P(i | j)
         mu = pairs.x.reshape(n_order, n_order, -1)
         cov = pairs.P.reshape(n_order, n_order, *pairs.P.shape[1:])
         new_mu = np.einsum("ij,ijn->jn", w, mu)
@@ -342,7 +341,7 @@ min_visible, support, blur, p_stay, lam, mse_rate, mse_floor, evidence
         self._init_common(frame, boxes)
         m = self.model
         self.kf = KalmanFilter(
-            np.zeros((boxes.shape[0], m.dim)), m.P0, m.F, m.Q, m.H, np.eye(2) * self.r_floor
+            np.zeros((boxes.shape[0], m.dim)), m.P0, m.F, m.Q, m.H, np.eye(2) * self.params.r_floor
         )
 
     def _step(self, frame: NDArray[np.uint8]) -> Estimate:
@@ -353,14 +352,14 @@ min_visible, support, blur, p_stay, lam, mse_rate, mse_floor, evidence
         prior = self.order_prob @ self._evidence.pi
         log_ev = self._evidence.log_evidence(meas.mse, meas.counts)
         logp = np.log(np.maximum(prior, 1e-300)) + log_ev
-        self.order_prob = _softmax(logp)
+        self.order_prob = normalised_weights(logp)
         valid = np.isfinite(meas.mse)  # (L, M)
         q = self.order_prob[:, None] * valid
         mass = q.sum(axis=0)  # (M,)
         seen = mass >= 0.5
         q = q / np.where(mass > 0, mass, 1.0)
         y = np.nan_to_num(meas.centres - self._origin[None])  # (L, M, 2)
-        r = measurement_cov(meas.mse, self.r_gain, self.r_floor)  # (L, M, 2, 2)
+        r = measurement_cov(meas.mse, self.params.r_gain, self.params.r_floor)  # (L, M, 2, 2)
         # Moment-matched mixture of the hypothesized measurements, per object.
         y_hat = np.einsum("lm,lmc->mc", q, y)
         dev = y - y_hat[None]

@@ -8,7 +8,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from trackers.base import Estimate, Tracker
-from trackers.meanshift import ColourTargets, MeanShiftParams, keep_inside
+from trackers.meanshift import (
+    MeanShiftParams,
+    colour_model,
+    keep_inside,
+    set_mean_shift,
+    window_boxes,
+)
 from trackers.params import check_number
 
 __all__ = ["SOK", "SokParams"]
@@ -78,23 +84,25 @@ class SOK(Tracker):
     Params = SokParams
 
     def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
-        self.targets = ColourTargets(frame, boxes, kernel=self.kernel, bins=self.bins)
+        self.model = colour_model(frame, boxes, self.params)
+        self.sizes = boxes[:, 2:4].copy()
         self.centres = boxes[:, :2] + 0.5 * boxes[:, 2:4]
 
     def _step(self, frame: NDArray[np.uint8]) -> Estimate:
-        obs = self.targets.observe(frame)
-        res = self.targets.shift(obs, self.centres[:, None, :], max_iter=self.max_iter,
-                                 eps=self.eps)
+        p = self.params
+        obs = self.model.observe(frame)
+        res = set_mean_shift(obs, self.centres[:, None, :], self.sizes, max_iter=p.max_iter,
+                             eps=p.eps)
         centres = res.centres[:, 0]
         confidence = 1.0 - res.distances[:, 0]
-        spawned = confidence < self.threshold
+        spawned = confidence < p.threshold
         low = np.flatnonzero(spawned)
         if low.size:
-            grid = self.spacing * _OCTAL[None] * self.targets.sizes[low, None, :]
+            grid = p.spacing * _OCTAL[None] * self.sizes[low, None, :]
             starts = centres[low, None, :] + grid
             keep_inside(starts, frame.shape)
-            extra = self.targets.shift(obs, starts, max_iter=self.max_iter, eps=self.eps,
-                                       which=low)
+            extra = set_mean_shift(obs, starts, self.sizes, max_iter=p.max_iter, eps=p.eps,
+                                   which=low)
             cand = np.concatenate([centres[low, None, :], extra.centres], axis=1)
             cand_conf = np.concatenate([confidence[low, None], 1.0 - extra.distances], axis=1)
             # The most confident of the nine; confidences equal up to rounding are a tie,
@@ -108,5 +116,5 @@ class SOK(Tracker):
             confidence[low] = cand_conf[rows, pick]
         keep_inside(centres, frame.shape)
         self.centres = centres
-        return Estimate(self.targets.boxes(centres[:, None, :])[:, 0],
+        return Estimate(window_boxes(centres[:, None, :], self.sizes)[:, 0],
                         {"confidence": confidence, "spawned": spawned})

@@ -150,6 +150,6 @@ def test_layers_keep_valid_betas_weights_and_particles(scenegen_sequence, n_laye
     beta = result.extras["beta"][1:]
     assert beta.shape == (3, 2, n_layers)
     assert np.all((beta > 0) & (beta <= 1)) and np.all(beta[..., -1] == 1.0)
-    np.testing.assert_allclose(tracker.weights.sum(axis=1), 1.0, atol=1e-12)
+    np.testing.assert_allclose(tracker.weights.sum(axis=0), 1.0, atol=1e-12)
     h, w = frames.shape[1:3]
     assert np.all((tracker.particles >= 0) & (tracker.particles <= [w, h]))

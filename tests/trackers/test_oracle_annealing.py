@@ -20,6 +20,7 @@ import trackers
 from trackers.annealed import AnnealedPF, survival_rate
 from trackers.filters.resampling import RESAMPLERS, resample_groups
 from trackers.kams import KAMS
+from trackers.meanshift import set_log_likelihoods
 from trackers.models.observation import ColourModel
 
 
@@ -53,9 +54,9 @@ def recording(cls):
             super()._init(frame, boxes)
             self.layers = []
 
-        def _move(self, obs, particles):
-            super()._move(obs, particles)
-            self.layers.append(self.targets.log_likelihoods(obs, particles.copy()))
+        def _move(self, obs, sets):
+            super()._move(obs, sets)
+            self.layers.append(set_log_likelihoods(obs, sets.copy(), self.sizes))
 
     return Recording
 
@@ -165,8 +166,10 @@ def test_one_layer_with_beta_one_is_the_bootstrap_filter(resampler):
     for frame, (x, w) in zip(frames[1:], expected, strict=True):
         est = tracker.step(frame)
         np.testing.assert_array_equal(est.extras["beta"], 1.0)
-        np.testing.assert_allclose(tracker.particles, x, rtol=0, atol=1e-12)
-        np.testing.assert_allclose(tracker.weights, w, rtol=1e-12, atol=1e-300)
+        # The tracker's sets are (N, K, 2) and (N, K); the reference's object-major.
+        np.testing.assert_allclose(tracker.particles, x.swapaxes(0, 1), rtol=0, atol=1e-12)
+        np.testing.assert_allclose(tracker.weights, w.swapaxes(0, 1), rtol=1e-12,
+                                   atol=1e-300)
 
 
 def test_mode_estimate_and_confidence_are_computed_from_the_final_layer():
@@ -183,7 +186,7 @@ def test_mode_estimate_and_confidence_are_computed_from_the_final_layer():
     model.set_references(frames[0], boxes0)
     for frame in frames[1:]:
         est = tracker.step(frame)
-        x, w = tracker.particles, tracker.weights
+        x, w = tracker.particles.swapaxes(0, 1), tracker.weights.swapaxes(0, 1)  # (K, N)
         for k, radius in enumerate((10.0, 15.0)):
             best = x[k, np.argmax(w[k])]
             r = np.hypot(*(x[k] - best).T)

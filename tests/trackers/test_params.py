@@ -80,6 +80,7 @@ def test_unknown_keyword_is_a_type_error_naming_it():
         ("kalman", {"velocity_std": 0.0}, "velocity_std must be finite and > 0"),
         ("shm", {"p_stay": 0.0}, r"p_stay must be in \(0, 1\]"),
         ("shm-fast", {"evidence": "x"}, "unknown evidence 'x'; valid: union, objects"),
+        ("shm", {"use_mse": "no"}, "use_mse must be True or False, got 'no'"),
     ],
 )
 def test_bad_value_is_one_line_naming_the_parameter(name, params, message):

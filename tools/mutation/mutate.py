@@ -75,8 +75,7 @@ MODULES: dict[str, Module] = {
     ),
     "particle": Module(
         "trackers/particle.py",
-        ("circular_shift", "_normalised_weights", "_group_log_sum_exp",
-         "_ParticleTracker._init", "_ParticleTracker._boxes", "_ParticleTracker._estimate",
+        ("circular_shift", "_ParticleTracker._init", "_ParticleTracker._boxes", "_ParticleTracker._estimate",
          "Condensation._init", "Condensation._step", "JointPF._step",
          "_Partitioned._partitioned_step", "_Partitioned._reassemble",
          "PartitionedSampling._groups", "DistributedPartitionedSampling._init",
@@ -95,14 +94,14 @@ MODULES: dict[str, Module] = {
     ),
     "annealed": Module(
         "trackers/annealed.py",
-        ("normalised_weights", "survival_rate", "survival_beta", "_bracket",
+        ("survival_rate", "survival_beta", "_bracket",
          "weighted_estimate", "resample_targets", "AnnealedPF._init", "AnnealedPF._step",
          "AnnealedPF._beta", "_layer_sigmas"),
         ("tests/trackers/test_oracle_annealing.py", "tests/trackers/test_annealed.py"),
     ),
     "shm": Module(
         "trackers/shm.py",
-        ("transition_matrix", "_softmax", "_OrderingEvidence.__init__",
+        ("transition_matrix", "_OrderingEvidence.__init__",
          "_OrderingEvidence.log_evidence", "_SHMBase._init_common", "SHMTracker._init",
          "SHMTracker._step", "FastSHMTracker._init", "FastSHMTracker._step"),
         ("tests/trackers/test_oracle_shm.py", "tests/trackers/test_shm.py"),

@@ -1,3 +1,3 @@
-"""How it is filtered: the Kalman filter, resamplers and particle-set diagnostics."""
+"""How it is filtered: the Kalman filter, resamplers, weight normaliser, set diagnostics."""
 
-__all__: list[str] = []
+__all__ = ["diagnostics", "kalman", "resampling", "weights"]

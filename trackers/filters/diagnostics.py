@@ -1,4 +1,4 @@
-"""Impoverishment diagnostics of a particle set (DPS §3.1; ALGORITHMS.md §3.5).
+"""Impoverishment diagnostics of a particle set (DPS §3.1; docs/algorithms.md §2.7).
 
 - Uniqueness of object i: the number of distinct hypotheses of its sub-state X_i among
   the N particles, divided by N. Resampling copies particles; only propagation makes new

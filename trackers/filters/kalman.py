@@ -7,7 +7,7 @@ for the SHM filter). Its equations and attribute names follow FilterPy's
 that the two agree to rounding error; ``update(None)`` is a missed measurement.
 
 ``MotionModel`` builds the per-object matrices for a 2-D position (x, y): constant
-velocity, or a second-order autoregression (AR2, ALGORITHMS.md §1.1), and stacks them
+velocity, or a second-order autoregression (AR2, docs/algorithms.md §1.1), and stacks them
 block-diagonally for a joint state of several objects (SHM paper §2.2, eq. 2).
 
 Example
@@ -103,7 +103,7 @@ class MotionModel:
         """AR2 per coordinate, state (x_t, y_t, x_{t-1}, y_{t-1}).
 
         ``c_t = a1 c_{t-1} + a2 c_{t-2} + noise_std ε`` on the displacement from the first
-        position (the AR2 mean c̄ of ALGORITHMS.md §1.1 is the first position); with
+        position (the AR2 mean c̄ of docs/algorithms.md §1.1 is the first position); with
         ``a1 + a2 = 1`` the mean drops out. ``a1 = 2, a2 = -1`` is constant velocity with
         acceleration noise. ``P0`` treats the previous position as the current one minus a
         velocity of std ``velocity_std``.

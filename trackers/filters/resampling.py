@@ -1,4 +1,4 @@
-"""Resamplers by name, and weighted resampling (ALGORITHMS.md §3.2).
+"""Resamplers by name, and weighted resampling (docs/algorithms.md §2.4).
 
 Every resampler maps normalised weights to ancestor indices. Four schemes (Douc, Cappé &
 Moulines 2005), all inverse-CDF except the deterministic part of ``residual``:
@@ -193,7 +193,7 @@ def weighted_resample_groups(
     method: str = "systematic",
     rng: np.random.Generator,
 ) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
-    """Weighted resampling (MacCormick & Blake 2000; ALGORITHMS.md §3.2), per group.
+    """Weighted resampling (MacCormick & Blake 2000; docs/algorithms.md §2.4), per group.
 
     Draws ancestors k with probability ρ_k ∝ π_k g(x_k) inside each group and gives the
     new particle the weight π_k / ρ_k, renormalised in its group: the set represents the

@@ -2,7 +2,8 @@
 
 ``histogram``: frame quantisation, batched kernel-weighted region histograms and
 Bhattacharyya distances. ``meanshift``: batched kernel mean shift. ``sampling``: grouped
-inverse-CDF resampling and distinct-state counts of particle sets.
+inverse-CDF resampling and distinct-state counts of particle sets. ``template``: masked
+template matching of every object under every depth ordering.
 """
 
-__all__ = ["histogram", "meanshift", "sampling"]
+__all__ = ["histogram", "meanshift", "sampling", "template"]

@@ -1,13 +1,13 @@
 """Batched kernel-weighted colour histograms on a bin-index image (numba).
 
 Every particle tracker spends its time building the colour histograms of candidate
-regions (ALGORITHMS.md §2.2). The frame is quantised once into a bin-index image
+regions (docs/algorithms.md §2.2). The frame is quantised once into a bin-index image
 (``quantize_rgb`` or ``quantize_hsv``); then one compiled call builds the histograms of
 all candidate boxes of all objects (``region_histograms``), or directly their
 Bhattacharyya distances to reference histograms (``region_distances``, which never
 materialises the (P, B) histogram array).
 
-Conventions shared by every function here (CONTRACT.md "Coordinates"):
+Conventions shared by every function here (docs/algorithms.md, "Notation"):
 
 - A box is [x, y, w, h]. Pixel (row r, column c) belongs to a box if its centre
   (c + 0.5, r + 0.5) lies in [x, x + w) × [y, y + h). Pixels outside the frame are
@@ -896,7 +896,7 @@ def prepared_distances(
 def bhattacharyya_coefficient(
     hists: NDArray[np.floating], refs: NDArray[np.floating]
 ) -> NDArray[np.float64]:
-    """ρ = Σ_u sqrt(p_u q_u) per row (ALGORITHMS.md §2.1).
+    """ρ = Σ_u sqrt(p_u q_u) per row (docs/algorithms.md §2.2).
 
     Parameters
     ----------

@@ -359,6 +359,19 @@ def mean_shift(
     >>> np.round(r.centres, 1).tolist()
     [[20.0, 20.0]]
     """
+    img, q, idx, y, hw = _checked_inputs(bin_img, models, model_index, centres, sizes,
+                                         kernel=kernel, max_iter=max_iter, eps=eps,
+                                         min_distance=min_distance, check_bins=check_bins)
+    out, dist, iters = _mean_shift(img.astype(np.int32, copy=False), q, idx, y, hw,
+                                   int(kernel), int(max_iter), float(eps),
+                                   float(min_distance))
+    return MeanShiftResult(out, dist, iters)
+
+
+def _checked_inputs(bin_img, models, model_index, centres, sizes, *, kernel, max_iter, eps,
+                    min_distance, check_bins):
+    """``mean_shift``'s arguments validated and made contiguous (bin image, models,
+    model index, centres, sizes), or ``ValueError`` naming the first bad one."""
     img = np.ascontiguousarray(bin_img)
     if img.ndim != 2 or not np.issubdtype(img.dtype, np.integer):
         raise ValueError(f"bin_img must be an integer array of shape (H, W), got {img.dtype}"
@@ -395,7 +408,4 @@ def mean_shift(
         raise ValueError(f"eps must be >= 0, got {eps!r}")
     if not (min_distance >= 0.0):
         raise ValueError(f"min_distance must be >= 0, got {min_distance!r}")
-    out, dist, iters = _mean_shift(img.astype(np.int32, copy=False), q, idx, y, hw,
-                                   int(kernel), int(max_iter), float(eps),
-                                   float(min_distance))
-    return MeanShiftResult(out, dist, iters)
+    return img, q, idx, y, hw

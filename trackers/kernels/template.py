@@ -252,6 +252,7 @@ def layered_match(
     h = frame.shape[0]
     w = frame.shape[1]
     n_order, m_obj = orderings.shape
+    # Memo of the searches run: (object, front objects and their positions) -> result.
     n_memo_max = n_order * m_obj
     memo_obj = np.empty(n_memo_max, dtype=np.int64)
     memo_bits = np.empty(n_memo_max, dtype=np.int64)
@@ -277,61 +278,26 @@ def layered_match(
             tw = sizes[m, 1]
             rx = origins[m, 0] - radius
             ry = origins[m, 1] - radius
-            rw = tw + 2 * radius
-            rh = th + 2 * radius
-            # Front objects that can mask this object's search region.
+            if not active[m]:
+                _write_missed(out_pos, out_mse, out_count, l, m)
+                continue
             n_front = 0
             bits = np.int64(0)
             if masking:
-                for dd in range(d):
-                    f = orderings[l, dd]
-                    if not matched[f]:
-                        continue
-                    fx = pos[f, 0]
-                    fy = pos[f, 1]
-                    overlap_x = fx < rx + rw and fx + sizes[f, 1] > rx
-                    if overlap_x and fy < ry + rh and fy + sizes[f, 0] > ry:
-                        front[n_front] = f
-                        front_pos[n_front, 0] = fx
-                        front_pos[n_front, 1] = fy
-                        n_front += 1
-                        bits |= np.int64(1) << f
-            hit = -1
-            if not active[m]:
-                out_pos[l, m, 0] = 0
-                out_pos[l, m, 1] = 0
-                out_mse[l, m] = np.nan
-                out_count[l, m] = 0
-                continue
-            for k in range(n_memo):
-                if memo_obj[k] != m or memo_bits[k] != bits:
-                    continue
-                same = True
-                for q in range(n_front):
-                    f = front[q]
-                    if (memo_fpos[k, f, 0] != front_pos[q, 0]
-                            or memo_fpos[k, f, 1] != front_pos[q, 1]):
-                        same = False
-                        break
-                if same:
-                    hit = k
-                    break
+                n_front, bits = _front_objects(orderings[l], d, matched, pos, sizes, rx, ry,
+                                               tw + 2 * radius, th + 2 * radius, front,
+                                               front_pos)
+            hit = _memo_find(memo_obj, memo_bits, memo_fpos, n_memo, m, bits, front,
+                             front_pos, n_front)
             if hit < 0:
-                sub = valid[:rh, :rw]
+                sub = valid[: th + 2 * radius, : tw + 2 * radius]
                 _fill_valid(h, w, rx, ry, sub, support, sizes, front, n_front, front_pos)
                 x, y, e, cnt = _match(frame, templates[m], support[m], th, tw, radius, step,
-                                 min_visible, sub, rx, ry, offsets)
+                                      min_visible, sub, rx, ry, offsets)
                 n_run += 1
                 hit = n_memo
-                memo_obj[hit] = m
-                memo_bits[hit] = bits
-                for q in range(n_front):
-                    memo_fpos[hit, front[q], 0] = front_pos[q, 0]
-                    memo_fpos[hit, front[q], 1] = front_pos[q, 1]
-                memo_pos[hit, 0] = x
-                memo_pos[hit, 1] = y
-                memo_mse[hit] = e
-                memo_cnt[hit] = cnt
+                _memo_store(memo_obj, memo_bits, memo_fpos, memo_pos, memo_mse, memo_cnt,
+                            hit, m, bits, front, front_pos, n_front, x, y, e, cnt)
                 n_memo += 1
             e = memo_mse[hit]
             if np.isfinite(e):
@@ -343,9 +309,76 @@ def layered_match(
                 out_mse[l, m] = e
                 out_count[l, m] = memo_cnt[hit]
             else:
-                out_pos[l, m, 0] = 0
-                out_pos[l, m, 1] = 0
-                out_mse[l, m] = np.nan
-                out_count[l, m] = 0
+                _write_missed(out_pos, out_mse, out_count, l, m)
     return n_run
+
+
+@njit(cache=True)
+def _front_objects(order, d, matched, pos, sizes, rx, ry, rw, rh, front,
+                   front_pos):  # pragma: no cover - compiled
+    """The objects before position ``d`` of ``order`` that were matched and whose
+    footprint meets the search region [rx, rx + rw) × [ry, ry + rh).
+
+    Writes them and their matched top-left corners into ``front`` and ``front_pos``;
+    returns their number and their set as a bit mask (bit f for object f).
+    """
+    n_front = 0
+    bits = np.int64(0)
+    for dd in range(d):
+        f = order[dd]
+        if not matched[f]:
+            continue
+        fx = pos[f, 0]
+        fy = pos[f, 1]
+        overlap_x = fx < rx + rw and fx + sizes[f, 1] > rx
+        if overlap_x and fy < ry + rh and fy + sizes[f, 0] > ry:
+            front[n_front] = f
+            front_pos[n_front, 0] = fx
+            front_pos[n_front, 1] = fy
+            n_front += 1
+            bits |= np.int64(1) << f
+    return n_front, bits
+
+
+@njit(cache=True)
+def _memo_find(memo_obj, memo_bits, memo_fpos, n_memo, m, bits, front, front_pos,
+               n_front):  # pragma: no cover - compiled
+    """Index of the memoised search of object ``m`` behind the same front objects at the
+    same positions, or -1."""
+    for k in range(n_memo):
+        if memo_obj[k] != m or memo_bits[k] != bits:
+            continue
+        same = True
+        for q in range(n_front):
+            f = front[q]
+            if memo_fpos[k, f, 0] != front_pos[q, 0] or memo_fpos[k, f, 1] != front_pos[q, 1]:
+                same = False
+                break
+        if same:
+            return k
+    return -1
+
+
+@njit(cache=True)
+def _memo_store(memo_obj, memo_bits, memo_fpos, memo_pos, memo_mse, memo_cnt, k, m, bits,
+                front, front_pos, n_front, x, y, e, cnt):  # pragma: no cover - compiled
+    """Record the search of object ``m`` behind ``front`` as memo entry ``k``."""
+    memo_obj[k] = m
+    memo_bits[k] = bits
+    for q in range(n_front):
+        memo_fpos[k, front[q], 0] = front_pos[q, 0]
+        memo_fpos[k, front[q], 1] = front_pos[q, 1]
+    memo_pos[k, 0] = x
+    memo_pos[k, 1] = y
+    memo_mse[k] = e
+    memo_cnt[k] = cnt
+
+
+@njit(cache=True)
+def _write_missed(out_pos, out_mse, out_count, l, m):  # pragma: no cover - compiled
+    """Object ``m`` is missed under ordering ``l``."""
+    out_pos[l, m, 0] = 0
+    out_pos[l, m, 1] = 0
+    out_mse[l, m] = np.nan
+    out_count[l, m] = 0
 

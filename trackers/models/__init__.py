@@ -1,3 +1,3 @@
-"""What is filtered: observation models (colour histograms), dynamics, layered templates."""
+"""What is filtered: observation models (protocol, colour histograms), dynamics, layers."""
 
-__all__: list[str] = []
+__all__ = ["dynamics", "layered", "observation"]

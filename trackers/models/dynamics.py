@@ -6,7 +6,7 @@ y = row) and a the log scale, so that the box of a state is
     w = w0 · exp(a),  h = h0 · exp(a),  x = u − w / 2,  y = v − h / 2,
 
 with (w0, h0) the object's initial box size. A particle carries X_t and X_{t−1}, since
-the AR2 model (ALGORITHMS.md §1.1) predicts from both:
+the AR2 model (docs/algorithms.md §1.1) predicts from both:
 
     X_t = X̄ + A1 (X_{t−1} − X̄) + A2 (X_{t−2} − X̄) + σ ε_t,   ε_t ~ N(0, I).
 
@@ -51,7 +51,7 @@ def boxes_from_states(states: NDArray[np.floating], sizes: NDArray[np.floating]
 
 @dataclass(frozen=True)
 class AR2:
-    """AR2 dynamics of (u, v, a) with per-coordinate noise (ALGORITHMS.md §1.1, §3).
+    """AR2 dynamics of (u, v, a) with per-coordinate noise (docs/algorithms.md §1.1, §2.1).
 
     Parameters
     ----------

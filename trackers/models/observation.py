@@ -41,7 +41,7 @@ Colour-histogram models (``ColourModel``)
 A ``ColourModel`` turns a frame into a bin-index image once (``ColourModel.observe``),
 then scores any number of candidate boxes of any of the tracked objects in one compiled
 call (``FrameObservation.distances`` / ``log_likelihoods``; the likelihood is exp(−λ d²),
-ALGORITHMS.md §2)::
+docs/algorithms.md §2.2)::
 
     model = ColourModel("hsv", lam=20.0)
     model.set_references(frame0, boxes0)            # (K, 4): one template per object
@@ -79,6 +79,7 @@ from trackers.kernels.histogram import (
     quantize_rgb,
     region_histograms,
 )
+from trackers.kernels.meanshift import MEAN_SHIFT_KERNELS, MeanShiftResult, mean_shift
 
 __all__ = [
     "MODELS",
@@ -135,7 +136,7 @@ class ColourModel:
         Kernel profile weighting the pixels of a region; None takes the model's default
         ("epanechnikov" for "hsv", "cone" for "rgb").
     lam : float, optional
-        λ of the likelihood p(Z | X) ∝ exp(−λ d²) (ALGORITHMS.md §2.1), > 0.
+        λ of the likelihood p(Z | X) ∝ exp(−λ d²) (docs/algorithms.md §2.2), > 0.
     s_min, v_min : float, optional
         Saturation and value thresholds of the "hsv" model (fractions of the range).
 
@@ -279,6 +280,44 @@ class FrameObservation:
         """log p(Z | X) = −λ d² of each box (P, 4) for its object (P,); shape (P,)."""
         d = self.distances(boxes, objects)
         return -self.model.lam * d * d
+
+    def mean_shift(self, centres: NDArray[np.floating], sizes: NDArray[np.floating],
+                   objects: NDArray[np.integer], *, max_iter: int, eps: float
+                   ) -> MeanShiftResult:
+        """Kernel mean shift of windows towards their objects' templates, in one call.
+
+        Parameters
+        ----------
+        centres : ndarray of shape (P, 2)
+            Start centres (x, y) of the windows, pixels.
+        sizes : ndarray of shape (P, 2)
+            Window (width, height); the window is the ellipse inscribed in that box.
+        objects : ndarray of shape (P,), integer
+            Object index (row of ``model.references``) of each window.
+        max_iter : int
+            Largest number of shifts per window.
+        eps : float
+            Stop when a shift moves the window by less than ``eps`` pixels.
+
+        Returns
+        -------
+        MeanShiftResult
+            Converged centres (P, 2), their Bhattacharyya distances (P,) and the shifts
+            used (P,) (``trackers.kernels.meanshift``).
+
+        Raises
+        ------
+        ValueError
+            For a model of several parts or a kernel mean shift has no shadow for.
+        """
+        m = self.model
+        if m.n_parts != 1 or m.kernel not in MEAN_SHIFT_KERNELS:
+            raise ValueError(f"mean shift needs a one-part model with kernel "
+                             f"{' or '.join(MEAN_SHIFT_KERNELS)}, got n_parts={m.n_parts}, "
+                             f"kernel={m.kernel!r}")
+        return mean_shift(self.bin_img, m.references, objects, centres, sizes,
+                          kernel=KERNELS[m.kernel], max_iter=max_iter, eps=eps,
+                          check_bins=False)
 
 
 class PositionModel:
