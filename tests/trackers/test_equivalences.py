@@ -73,6 +73,9 @@ def test_dps_with_one_group_is_ps_draw_for_draw(resampler, assignment):
             frames, boxes0)
     b = run(PartitionedSampling(ordering=0, **params), frames, boxes0)
     assert_same(a, b)
+    dps = DistributedPartitionedSampling(n_groups=1, assignment=assignment, **params)
+    dps.init(frames[0], boxes0)
+    np.testing.assert_array_equal(dps.step(frames[1]).extras["mixture_weights"], [1.0])
 
 
 @pytest.mark.parametrize("resampler", RESAMPLERS)

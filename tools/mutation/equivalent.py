@@ -82,3 +82,21 @@ EQUIVALENT["metrics"] = [  # noqa: F821
      "missing pairs stay below any threshold in (0, 1] (idf1 does not check the "
      "threshold: at iou_threshold = 0 the original counts missing frames as matches)"),
 ]
+EQUIVALENT["particle"] += [  # noqa: F821
+    ("np.exp(logpi - logpi.max()), np.exp(log_g - log_g.max()), sizes,",
+     "np.exp(logpi - logpi.max()), np.exp(log_g + log_g.max()), sizes,",
+     "a constant factor of g cancels in weighted resampling; the shift only keeps exp() "
+     "in range (log_g is at most 0 after the shift, at least a few hundred below)"),
+]
+EQUIVALENT["annealed"] = [  # noqa: F821
+    ("coarse = np.broadcast_to(np.logspace(-8.0, 0.0, 65), (log_w.shape[0], 65))",
+     "coarse = np.broadcast_to(np.logspace(- 7.0, 0.0, 65), (log_w.shape[0], 65))",
+     "the floor of the beta grid: a beta below 1e-7 is chosen only when the "
+     "log-likelihoods of one target span more than about 10^7 (lam d^2 <= lam here)"),
+    ("def _layer_sigmas(sigma: float | Sequence[float], decay: float,",
+     "def _layer_sigmas(sigma: float & Sequence[float], decay: float,",
+     "an annotation: never evaluated (from __future__ import annotations)"),
+    ("return particles.reshape(k * n, -1)[idx].reshape(particles.shape)",
+     "return particles.reshape(k * n, - 2)[idx].reshape(particles.shape)",
+     "numpy takes any negative size as the one inferred dimension"),
+]

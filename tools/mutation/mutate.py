@@ -75,7 +75,8 @@ MODULES: dict[str, Module] = {
     ),
     "particle": Module(
         "trackers/particle.py",
-        ("circular_shift", "_ParticleTracker._init", "_ParticleTracker._boxes", "_ParticleTracker._estimate",
+        ("circular_shift", "_ParticleTracker._init", "_ParticleTracker._boxes",
+         "_ParticleTracker._estimate",
          "Condensation._init", "Condensation._step", "JointPF._step",
          "_Partitioned._partitioned_step", "_Partitioned._reassemble",
          "PartitionedSampling._groups", "DistributedPartitionedSampling._init",
