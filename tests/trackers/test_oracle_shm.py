@@ -172,3 +172,47 @@ def test_first_overlap_posterior_is_the_squared_difference_evidence(evidence, la
     np.testing.assert_allclose(prob, expected / expected.sum(), rtol=1e-9)
     assert prob[0] > prob[1]  # object 0 in front explains the overlap better
 
+
+
+def test_fast_shm_update_is_the_kalman_update_with_the_moment_matched_measurement():
+    # As above, frame 1 overlaps (by half); each object's measurement is the mixture over
+    # orderings moment-matched: y = sum_j P_j y^j, R = sum_j P_j (R^j + (y^j - y)(y^j - y)'),
+    # fed to the object's Kalman filter; on frame 2 the evidence scale is the moving
+    # average of frame 1's. (Here both orderings find the same centres, so the spread
+    # term (y^j - y)(y^j - y)' is zero: a sign error in it is not caught; see README.)
+    xs = np.array([[46.0, 70.0], [58.0, 70.0], [59.0, 70.0]])
+    ys = np.array([[30.0, 34.0], [30.0, 34.0], [30.0, 34.0]])
+    frames, boxes0 = scene(5, xs, ys)
+    lam, rate = 1.0, 0.3
+    tracker = trackers.make("shm-fast", lam=lam, mse_rate=rate, mse_floor=1.0)
+    tracker.init(frames[0], boxes0)
+    matcher = LayeredMatcher(frames[0], boxes0, search_radius=12, step=2, min_visible=0.25,
+                             support="ellipse", blur=2.0)
+    centres0 = boxes0[:, :2] + boxes0[:, 2:] / 2
+    rows = tracker.orderings.astype(np.int64)
+    kf = tracker.kf
+    scale = None
+    prob = np.full(2, 0.5)
+    for frame in frames[1:3]:
+        x_pred = kf.x @ kf.F.T
+        p_pred = kf.F @ kf.P @ kf.F.T + kf.Q
+        meas = matcher.measure(frame, centres0 + x_pred[:, :2], rows)
+        e = (meas.mse * meas.counts).sum(axis=1) / meas.counts.sum(axis=1)
+        scale = max(e.min(), 1.0) if scale is None else scale
+        prior = prob @ np.array([[0.8, 0.2], [0.2, 0.8]])
+        post = prior * np.exp(-lam * e / scale)
+        prob = post / post.sum()
+        scale = max((1 - rate) * scale + rate * e.min(), 1.0)
+        est = tracker.step(frame)
+        np.testing.assert_allclose(est.extras["order_prob"], prob, rtol=1e-9)
+        for m in range(2):
+            y_j = meas.centres[:, m] - centres0[m]                       # (L, 2)
+            y = prob @ y_j
+            dev = y_j - y
+            r = sum(prob[j] * ((0.5 + 0.01 * meas.mse[j, m]) * np.eye(2)
+                               + np.outer(dev[j], dev[j])) for j in range(2))
+            h = kf.H
+            s = h @ p_pred[m] @ h.T + r
+            gain = p_pred[m] @ h.T @ np.linalg.inv(s)
+            np.testing.assert_allclose(kf.x[m], x_pred[m] + gain @ (y - h @ x_pred[m]),
+                                       rtol=0, atol=1e-9)

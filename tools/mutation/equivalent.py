@@ -100,3 +100,8 @@ EQUIVALENT["annealed"] = [  # noqa: F821
      "return particles.reshape(k * n, - 2)[idx].reshape(particles.shape)",
      "numpy takes any negative size as the one inferred dimension"),
 ]
+EQUIVALENT["shm"] += [  # noqa: F821
+    ("np.zeros((boxes.shape[0], m.dim)), m.P0, m.F, m.Q, m.H, np.eye(2) * self.params.r_floor",
+     "np.zeros((boxes.shape[0], m.dim)), m.P0, m.F, m.Q, m.H, np.eye(2) / self.params.r_floor",
+     "the filter's default R is never used: every update passes its own R"),
+]
