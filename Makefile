@@ -3,7 +3,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test test-slow lint bench clean
+.PHONY: demo test test-slow lint bench mutate clean
 
 $(BIN)/python:
 	$(PY) -m venv $(VENV)
@@ -27,6 +27,14 @@ lint: $(STAMP)
 
 bench: $(STAMP)
 	$(BIN)/scenegen bench
+
+# Mutation score of the formula modules (cosmic-ray; long, not part of `make test`).
+# MODULES: a subset (resampling particle meanshift annealed shm kalman metrics);
+# SAMPLE: mutants per module (0: all). Results in build/mutate/<module>.txt.
+MODULES ?=
+SAMPLE ?= 60
+mutate: $(STAMP)
+	$(BIN)/python tools/mutation/mutate.py --sample $(SAMPLE) $(MODULES)
 
 clean:
 	rm -rf $(VENV) report build *.egg-info
