@@ -49,8 +49,9 @@ def format_table(rows: list[BenchRow]) -> str:
     for r in rows:
         ratio = f"{r.ratio:.2f}x" if r.baseline else ""
         met = "" if r.met is None else ("yes" if r.met else "NO")
+        rate = f"{r.rate:.2f}" if r.unit == "exponent" else f"{r.rate:,.0f}"
         lines.append(
-            f"| {r.group} | {r.name} | {r.seconds * 1e3:.3f} ms | {r.rate:,.0f} {r.unit} "
+            f"| {r.group} | {r.name} | {r.seconds * 1e3:.3f} ms | {rate} {r.unit} "
             f"| {ratio} | {r.goal} | {met} |"
         )
     return "\n".join(lines)
