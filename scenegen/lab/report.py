@@ -20,6 +20,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from scenegen.errors import DataError
 from scenegen.lab.experiments import get, names, run_experiment, verdict_counts
 
 __all__ = ["DEMO_PLAN", "FULL_COMMAND", "build_report", "markdown_to_html", "run_all",
@@ -246,7 +247,13 @@ def build_report(out_dir: str | Path) -> Path:
         if not res_path.exists():
             body.append("<p class='no'>not run (no results.json)</p>")
             continue
-        all_results[name] = json.loads(res_path.read_text(encoding="utf-8"))
+        try:
+            loaded = json.loads(res_path.read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError, json.JSONDecodeError) as err:
+            raise DataError(f"{res_path}: not a readable results file ({err})") from None
+        if not isinstance(loaded, dict):
+            raise DataError(f"{res_path}: not a results file (a JSON object is expected)")
+        all_results[name] = loaded
         links = [f"<a href='{_rel(res_path, root)}'>results.json</a>"]
         table = folder / "table.md"
         if table.exists():
