@@ -28,6 +28,7 @@ from typing import Any
 
 import numpy as np
 
+from scenegen.datasets.executor import SCHEDULER_TIMEOUT, connect
 from scenegen.errors import ConfigError
 from scenegen.lab.experiments.definitions import Experiment, get
 
@@ -43,8 +44,6 @@ __all__ = [
     "write_json_atomic",
 ]
 
-SCHEDULER_TIMEOUT = 5.0
-"""Seconds to wait for a Dask scheduler before giving up (the contract allows 10)."""
 
 _DECIMALS = 6
 _MIN_OVERLAP = 0.1  # pairs overlapping less than this say nothing about depth order
@@ -344,54 +343,6 @@ def load_record(path: Path, task: Task) -> dict[str, Any] | None:
     return data
 
 
-async def _identity(address: str) -> dict[str, Any]:
-    from distributed.comm import connect
-
-    comm = await connect(address, timeout=SCHEDULER_TIMEOUT)
-    try:
-        await comm.write({"op": "identity", "reply": True})
-        return await comm.read()
-    finally:
-        await comm.close()
-
-
-def _probe(address: str) -> None:
-    """Check within :data:`SCHEDULER_TIMEOUT` seconds that a Dask scheduler answers.
-
-    Done before creating a ``Client``, whose failed construction can hang for longer (and
-    whose clean-up on garbage collection waits another 10 s).
-    """
-    import asyncio
-
-    try:
-        reply = asyncio.run(asyncio.wait_for(_identity(address), SCHEDULER_TIMEOUT))
-    except Exception as err:  # any failure to talk to it means: not a usable scheduler
-        why = (
-            "the peer does not speak the Dask protocol"
-            if isinstance(err, MemoryError)
-            else f"{type(err).__name__}: {str(err).splitlines()[0] if str(err) else 'no reply'}"
-        )
-        raise ConfigError(
-            f"cannot reach the Dask scheduler at {address!r} within {SCHEDULER_TIMEOUT:g} s: "
-            f"{why}"
-        ) from None
-    if not isinstance(reply, dict) or reply.get("type") != "Scheduler":
-        raise ConfigError(f"{address!r} answered, but it is not a Dask scheduler")
-
-
-def _connect(address: str) -> Any:
-    from distributed import Client
-
-    _probe(address)
-    try:
-        return Client(address, timeout=SCHEDULER_TIMEOUT, set_as_default=False)
-    except Exception as err:
-        raise ConfigError(
-            f"cannot reach the Dask scheduler at {address!r} within {SCHEDULER_TIMEOUT:g} s: "
-            f"{type(err).__name__}: {err}"
-        ) from None
-
-
 def execute(
     tasks: list[Task],
     runs_dir: Path,
@@ -483,7 +434,7 @@ def _run_dask(
 ) -> None:
     from distributed import as_completed as dask_completed
 
-    client = _connect(address)
+    client = connect(address)
     try:
         futures = {}
         for t in todo:
