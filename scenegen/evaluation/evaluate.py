@@ -137,8 +137,12 @@ def _finite(x: float) -> float | None:
     return float(x) if np.isfinite(x) else None
 
 
-def check_options(gt_mode: str, visibility_threshold: float, otb_average: str) -> None:
+def check_options(
+    gt_mode: str, visibility_threshold: float, otb_average: str, iou_threshold: float = 0.5
+) -> None:
     """Raise ConfigError naming an unknown ``gt_mode`` / ``otb_average`` or a bad threshold."""
+    if not 0.0 < iou_threshold <= 1.0:
+        raise ConfigError(f"iou_threshold must be in (0, 1], got {iou_threshold}")
     if gt_mode not in GT_MODES:
         raise ConfigError(f"gt_mode must be one of {', '.join(GT_MODES)}; got {gt_mode!r}")
     if not 0.0 <= visibility_threshold < 1.0:
@@ -210,7 +214,7 @@ def evaluate(
     ConfigError
         If an option is out of range.
     """
-    check_options(gt_mode, visibility_threshold, otb_average)
+    check_options(gt_mode, visibility_threshold, otb_average, iou_threshold)
     est = np.asarray(boxes, dtype=np.float64)
     ids = np.asarray(target_ids).astype(np.int64).reshape(-1)
     name = str(getattr(sequence, "name", ""))
@@ -328,7 +332,7 @@ def evaluate_tracks(
     DataError
         If the frame count differs from the sequence's.
     """
-    check_options(gt_mode, visibility_threshold, otb_average)
+    check_options(gt_mode, visibility_threshold, otb_average, iou_threshold)
     est = np.asarray(boxes, dtype=np.float64)
     ids = np.asarray(track_ids).astype(np.int64).reshape(-1)
     name = str(getattr(sequence, "name", ""))

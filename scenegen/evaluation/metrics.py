@@ -549,8 +549,7 @@ def clear_mot(gt: ArrayLike, est: ArrayLike, *, iou_threshold: float = 0.5) -> C
         MOTA is NaN when there is no ground-truth object at all, MOTP when nothing matches.
     """
     g, e = _check_tracks(gt, est)
-    if not 0.0 < iou_threshold <= 1.0:
-        raise ValueError(f"iou_threshold must be in (0, 1], got {iou_threshold}")
+    mot.check_threshold(iou_threshold)
     c = mot.clear(mot.mot_frames(g, e), threshold=iou_threshold)
     n_gt = c.tp + c.fn
     return ClearMot(
@@ -584,6 +583,7 @@ def idf1(gt: ArrayLike, est: ArrayLike, *, iou_threshold: float = 0.5) -> float:
     float
         IDF1 in [0, 1]; NaN when there are no detections on either side.
     """
+    mot.check_threshold(iou_threshold)
     g, e = _check_tracks(gt, est)
     if int(_present(g).sum()) + int(_present(e).sum()) == 0:
         return float("nan")

@@ -39,6 +39,7 @@ __all__ = [
     "MotFrames",
     "MotScores",
     "box_iou",
+    "check_threshold",
     "clear",
     "hota",
     "identity",
@@ -255,6 +256,16 @@ def _clear_final(tp: int, fn: int, fp: int, idsw: int, motp_sum: float, mt: int,
     )  # fmt: skip
 
 
+def check_threshold(threshold: float) -> None:
+    """Raise ValueError unless the match IoU ``threshold`` is in (0, 1].
+
+    A threshold of 0 would count every pair of boxes, overlapping or not, as a match (IoU
+    is never negative), which no metric intends; above 1 nothing ever matches.
+    """
+    if not 0.0 < float(threshold) <= 1.0:
+        raise ValueError(f"iou_threshold must be in (0, 1], got {threshold}")
+
+
 def clear(data: MotFrames, *, threshold: float = 0.5) -> ClearScores:
     """CLEAR MOT of one sequence, as TrackEval's ``CLEAR.eval_sequence``.
 
@@ -263,6 +274,7 @@ def clear(data: MotFrames, *, threshold: float = 0.5) -> ClearScores:
     An object matched to a different track than at its last match (any number of frames
     earlier) is an identity switch.
     """
+    check_threshold(threshold)
     if data.n_tracker_dets == 0:
         return ClearScores(0.0, 0.0, 0.0, 0, data.n_gt_dets, 0, 0, 0, 0, data.n_gt_ids, 0)
     if data.n_gt_dets == 0:
@@ -348,6 +360,7 @@ def identity(data: MotFrames, *, threshold: float = 0.5) -> IdentityScores:
     IDFN + IDFP by the Hungarian algorithm; a frame where both exist with IoU ≥
     ``threshold`` is an identity true positive.
     """
+    check_threshold(threshold)
     if data.n_tracker_dets == 0:
         return IdentityScores(0.0, 0.0, 0.0, 0, data.n_gt_dets, 0)
     if data.n_gt_dets == 0:

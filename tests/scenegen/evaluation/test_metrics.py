@@ -225,3 +225,21 @@ def test_ordering_index_and_depth_order_accuracy():
     far = boxes.copy()
     far[:, 1, 0] = 50
     assert math.isnan(m.depth_order_accuracy(prob, orderings, depth, far))
+
+
+@pytest.mark.parametrize("bad", [0.0, -0.1, 1.01])
+def test_iou_threshold_outside_0_1_is_refused_by_every_metric(bad: float) -> None:
+    # IoU is never negative, so a threshold of 0 would match disjoint boxes (IDF1 > 1).
+    gt = np.array([[[0.0, 0.0, 10.0, 10.0]], [[0.0, 0.0, 10.0, 10.0]]])
+    est = np.array([[[50.0, 50.0, 10.0, 10.0]], [[50.0, 50.0, 10.0, 10.0]]])
+    with pytest.raises(ValueError, match="iou_threshold must be in"):
+        m.idf1(gt, est, iou_threshold=bad)
+    with pytest.raises(ValueError, match="iou_threshold must be in"):
+        m.clear_mot(gt, est, iou_threshold=bad)
+
+
+def test_iou_threshold_of_one_is_allowed_and_disjoint_boxes_never_match() -> None:
+    gt = np.array([[[0.0, 0.0, 10.0, 10.0]]])
+    assert m.idf1(gt, gt.copy(), iou_threshold=1.0) == pytest.approx(1.0)
+    far = np.array([[[50.0, 50.0, 10.0, 10.0]]])
+    assert m.idf1(gt, far, iou_threshold=0.01) == 0.0
