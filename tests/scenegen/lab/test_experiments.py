@@ -209,6 +209,9 @@ def test_judged_claims_of_the_full_run(tmp_path):
     assert occ["dps-occlusion: occluded object's success of DPS above Non-PS's"] == "reproduced"
     assert occ["dps-occlusion: the PS orderings differ in the occluded object's success (the "
                "ordering matters)"] == "reproduced"
+    dancers = verdicts("dps-dancers")
+    assert dancers["dps-dancers: occluded object's success of DPS above Non-PS's"] \
+        == "reproduced"
 
 
 def test_report_links_tables_figures_and_previews(reference, tmp_path):
@@ -280,3 +283,32 @@ def test_experiment_all_writes_one_report(tmp_path, monkeypatch, capsys):
     doc = json.loads((tmp_path / "results.json").read_text())
     assert doc["experiments"]["shm-depth"]["scenes"] == 1
     assert main(["experiment", "all", "--method", "kalman", "-o", str(tmp_path)]) == 2
+
+
+def test_dps_limitation_pools_the_orderings_the_paper_puts_above_dps():
+    """dps-dancers (Table 4): the pool of PS orderings set by the paper's numbers
+    (PS(2,3,4,1), PS(3,4,1,2), PS(4,1,2,3), >= 10 points above DPS) against DPS, by the
+    two-proportion test; dps-occlusion, where DPS is above every ordering, has no such
+    claim."""
+    from scenegen.lab.experiments import summary
+    from scenegen.lab.experiments.definitions import PAPER
+
+    def row(k):
+        return {"hard": {"success": {"k": k, "n": 50, "pct": 2.0 * k}}}
+
+    rows = {"PS(1,2,3,4)": row(10), "PS(2,3,4,1)": row(40), "PS(3,4,1,2)": row(42),
+            "PS(4,1,2,3)": row(35), "DPS": row(18)}
+    claims: list = []
+    summary._pooled_ps_claims(claims, get("dps-dancers"), "dps-dancers", rows,
+                              PAPER["dps-dancers"]["dps-dancers"])
+    pool = [c for c in claims if "the paper finds above DPS" in c["claim"]]
+    assert len(pool) == 1
+    assert "PS(2,3,4,1), PS(3,4,1,2), PS(4,1,2,3)" in pool[0]["claim"]
+    assert pool[0]["test"].startswith("two-proportion") and pool[0]["verdict"] == "reproduced"
+    assert "78% of 150 vs DPS 36% of 50" in pool[0]["ours"]
+
+    rows = {f"PS({o})": row(20) for o in ("1,2,3", "2,3,1", "3,1,2")} | {"DPS": row(30)}
+    claims = []
+    summary._pooled_ps_claims(claims, get("dps-occlusion"), "dps-occlusion", rows,
+                              PAPER["dps-occlusion"]["dps-occlusion"])
+    assert claims and not [c for c in claims if "the paper finds above DPS" in c["claim"]]

@@ -335,3 +335,19 @@ def test_path_center_is_the_centre_before_position_noise():
     assert np.abs(noisy.mean(axis=0)).max() < 0.5
     np.testing.assert_allclose(noisy.std(axis=0), np.hypot(3.0, 12**-0.5), rtol=0.15)
     np.testing.assert_array_equal(gt.path_center[100:300, 2], np.float32([[200.0, 50.0]] * 200))
+
+
+def test_dps_dancers_partial_occlusion_and_erratic_sway():
+    # The tuned dps-dancers (see its docstring): dancer 4 passes partly behind dancer 3
+    # (less than half visible at the closest point, mostly not totally hidden), and the
+    # sway is erratic (acceleration noise σ = 2 px/frame²).
+    mins, acc = [], []
+    for seed in (101, 102, 103, 104):
+        seq = scenegen.generate("dps-dancers", seed=seed)
+        vis = np.asarray(seq.gt.visibility)[:, 3]
+        mins.append(vis.min())
+        assert vis[0] == 1.0 and vis[15:21].min() > 0.9  # visible between the crossings
+        cx = np.asarray(seq.gt.center)[:, :, 0]
+        acc.append(np.nanstd(np.diff(cx, 2, axis=0)))
+    assert np.median(mins) < 0.5 and max(mins) > 0.0
+    assert min(acc) > 1.5
