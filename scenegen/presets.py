@@ -317,7 +317,8 @@ def dps_occlusion_2() -> SceneConfig:
     half-red shirt of ``dps-occlusion`` (Non-PS 33 %, PS 42–67 %, DPS 42 %), both people in
     it (67 / 67–92 / 58 %), the second only (92 / 100 / 100 %). At the walker's own
     propagation every PS ordering and DPS spread it from the same share of distinct
-    ancestors, as on ``dps-occlusion`` (``tools/occlusion/cycle.py`` on seeds 1–3). Judged
+    ancestors, as on ``dps-occlusion`` (``tools/occlusion/cycle.py`` on seeds 1–3, 3
+    scenes x 1 run each: 30–33 %, spread 6.9 px; Non-PS 35 %). Judged
     on base seed 0: DPS 66 %, PS 62–74 % (69 % pooled), Non-PS 62 %; on base seed 5
     (replication): DPS 84 %, PS 58–78 % (67 % pooled, p = 0.010), Non-PS 46 %.
 
