@@ -1,0 +1,98 @@
+"""The occluded walker's particle diversity at the same point of every method's cycle.
+
+Usage (tuning seeds only; never the judged base seed 0)::
+
+    python tools/occlusion/cycle.py dps-occlusion --seeds 1,2,3 --scenes 3 --runs 1
+
+For each method of the ``dps-occlusion`` experiment it prints, averaged over frames 1..T-1
+(and over the frames where the walker is totally hidden, visibility < 5 %):
+
+- *ancestors*: distinct walker sub-states among the particles that are about to be
+  propagated for the walker, divided by N: how many hypotheses its dynamics spread from;
+- *spread*: the standard deviation (px) of the walker's u over its propagated candidates;
+- *end uniqueness*: the walker's uniqueness at the end of the step (what ``Estimate.extras``
+  and the experiment records report, DPS Fig. 8).
+
+The end-of-step uniqueness depends on where the walker sits in the ordering; the first two
+are measured at the walker's own propagation, the same point of the cycle for every
+method (docs/experiments.md, "DPS Table 3: why the orderings cannot differ").
+It wraps ``trackers.models.dynamics.AR2.propagate`` to see the propagated rows and reads the
+PS/DPS orderings and group sizes from the tracker's private attributes (a diagnostic, not
+an interface).
+"""
+
+from __future__ import annotations
+
+import argparse
+
+import numba
+import numpy as np
+
+import scenegen
+import trackers
+from scenegen.lab.experiments.definitions import get
+from scenegen.lab.experiments.runner import derive_seed, scene_seed
+from trackers.models import dynamics
+
+_CALLS: list[tuple[np.ndarray, np.ndarray]] = []
+_propagate = dynamics.AR2.propagate
+
+
+def _recording(self, x, prev, mean, rng):
+    new = _propagate(self, x, prev, mean, rng=rng)
+    _CALLS.append((np.array(x, copy=True), np.array(new, copy=True)))
+    return new
+
+
+def measure(preset: str, base: int, scene: int, slug: str, run: int) -> np.ndarray:
+    """(ancestors, spread, end uniqueness) averaged over all frames, then over hidden ones."""
+    exp = get("dps-occlusion")
+    method = exp.method(slug)
+    seq = scenegen.generate(preset, seed=scene_seed(base, exp.name, preset, scene))
+    tr = trackers.make(method.tracker, rng=derive_seed(base, "cycle", slug, preset, scene, run),
+                       **method.param_dict())
+    frames = seq.frames
+    tr.init(np.asarray(frames[0]), seq.init_boxes(0))
+    walker = 0  # the walker is the first target of both presets
+    vis = np.asarray(seq.gt.visibility[:, seq.initial_targets(0)[walker]])
+    rows = []
+    for t in range(1, len(frames)):
+        _CALLS.clear()
+        est = tr.step(np.asarray(frames[t]))
+        if method.tracker == "joint-pf":
+            x, new = _CALLS[0]
+            xw, nw = x[:, walker], new[:, walker]
+        else:
+            orders = tr._orders if hasattr(tr, "_orders") else tr._order
+            sizes = tr._sizes_c if hasattr(tr, "_sizes_c") else np.array([tr.params.n_particles])
+            group = np.repeat(np.arange(sizes.size), sizes)
+            sel = [orders[group, j] == walker for j in range(len(_CALLS))]
+            xw = np.concatenate([c[0][s] for c, s in zip(_CALLS, sel, strict=True)])
+            nw = np.concatenate([c[1][s] for c, s in zip(_CALLS, sel, strict=True)])
+        rows.append((np.unique(xw, axis=0).shape[0] / xw.shape[0], nw[:, 0].std(),
+                     est.extras["uniqueness"][walker]))
+    rows_a = np.asarray(rows)
+    hidden = vis[1:] < 0.05
+    return np.concatenate([rows_a.mean(axis=0), rows_a[hidden].mean(axis=0)])
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("preset", choices=("dps-occlusion", "dps-occlusion-2"))
+    ap.add_argument("--seeds", default="1,2,3", help="base seeds (tuning seeds only)")
+    ap.add_argument("--scenes", type=int, default=3)
+    ap.add_argument("--runs", type=int, default=1)
+    args = ap.parse_args()
+    bases = [int(b) for b in args.seeds.split(",")]
+    numba.set_num_threads(1)
+    dynamics.AR2.propagate = _recording
+    print("method   ancestors %  spread px  end uniq. %  | hidden: ancestors %  spread px")
+    for m in get("dps-occlusion").methods:
+        v = np.mean([measure(args.preset, b, s, m.slug, r) for b in bases
+                     for s in range(args.scenes) for r in range(args.runs)], axis=0)
+        print(f"{m.label:9s} {100 * v[0]:8.0f} {v[1]:10.1f} {100 * v[2]:11.0f}  | "
+              f"{100 * v[3]:17.0f} {v[4]:10.1f}", flush=True)
+
+
+if __name__ == "__main__":
+    main()
