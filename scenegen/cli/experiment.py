@@ -32,9 +32,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--seed", type=int, default=0, help="base seed (default 0)")
     p.add_argument("--method", action="append", default=None, metavar="NAME",
                    help="run only this method (repeatable; not with `all`)")
-    p.add_argument("--param", action="append", default=None, metavar="NAME=VALUE",
-                   help="set a tracker parameter on every method run, e.g. kernel=box "
-                   "(repeatable; not with `all`); runs stay paired with the default ones")
+    p.add_argument("--param", action="append", default=None, metavar="KEY=VALUE",
+                   help="set a tracker parameter on every method run, e.g. kernel=box; VALUE is "
+                   "read as JSON when it parses, else as a string (repeatable; not with "
+                   "`all`); the runs stay paired with the default ones")
     p.add_argument("--quick", action="store_true",
                    help="scaled-down settings (fewer frames/particles), for smoke tests")
     p.add_argument("-o", "--output", required=True, type=Path, help="output folder DIR")
@@ -52,30 +53,24 @@ def _say_verdicts(name: str, results: dict, where: Path) -> None:
 def parse_overrides(items: list[str] | None) -> dict:
     """``["kernel=box", "box_levels=4"]`` -> ``{"kernel": "box", "box_levels": 4}``.
 
-    A value is read as a Python literal (number, tuple, None, True/False, quoted string)
-    when it is one, else kept as the string.
+    As ``scenegen track --param``: a value is read as JSON when it parses (``4``,
+    ``[2, 2, 0.001]``, ``null``), else kept as the string.
 
     Raises
     ------
     ConfigError
         For an item without ``=`` or a parameter given twice.
     """
-    import ast
-
+    from scenegen.cli.track import parse_params
     from scenegen.errors import ConfigError
 
     out: dict = {}
     for item in items or ():
-        name, sep, text = item.partition("=")
-        name = name.strip()
-        if not sep or not name:
-            raise ConfigError(f"--param must be NAME=VALUE, got {item!r}")
+        parsed = parse_params([item])
+        name = next(iter(parsed))
         if name in out:
             raise ConfigError(f"--param {name} given twice")
-        try:
-            out[name] = ast.literal_eval(text.strip())
-        except (ValueError, SyntaxError):
-            out[name] = text.strip()
+        out.update(parsed)
     return out
 
 

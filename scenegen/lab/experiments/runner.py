@@ -186,7 +186,7 @@ def plan_tasks(
                     f"values: {', '.join(f'{x:g}' for x in valid) or 'none (no sweep)'}"
                 )
         sweep = [(p, v) for p, v in exp.sweep_values(False) if v in wanted]
-    over = tuple(sorted((overrides or {}).items()))
+    over = tuple(sorted((str(k), _frozen(v)) for k, v in (overrides or {}).items()))
     for m in chosen if over else ():
         check_overrides(exp, m.slug, dict(over))
     tasks = []
@@ -199,6 +199,13 @@ def plan_tasks(
                         tasks.append(Task(exp.name, m.slug, preset, param, v, s, r, seed, quick,
                                           over))
     return tasks
+
+
+def _frozen(value: Any) -> Any:
+    """Lists (as JSON gives them) as tuples, recursively, so that a task stays hashable."""
+    if isinstance(value, (list, tuple)):
+        return tuple(_frozen(v) for v in value)
+    return value
 
 
 def check_overrides(exp: Experiment, method: str, overrides: dict[str, Any]) -> None:

@@ -17,12 +17,12 @@ NAME = "dps-synthetic"
 EXP = get(NAME)
 
 
-def test_parse_overrides_reads_literals_and_keeps_words():
-    assert parse_overrides(["kernel=box", "box_levels=4", "sigma=(1, 1, 0.01)",
-                            "n_parts=None"]) == {
-        "kernel": "box", "box_levels": 4, "sigma": (1, 1, 0.01), "n_parts": None}
+def test_parse_overrides_reads_json_and_keeps_words():
+    assert parse_overrides(["kernel=box", "box_levels=4", "sigma=[1, 1, 0.01]",
+                            "n_parts=null"]) == {
+        "kernel": "box", "box_levels": 4, "sigma": [1, 1, 0.01], "n_parts": None}
     assert parse_overrides(None) == {}
-    with pytest.raises(ConfigError, match="NAME=VALUE"):
+    with pytest.raises(ConfigError, match="KEY=VALUE"):
         parse_overrides(["kernel"])
     with pytest.raises(ConfigError, match="given twice"):
         parse_overrides(["kernel=box", "kernel=uniform"])
@@ -41,6 +41,14 @@ def test_overridden_tasks_keep_the_default_seeds_and_carry_the_parameter():
         params = tracker_params(EXP, b)
         assert params["kernel"] == "box" and params["box_levels"] == 4
         assert "kernel" not in tracker_params(EXP, a)
+
+
+def test_list_values_make_hashable_tasks():
+    (task,) = plan_tasks(EXP, runs=1, scenes=1, seed=0, quick=True, methods=["dps"],
+                         overrides={"sigma": [1.0, 1.0, 0.01]})
+    assert task.overrides == (("sigma", (1.0, 1.0, 0.01)),)
+    assert hash(task) == hash(task)
+    assert tracker_params(EXP, task)["sigma"] == (1.0, 1.0, 0.01)
 
 
 @pytest.mark.parametrize(("over", "match"), [
