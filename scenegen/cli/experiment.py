@@ -7,7 +7,7 @@ import argparse
 import sys
 from pathlib import Path
 
-__all__ = ["cmd_experiment", "register"]
+__all__ = ["cmd_experiment", "parse_overrides", "register"]
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -32,6 +32,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--seed", type=int, default=0, help="base seed (default 0)")
     p.add_argument("--method", action="append", default=None, metavar="NAME",
                    help="run only this method (repeatable; not with `all`)")
+    p.add_argument("--param", action="append", default=None, metavar="KEY=VALUE",
+                   help="set a tracker parameter on every method run, e.g. kernel=box; VALUE is "
+                   "read as JSON when it parses, else as a string (repeatable; not with "
+                   "`all`); the runs stay paired with the default ones")
     p.add_argument("--quick", action="store_true",
                    help="scaled-down settings (fewer frames/particles), for smoke tests")
     p.add_argument("-o", "--output", required=True, type=Path, help="output folder DIR")
@@ -46,6 +50,30 @@ def _say_verdicts(name: str, results: dict, where: Path) -> None:
           f"{c['inconclusive']} inconclusive; table: {where}", file=sys.stderr)
 
 
+def parse_overrides(items: list[str] | None) -> dict:
+    """``["kernel=box", "box_levels=4"]`` -> ``{"kernel": "box", "box_levels": 4}``.
+
+    As ``scenegen track --param``: a value is read as JSON when it parses (``4``,
+    ``[2, 2, 0.001]``, ``null``), else kept as the string.
+
+    Raises
+    ------
+    ConfigError
+        For an item without ``=`` or a parameter given twice.
+    """
+    from scenegen.cli.track import parse_params
+    from scenegen.errors import ConfigError
+
+    out: dict = {}
+    for item in items or ():
+        parsed = parse_params([item])
+        name = next(iter(parsed))
+        if name in out:
+            raise ConfigError(f"--param {name} given twice")
+        out.update(parsed)
+    return out
+
+
 def cmd_experiment(args: argparse.Namespace) -> int:
     """Run the experiment (or all of them) and print where the results are; 0 on success.
 
@@ -53,7 +81,7 @@ def cmd_experiment(args: argparse.Namespace) -> int:
     ------
     ConfigError
         Unknown experiment or method (listing the valid ones), bad --runs/--scenes/--jobs/
-        --seed, or an unreachable scheduler (within 10 s, naming the address).
+        --seed/--param, or an unreachable scheduler (within 10 s, naming the address).
     """
     from scenegen.errors import ConfigError
     from scenegen.lab.experiments import get, run_experiment
@@ -63,6 +91,8 @@ def cmd_experiment(args: argparse.Namespace) -> int:
 
         if args.method:
             raise ConfigError("--method cannot be used with `experiment all`")
+        if args.param:
+            raise ConfigError("--param cannot be used with `experiment all`")
         index = run_all(args.output, runs=args.runs, scenes=args.scenes, jobs=args.jobs,
                         scheduler=args.scheduler, seed=args.seed, quick=args.quick,
                         progress=sys.stderr.isatty(), say=_say_verdicts)
@@ -80,6 +110,7 @@ def cmd_experiment(args: argparse.Namespace) -> int:
         quick=args.quick,
         methods=args.method,
         progress=sys.stderr.isatty(),
+        overrides=parse_overrides(args.param),
     )
     _say_verdicts(args.name, results, args.output / "table.md")
     print(str((args.output / "results.json").resolve()))

@@ -95,6 +95,7 @@ def run_experiment(
     values: Iterable[float] | None = None,
     progress: bool = True,
     figures: bool = True,
+    overrides: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
     """Run experiment ``name`` and write its results into ``out_dir``.
 
@@ -126,6 +127,11 @@ def run_experiment(
         Show a progress bar.
     figures : bool
         Write the PNG figures.
+    overrides : dict, optional
+        Tracker parameters set on every chosen method over its own (for example
+        ``{"kernel": "box"}``). The runs keep the seeds of the default runs (paired with
+        them), store the parameters in their records, and ``results.json`` lists them
+        under ``"overrides"`` (absent without overrides).
 
     Returns
     -------
@@ -135,8 +141,8 @@ def run_experiment(
     Raises
     ------
     ConfigError
-        Unknown experiment or method (listing the valid ones), bad runs/scenes/jobs/seed, or an
-        unreachable scheduler.
+        Unknown experiment or method (listing the valid ones), bad runs/scenes/jobs/seed, an
+        override a chosen method does not accept, or an unreachable scheduler.
     """
     exp = get(name)
     if jobs is not None and jobs < 1:
@@ -144,7 +150,7 @@ def run_experiment(
     r = exp.runs if runs is None else int(runs)
     s = exp.scenes if scenes is None else int(scenes)
     tasks = plan_tasks(exp, runs=r, scenes=s, seed=int(seed), quick=quick, methods=methods,
-                       values=values)
+                       values=values, overrides=overrides)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     records = execute(tasks, out / "runs", jobs=jobs, scheduler=scheduler, progress=progress)
@@ -167,6 +173,8 @@ def run_experiment(
         ],
         **agg,
     }
+    if overrides:
+        results["overrides"] = dict(sorted(overrides.items()))
     results = _round(json.loads(json.dumps(results)))
     write_json_atomic(out / "results.json", results, indent=1)
     _write_text(out / "table.md", render_table(exp, results, WHY.get(exp.name, "")))

@@ -90,6 +90,10 @@ class Task:
         The experiment's base seed (``--seed``).
     quick : bool
         Scaled-down mode (fewer frames or particles).
+    overrides : tuple of (str, value)
+        Tracker parameters set for this run over the method's own (``--param``), sorted by
+        name; () for the experiment as defined. They do not enter the seeds, so a run
+        with overrides is paired with the default run of the same key.
     """
 
     experiment: str
@@ -101,6 +105,7 @@ class Task:
     run: int
     seed: int
     quick: bool
+    overrides: tuple[tuple[str, Any], ...] = ()
 
     @property
     def sweep_label(self) -> str:
@@ -124,10 +129,16 @@ class Task:
 
     def filename(self) -> str:
         sweep = f"__{self.param}{self.value:g}" if self.param else ""
-        return f"{self.method}__{self.preset}{sweep}__s{self.scene:03d}__r{self.run:03d}.json"
+        over = "".join(f"__{k}-{v}" for k, v in self.overrides)
+        return (f"{self.method}__{self.preset}{sweep}{over}__s{self.scene:03d}"
+                f"__r{self.run:03d}.json")
 
     def key(self) -> dict[str, Any]:
-        return asdict(self)
+        key = asdict(self)
+        if not self.overrides:
+            # Records of runs without overrides keep the key they had before overrides existed.
+            del key["overrides"]
+        return key
 
 
 def plan_tasks(
@@ -139,18 +150,22 @@ def plan_tasks(
     quick: bool,
     methods: Iterable[str] | None = None,
     values: Iterable[float] | None = None,
+    overrides: dict[str, Any] | None = None,
 ) -> list[Task]:
     """Every task of an experiment, in a fixed order.
 
     Every method runs on every preset, ``scenes`` scenes (default the experiment's S) and
     ``runs`` tracker runs per scene. ``methods`` (slugs or labels) and ``values`` (of the
     swept parameter) restrict the sweep; by default every method runs at every value.
+    ``overrides`` (tracker parameter -> value) is set on every chosen method's tracker
+    (see ``Task.overrides``); each method's tracker must accept it with that value.
 
     Raises
     ------
     ConfigError
         For runs or scenes < 1, a negative seed, an unknown method or a value outside the sweep
-        (listing the valid ones).
+        (listing the valid ones), or an override that a chosen method's tracker does not
+        accept (naming the method).
     """
     if runs < 1:
         raise ConfigError(f"runs must be >= 1, got {runs}")
@@ -171,6 +186,9 @@ def plan_tasks(
                     f"values: {', '.join(f'{x:g}' for x in valid) or 'none (no sweep)'}"
                 )
         sweep = [(p, v) for p, v in exp.sweep_values(False) if v in wanted]
+    over = tuple(sorted((str(k), _frozen(v)) for k, v in (overrides or {}).items()))
+    for m in chosen if over else ():
+        check_overrides(exp, m.slug, dict(over))
     tasks = []
     for m in chosen:
         for param, value in sweep:
@@ -178,8 +196,44 @@ def plan_tasks(
             for preset in exp.presets:
                 for s in range(n_scenes):
                     for r in range(runs):
-                        tasks.append(Task(exp.name, m.slug, preset, param, v, s, r, seed, quick))
+                        tasks.append(Task(exp.name, m.slug, preset, param, v, s, r, seed, quick,
+                                          over))
     return tasks
+
+
+def _frozen(value: Any) -> Any:
+    """Lists (as JSON gives them) as tuples, recursively, so that a task stays hashable."""
+    if isinstance(value, (list, tuple)):
+        return tuple(_frozen(v) for v in value)
+    return value
+
+
+def check_overrides(exp: Experiment, method: str, overrides: dict[str, Any]) -> None:
+    """Check that method ``method``'s tracker accepts the parameter ``overrides``.
+
+    Raises
+    ------
+    ConfigError
+        Naming the method and the parameter it has not, or the tracker's own message for a
+        value it rejects.
+    """
+    from trackers.registry import get_class as tracker_class
+
+    m = exp.method(method)
+    cls = tracker_class(m.tracker)
+    fields = cls.Params.names()
+    swept = exp.sweep[0][0] if exp.sweep else None
+    for name in overrides:
+        if name not in fields or name == swept:
+            why = (f"cannot override the swept parameter {name!r}" if name == swept
+                   else f"has no parameter {name!r}")
+            raise ConfigError(f"method {m.slug!r} (tracker {m.tracker!r}) {why}; its "
+                              f"parameters: {', '.join(fields)}")
+    params = {**m.param_dict(), **overrides}
+    try:
+        cls.Params(**params)
+    except (TypeError, ValueError) as err:
+        raise ConfigError(f"method {m.slug!r} (tracker {m.tracker!r}): {err}") from None
 
 
 @functools.lru_cache(maxsize=4)
@@ -212,6 +266,7 @@ def tracker_params(exp: Experiment, task: Task) -> dict[str, Any]:
     params = exp.method(task.method).param_dict()
     if task.param:
         params[task.param] = task.value
+    params.update(task.overrides)
     if task.quick and "n_particles" in params:
         params["n_particles"] = min(int(params["n_particles"]), exp.quick_particles)
     return params

@@ -100,6 +100,28 @@ def test_integral_path_is_bit_identical_to_the_direct_path(seed, levels, n_parts
     np.testing.assert_allclose(1 - direct**2, np.minimum(rho, 1.0), rtol=0, atol=1e-12)
 
 
+@pytest.mark.parametrize("kernel", [KERNEL_UNIFORM, KERNEL_BOX])
+@pytest.mark.parametrize("spread", [30.0, 300.0])
+def test_integral_is_exact_for_16_and_32_bit_counts_and_colours_shared_by_bands(kernel,
+                                                                              spread):
+    # Clouds of boxes whose union is below (16-bit integral) or above (32-bit) 2**16
+    # pixels; five colours, so that both bands' supports hold the same colours (one channel
+    # per colour, read by both bands).
+    rng = np.random.default_rng(7)
+    bin_img = np.ascontiguousarray(rng.integers(0, 5, size=(290, 310)), dtype=np.int32)
+    centre = np.array([150.0, 140.0])
+    xy = centre + rng.uniform(-spread / 2, spread / 2, (200, 2))
+    wh = rng.uniform(8, 60, (200, 2))
+    boxes = np.column_stack([xy - wh / 2, wh])
+    refs = region_histograms(bin_img, boxes[:3], 5, kernel, 2)
+    index = rng.integers(0, 3, len(boxes))
+    direct = region_distances(bin_img, boxes, refs, index, kernel, 2, method="direct")
+    integral = region_distances(bin_img, boxes, refs, index, kernel, 2, method="integral")
+    np.testing.assert_array_equal(direct, integral)
+    np.testing.assert_array_equal(
+        direct, region_distances(bin_img, boxes, refs, index, kernel, 2, method="auto"))
+
+
 def test_one_level_is_the_uniform_kernel():
     bin_img, boxes, _ = _scene(3, 40, 60, 5, 30)
     np.testing.assert_allclose(

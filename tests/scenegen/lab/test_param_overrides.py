@@ -1,0 +1,130 @@
+"""`--param`: tracker parameters set on every method of an experiment, paired with the
+default runs and recorded; and the paired comparison of two settings (kernel_quality)."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from scenegen.cli.experiment import parse_overrides
+from scenegen.errors import ConfigError
+from scenegen.lab import kernel_quality as kq
+from scenegen.lab.experiments import get, run_experiment
+from scenegen.lab.experiments.runner import load_record, plan_tasks, tracker_params
+
+NAME = "dps-synthetic"
+EXP = get(NAME)
+
+
+def test_parse_overrides_reads_json_and_keeps_words():
+    assert parse_overrides(["kernel=box", "box_levels=4", "sigma=[1, 1, 0.01]",
+                            "n_parts=null"]) == {
+        "kernel": "box", "box_levels": 4, "sigma": [1, 1, 0.01], "n_parts": None}
+    assert parse_overrides(None) == {}
+    with pytest.raises(ConfigError, match="KEY=VALUE"):
+        parse_overrides(["kernel"])
+    with pytest.raises(ConfigError, match="given twice"):
+        parse_overrides(["kernel=box", "kernel=uniform"])
+
+
+def test_overridden_tasks_keep_the_default_seeds_and_carry_the_parameter():
+    kw = {"runs": 2, "scenes": 2, "seed": 0, "quick": True, "methods": ["dps"]}
+    plain = plan_tasks(EXP, **kw)
+    boxed = plan_tasks(EXP, **kw, overrides={"kernel": "box", "box_levels": 4})
+    assert len(plain) == len(boxed)
+    for a, b in zip(plain, boxed, strict=True):
+        assert b.overrides == (("box_levels", 4), ("kernel", "box"))
+        assert (a.scene_seed(), a.tracker_seed()) == (b.scene_seed(), b.tracker_seed())
+        assert a.filename() != b.filename() and "kernel-box" in b.filename()
+        assert "overrides" not in a.key() and b.key()["overrides"] == b.overrides
+        params = tracker_params(EXP, b)
+        assert params["kernel"] == "box" and params["box_levels"] == 4
+        assert "kernel" not in tracker_params(EXP, a)
+
+
+def test_list_values_make_hashable_tasks():
+    (task,) = plan_tasks(EXP, runs=1, scenes=1, seed=0, quick=True, methods=["dps"],
+                         overrides={"sigma": [1.0, 1.0, 0.01]})
+    assert task.overrides == (("sigma", (1.0, 1.0, 0.01)),)
+    assert hash(task) == hash(task)
+    assert tracker_params(EXP, task)["sigma"] == (1.0, 1.0, 0.01)
+
+
+@pytest.mark.parametrize(("over", "match"), [
+    ({"kernl": "box"}, "has no parameter 'kernl'"),
+    ({"lam": 30.0}, "cannot override the swept parameter 'lam'"),
+    ({"kernel": "boxx"}, "unknown kernel 'boxx'"),
+    ({"box_levels": 0}, "box_levels must be"),
+])
+def test_overrides_a_method_does_not_accept_are_refused_before_running(over, match):
+    with pytest.raises(ConfigError, match=match):
+        plan_tasks(EXP, runs=1, seed=0, quick=True, overrides=over)
+
+
+def test_kams_trackers_refuse_the_box_kernel():
+    with pytest.raises(ConfigError, match="method 'kams'"):
+        plan_tasks(get("kams-robustness"), runs=1, seed=0, quick=True,
+                   overrides={"kernel": "box"})
+
+
+def test_an_overridden_run_is_recorded_and_stale_for_the_default(tmp_path):
+    res = run_experiment(NAME, tmp_path, runs=1, scenes=1, quick=True, methods=["dps"],
+                         jobs=1, progress=False, figures=False, overrides={"kernel": "box"})
+    assert res["overrides"] == {"kernel": "box"}
+    stored = json.loads((tmp_path / "results.json").read_text())
+    assert stored["overrides"] == {"kernel": "box"}
+    (task,) = plan_tasks(EXP, runs=1, scenes=1, seed=0, quick=True, methods=["dps"],
+                         overrides={"kernel": "box"})
+    record = load_record(tmp_path / "runs" / task.filename(), task)
+    assert record is not None and record["params"]["kernel"] == "box"
+    (plain,) = plan_tasks(EXP, runs=1, scenes=1, seed=0, quick=True, methods=["dps"])
+    # The default run's file is another one, and the overridden record does not pass for it.
+    assert not (tmp_path / "runs" / plain.filename()).exists()
+    assert load_record(tmp_path / "runs" / task.filename(), plain) is None
+
+
+def _rate(k, n, lo, hi):
+    return {"k": k, "n": n, "pct": 100.0 * k / n, "ci": [lo, hi]}
+
+
+def test_compare_puts_each_value_beside_the_base_interval():
+    base = {"m": {"DPS": {"success": _rate(8, 10, 49.0, 94.3),
+                          "precision": {"mean": 80.0, "ci": [78.0, 82.0], "n": 10}},
+                  "only_base": _rate(1, 2, 9.5, 90.5)}}
+    other = {"m": {"DPS": {"success": _rate(5, 10, 23.7, 76.3),
+                           "precision": {"mean": 81.0, "ci": [79.0, 83.0], "n": 10}}}}
+    rows = kq.compare("x", base, other)
+    by_path = {r.path: r for r in rows}
+    assert set(by_path) == {"m/DPS/success", "m/DPS/precision"}
+    assert by_path["m/DPS/success"].kind == "rate" and by_path["m/DPS/success"].inside
+    assert by_path["m/DPS/precision"].kind == "mean" and by_path["m/DPS/precision"].inside
+    worse = kq.compare("x", base, {"m": {"DPS": {"success": _rate(2, 10, 5.7, 51.0)}}})
+    assert [r.inside for r in worse] == [False]
+    text = kq.render(rows + worse, base="epan", other="box", metrics=["success"])
+    assert "| x | m/DPS/success | 80.0 [49.0–94.3] (10) | 50.0 [23.7–76.3] (10) | yes |" in text
+    assert "**no**" in text and "1 of 2 values of box inside epan's interval" in text
+
+
+def test_compare_root_summarises_both_sides_and_adds_shared_runs(tmp_path, monkeypatch):
+    for side, n in (("base", 2), ("other", 1), ("shared", 1)):
+        runs = tmp_path / "exp" / side / "runs"
+        runs.mkdir(parents=True)
+        for i in range(n):
+            (runs / f"r{i}.json").write_text(json.dumps({"side": side}))
+    seen = {}
+
+    def fake_summary(name, records):
+        sides = sorted(r["side"] for r in records)
+        seen[sides[0] if sides[0] != "shared" else sides[-1]] = sides
+        k = len(records)
+        return {"M": {"success": _rate(k, 4, 10.0 * k, 30.0 * k)}}
+
+    monkeypatch.setattr(kq, "summary_of", fake_summary)
+    (row,) = kq.compare_root(tmp_path)
+    assert seen == {"base": ["base", "base", "shared"], "other": ["other", "shared"]}
+    assert (row.experiment, row.path, row.base, row.other) == ("exp", "M/success", 75.0, 50.0)
+    assert row.inside  # 50 in [30, 90]
+    out = tmp_path / "t.md"
+    assert kq.main([str(tmp_path), "-o", str(out)]) == 0
+    assert "M/success" in out.read_text()
