@@ -160,7 +160,8 @@ def _parse(p: Path) -> Any:
     try:
         return json.loads(text, object_pairs_hook=_no_duplicates, parse_constant=_no_constant)
     except json.JSONDecodeError as err:
-        raise DataError(f"{p}: not a readable JSON file ({err.msg} at line {err.lineno} "
+        msg = err.msg.removesuffix(" at")
+        raise DataError(f"{p}: not a readable JSON file ({msg} at line {err.lineno} "
                         f"column {err.colno}: truncated or damaged)") from None  # fmt: skip
     except RecursionError:
         raise DataError(f"{p}: not a readable JSON file (nested too deeply)") from None

@@ -10,7 +10,8 @@ tied to exactly those records.
 
 - A resumed sweep (:func:`scenegen.lab.experiments.runner.execute`) treats a record that
   is damaged, edited, malformed or written by an older version (no digest) as not done:
-  it is computed again, with one warning line on stderr.
+  it is computed again, with one warning line on stderr; so is a sealed record that
+  ``results.json`` lists with another digest (edited after the results were computed).
 - :func:`read_results` (the report) raises one :class:`~scenegen.errors.DataError` line
   naming the file for a damaged, edited, malformed or old ``results.json``.
 - :func:`check_experiment` (``scenegen validate DIR``) checks everything: each listed
@@ -22,6 +23,7 @@ tied to exactly those records.
 
 from __future__ import annotations
 
+import functools
 import json
 import sys
 from dataclasses import fields
@@ -35,9 +37,12 @@ __all__ = [
     "RECORDS",
     "check_experiment",
     "check_report",
+    "listed_digest",
+    "listing",
     "read_record",
     "read_results",
     "record_problems",
+    "report_entry",
     "warn",
     "write_record",
     "write_results",
@@ -153,6 +158,29 @@ def _entries(results: dict[str, Any]) -> list[tuple[str, str]] | None:
         name, digest = e.split(" ")
         out.append((name, digest))
     return out
+
+
+@functools.lru_cache(maxsize=4)
+def _listed(path: Path, version: tuple[int, int, int]) -> tuple[int, bool, dict[str, str]]:
+    try:
+        res = read_results(path)
+    except DataError:
+        return (-1, False, {})
+    return (res["seed"], res["quick"], dict(_entries(res) or []))
+
+
+def listed_digest(record_path: Path, seed: int, quick: bool) -> str | None:
+    """The digest that ``DIR/results.json`` lists for the run file ``DIR/runs/NAME``, or
+    None (no sound ``results.json`` of that base seed and mode, or the run not listed)."""
+    res = record_path.parent.parent / "results.json"
+    try:
+        st = res.stat()
+    except OSError:
+        return None
+    s, q, listed = _listed(res, (st.st_ino, st.st_size, st.st_mtime_ns))
+    if (s, q) != (seed, quick):
+        return None
+    return listed.get(record_path.name)
 
 
 def write_results(path: Path, results: dict[str, Any]) -> None:

@@ -325,15 +325,19 @@ def write_json_atomic(path: Path, data: Any, *, indent: int | None = None) -> No
 def load_record(path: Path, task: Task) -> dict[str, Any] | None:
     """The stored record of ``task`` at ``path``, or None if missing, damaged or stale.
 
-    Damaged means unreadable, not matching its digest (edited), not a run record, or
-    written by an older version (no digest, see :mod:`scenegen.lab.experiments.outputs`):
-    the run is computed again, with one warning line on stderr. Stale means stored for
-    another key (experiment, method, preset, value, scene, run, seed, quick), with other
-    tracker parameters, or for another version of the preset's config
-    (:func:`scene_digest`); it is computed again silently.
+    Damaged means unreadable, not matching its digest (edited), not a run record, a record
+    of another run (its key names another file), or written by an older version (no
+    digest, see :mod:`scenegen.lab.experiments.outputs`): the run is computed again, with
+    one warning line on stderr. Stale means stored for another key (experiment, method,
+    preset, value, scene, run, seed, quick), with other tracker parameters, or for another
+    version of the preset's config (:func:`scene_digest`); it is computed again silently. A
+    sound, fresh record that the folder's ``results.json`` (of the same seed and mode)
+    lists with another digest was edited (its digest recomputed) or replaced after the
+    results were computed: it is computed again, with a warning.
     """
     from scenegen.errors import DataError
-    from scenegen.lab.experiments.outputs import read_record, warn
+    from scenegen.io.sealed import content_digest
+    from scenegen.lab.experiments.outputs import listed_digest, read_record, warn
 
     if not path.exists():
         return None
@@ -342,12 +346,21 @@ def load_record(path: Path, task: Task) -> dict[str, Any] | None:
     except DataError as err:
         warn(f"{err}; computing this run again")
         return None
+    if Task(**data["key"]).filename() != path.name:
+        warn(f"{path}: holds another run ({Task(**data['key']).filename()}); computing this "
+             "run again")  # fmt: skip
+        return None
     if data.get("key") != _round(task.key()):
         return None
     # Parameters changed since the run was stored (a new version of the experiment).
     if data.get("params") != _round(tracker_params(get(task.experiment), task)):
         return None
     if data.get("scene_digest") != scene_digest(task.preset):
+        return None
+    listed = listed_digest(path, task.seed, task.quick)
+    if listed is not None and listed != content_digest(data):
+        warn(f"{path}: is not the run its results.json was computed from (edited since); "
+             "computing this run again")  # fmt: skip
         return None
     return data
 
