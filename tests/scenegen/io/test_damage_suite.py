@@ -99,6 +99,7 @@ class Tally:
     def __init__(self) -> None:
         self.counts: Counter[str] = Counter()
         self.failures: list[str] = []
+        self.by_kind: Counter[str] = Counter()
 
     def fail(self, what: str, line: str) -> None:
         self.counts[what] += 1
@@ -242,8 +243,10 @@ def judge_folder(tally, v, dst, results, original, original_results):
         return
     if vcode == 1:
         tally.counts["reported by validate"] += 1
+        tally.by_kind[v.kind] += 1
     elif folder_content(path) == original:
         tally.counts["harmless (no readable change)"] += 1
+        tally.by_kind[f"{v.kind} (harmless)"] += 1
     else:
         tally.fail("WRONG VALID", f"{v.name}: {verr.strip()}")
     for code, err in others:
@@ -314,7 +317,9 @@ def test_slow_damaged_experiment_outputs(experiment, tmp_path, capsys):
         print(f"\nexperiment-folder variants tried: {n}; " + "; ".join(
             f"{k}: {c}" for k, c in sorted(tally.counts.items())))  # fmt: skip
         for k in FOLDER_KINDS:
-            print(f"  {k}: {sum(1 for i in range(n) if FOLDER_KINDS[i % len(FOLDER_KINDS)] == k)}")
+            tried = sum(1 for i in range(n) if FOLDER_KINDS[i % len(FOLDER_KINDS)] == k)
+            print(f"  {k}: tried {tried}, reported {tally.by_kind[k]}, harmless "
+                  f"{tally.by_kind[k + ' (harmless)']}")
         for line in tally.failures[:20]:
             print("  " + line)
     assert tally.failures == []
