@@ -42,7 +42,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("file", type=Path)
     p.add_argument(
         "--deep", action="store_true",
-        help="also re-render each sequence from its config and seed and compare",
+        help="also re-render each sequence from its config and seed and compare (an "
+        "experiment folder: run every run again and compare with its record)",
     )  # fmt: skip
     p.set_defaults(func=cmd_validate)
 
