@@ -26,7 +26,7 @@ from __future__ import annotations
 import functools
 import json
 import sys
-from dataclasses import fields
+from dataclasses import MISSING, fields
 from pathlib import Path
 from typing import Any
 
@@ -55,8 +55,15 @@ _PER_FRAME = ("state", "precision", "recall", "iou", "centre_error", "path_error
 _MAX_LISTED = 5  # problem lines per folder before "and N more"
 
 
+_warned: set[str] = set()
+
+
 def warn(line: str) -> None:
-    """Print one warning line on stderr."""
+    """Print one warning line on stderr (once per process: a resumed sweep may look at a
+    damaged record both when it plans its tasks and when it collects them)."""
+    if line in _warned:
+        return
+    _warned.add(line)
     print(f"scenegen: warning: {line}", file=sys.stderr, flush=True)
 
 
@@ -89,7 +96,8 @@ def record_problems(data: Any) -> list[str]:
     out = []
     key = data.get("key")
     names = {f.name for f in fields(Task)}
-    if not isinstance(key, dict) or set(key) != names:
+    required = {f.name for f in fields(Task) if f.default is MISSING}  # others: optional
+    if not isinstance(key, dict) or not required <= set(key) <= names:
         out.append("key is not a run key")
     else:
         try:
