@@ -35,11 +35,15 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--json", action="store_true", help="print one JSON document")
     p.set_defaults(func=cmd_inspect)
 
-    p = sub.add_parser("validate", help="check a scenegen file; exit 1 on any problem")
+    p = sub.add_parser(
+        "validate", help="check a scenegen file, dataset, experiment or report folder; exit 1 "
+        "on any problem",
+    )  # fmt: skip
     p.add_argument("file", type=Path)
     p.add_argument(
         "--deep", action="store_true",
-        help="also re-render each sequence from its config and seed and compare",
+        help="also re-render each sequence from its config and seed and compare (an "
+        "experiment folder: run every run again and compare with its record)",
     )  # fmt: skip
     p.set_defaults(func=cmd_validate)
 
@@ -224,7 +228,21 @@ def cmd_inspect(args: argparse.Namespace) -> int:
 def cmd_validate(args: argparse.Namespace) -> int:
     import sys
 
-    if args.file.is_dir():  # a dataset folder (scenegen dataset): every shard and digest
+    folder = args.file
+    if folder.is_dir() and not (folder / "manifest.json").exists() and (
+        (folder / "results.json").exists() or (folder / "runs").is_dir()
+        or (folder / "experiments").is_dir()
+    ):  # an experiment or report folder: its sealed records, results.json and table.md
+        from scenegen.lab.experiments.outputs import check_experiment, check_report
+
+        report = (folder / "experiments").is_dir()
+        problems = check_report(folder) if report else check_experiment(folder, deep=args.deep)
+        for line in problems:
+            print(line, file=sys.stderr)
+        if not problems:
+            print(f"{folder}: valid {'report' if report else 'experiment'} folder")
+        return 1 if problems else 0
+    if folder.is_dir():  # a dataset folder (scenegen dataset): every shard and digest
         from scenegen.cli.dataset import cmd_validate_dataset
 
         return cmd_validate_dataset(args)

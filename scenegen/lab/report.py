@@ -13,7 +13,6 @@ experiments' full counts.
 from __future__ import annotations
 
 import html
-import json
 import re
 import sys
 from collections.abc import Callable
@@ -21,7 +20,11 @@ from pathlib import Path
 from typing import Any
 
 from scenegen.errors import DataError
+from scenegen.io.sealed import write_sealed_json
 from scenegen.lab.experiments import get, names, run_experiment, verdict_counts
+from scenegen.lab.experiments.outputs import read_results, report_entry
+from scenegen.lab.experiments.tables import render_table
+from scenegen.lab.experiments.why import WHY
 
 __all__ = ["DEMO_PLAN", "FULL_COMMAND", "build_report", "markdown_to_html", "run_all",
            "run_demo_experiments"]
@@ -247,21 +250,19 @@ def build_report(out_dir: str | Path) -> Path:
         if not res_path.exists():
             body.append("<p class='no'>not run (no results.json)</p>")
             continue
-        try:
-            loaded = json.loads(res_path.read_text(encoding="utf-8"))
-        except (OSError, UnicodeDecodeError, json.JSONDecodeError) as err:
-            raise DataError(f"{res_path}: not a readable results file ({err})") from None
-        if not isinstance(loaded, dict):
-            raise DataError(f"{res_path}: not a results file (a JSON object is expected)")
-        all_results[name] = loaded
+        loaded = read_results(res_path, name)
+        all_results[name] = report_entry(loaded)
         links = [f"<a href='{_rel(res_path, root)}'>results.json</a>"]
         table = folder / "table.md"
         if table.exists():
             links.append(f"<a href='{_rel(table, root)}'>table.md</a>")
-            md = table.read_text(encoding="utf-8")
-            if md.startswith("# "):
-                md = md.split("\n", 1)[1] if "\n" in md else ""
-            body.append(markdown_to_html(md))
+        try:  # the table of the sealed results, not the unsealed table.md
+            md = render_table(get(name), loaded, WHY.get(name, ""))
+            _overview({name: loaded})
+        except Exception as err:  # noqa: BLE001 - a sealed file with contents no table expects
+            raise DataError(f"{res_path}: not an experiment's results ({type(err).__name__}: "
+                            f"{str(err)[:80]})") from None  # fmt: skip
+        body.append(markdown_to_html(md.split("\n", 1)[1] if "\n" in md else ""))
         body.append("<p>" + " · ".join(links) + "</p>")
         for png in sorted(folder.glob("*.png")):
             body.append(f"<p><a href='{_rel(png, root)}'><img src='{_rel(png, root)}' "
@@ -286,8 +287,5 @@ def build_report(out_dir: str | Path) -> Path:
     parts.append("</body></html>")
     index = root / "index.html"
     _write_atomic(index, "\n".join(parts) + "\n")
-    _write_atomic(
-        root / "results.json",
-        json.dumps({"experiments": all_results}, sort_keys=True, indent=1) + "\n",
-    )
+    write_sealed_json(root / "results.json", {"experiments": all_results}, indent=1)
     return index

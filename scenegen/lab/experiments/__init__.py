@@ -34,13 +34,13 @@ from typing import Any
 
 from scenegen.errors import ConfigError
 from scenegen.lab.experiments.definitions import EXPERIMENTS, PAPER, Experiment, Method, get, names
+from scenegen.lab.experiments.outputs import RECORDS, listing, write_results
 from scenegen.lab.experiments.runner import (
     Task,
     derive_seed,
     execute,
     plan_tasks,
     run_task,
-    write_json_atomic,
 )
 from scenegen.lab.experiments.summary import summarize
 from scenegen.lab.experiments.tables import render_table, verdict_counts
@@ -56,6 +56,7 @@ __all__ = [
     "derive_seed",
     "get",
     "names",
+    "results_document",
     "run_experiment",
     "run_task",
     "verdict_counts",
@@ -79,6 +80,42 @@ def _write_text(path: Path, text: str) -> None:
     from scenegen.io.atomic import write_text
 
     write_text(path, text)
+
+
+def results_document(exp: Experiment, records: list[dict[str, Any]]) -> dict[str, Any]:
+    """The content of ``results.json`` for ``records`` (the runs of one sweep, in run order).
+
+    Everything in it derives from the records: S, R, the base seed and the quick flag from
+    their keys, the summary from their measures, and the ``records`` listing (every run
+    file with its digest), so ``scenegen validate DIR`` can compute it again.
+    """
+    keys = [r["key"] for r in records]
+    r = max(k["run"] for k in keys) + 1
+    s = max(k["scene"] for k in keys) + 1
+    seed, quick = int(keys[0]["seed"]), bool(keys[0]["quick"])
+    chosen = {k["method"] for k in keys}
+    results: dict[str, Any] = {
+        "experiment": exp.name,
+        "title": exp.title,
+        "runs": r,
+        "scenes": s,
+        "indicative": bool(quick or r * s < exp.runs * exp.scenes),
+        "seed": seed,
+        "quick": quick,
+        "presets": list(exp.presets),
+        "sweep": [[k, [float(v) for v in vals]] for k, vals in exp.sweep],
+        "methods": [
+            {"label": m.label, "slug": m.slug, "tracker": m.tracker, "params": m.param_dict()}
+            for m in exp.methods
+            if m.slug in chosen
+        ],
+        **summarize(exp, records),
+        RECORDS: listing(records),
+    }
+    over = keys[0].get("overrides")
+    if over:
+        results["overrides"] = dict(sorted(map(tuple, over)))
+    return _round(json.loads(json.dumps(results)))
 
 
 def run_experiment(
@@ -154,29 +191,8 @@ def run_experiment(
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     records = execute(tasks, out / "runs", jobs=jobs, scheduler=scheduler, progress=progress)
-    agg = summarize(exp, records)
-    chosen = {t.method for t in tasks}
-    results: dict[str, Any] = {
-        "experiment": exp.name,
-        "title": exp.title,
-        "runs": r,
-        "scenes": s,
-        "indicative": bool(quick or r * s < exp.runs * exp.scenes),
-        "seed": int(seed),
-        "quick": bool(quick),
-        "presets": list(exp.presets),
-        "sweep": [[k, [float(v) for v in vals]] for k, vals in exp.sweep],
-        "methods": [
-            {"label": m.label, "slug": m.slug, "tracker": m.tracker, "params": m.param_dict()}
-            for m in exp.methods
-            if m.slug in chosen
-        ],
-        **agg,
-    }
-    if overrides:
-        results["overrides"] = dict(sorted(overrides.items()))
-    results = _round(json.loads(json.dumps(results)))
-    write_json_atomic(out / "results.json", results, indent=1)
+    results = results_document(exp, records)
+    write_results(out / "results.json", results)
     _write_text(out / "table.md", render_table(exp, results, WHY.get(exp.name, "")))
     if figures:
         from scenegen.lab.experiments.figures import write_figures

@@ -7,10 +7,10 @@ scene. The seeds come from a SHA-256 hash of that key (never Python's ``hash``),
 run gives the same numbers whichever process or machine runs it.
 The worker generates the run's sequence itself (cached per process), runs the tracker and
 returns a small record of per-frame measures with floats rounded to fixed decimals. The
-parent stores each record as it arrives (one JSON file per run under ``DIR/runs/``,
+parent stores each record as it arrives (one sealed JSON file per run under ``DIR/runs/``,
 written to a temporary file in that folder and renamed into place), so running the same
-command again skips finished runs; a Dask worker lost mid-sweep only loses the task it was
-running, which the scheduler retries.
+command again skips finished runs (and computes damaged ones again); a Dask worker lost
+mid-sweep only loses the task it was running, which the scheduler retries.
 """
 
 from __future__ import annotations
@@ -378,22 +378,44 @@ def write_json_atomic(path: Path, data: Any, *, indent: int | None = None) -> No
 
 
 def load_record(path: Path, task: Task) -> dict[str, Any] | None:
-    """The stored record of ``task`` at ``path``, or None if missing, unreadable or stale.
+    """The stored record of ``task`` at ``path``, or None if missing, damaged or stale.
 
-    Stale means stored for another key (experiment, method, preset, value, scene, run,
-    seed, quick), with other tracker parameters, or for another version of the preset's
-    config (:func:`scene_digest`).
+    Damaged means unreadable, not matching its digest (edited), not a run record, a record
+    of another run (its key names another file), or written by an older version (no
+    digest, see :mod:`scenegen.lab.experiments.outputs`): the run is computed again, with
+    one warning line on stderr. Stale means stored for another key (experiment, method,
+    preset, value, scene, run, seed, quick), with other tracker parameters, or for another
+    version of the preset's config (:func:`scene_digest`); it is computed again silently. A
+    sound, fresh record that the folder's ``results.json`` (of the same seed and mode)
+    lists with another digest was edited (its digest recomputed) or replaced after the
+    results were computed: it is computed again, with a warning.
     """
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+    from scenegen.errors import DataError
+    from scenegen.io.sealed import content_digest
+    from scenegen.lab.experiments.outputs import listed_digest, read_record, warn
+
+    if not path.exists():
         return None
-    if not isinstance(data, dict) or data.get("key") != _round(task.key()):
+    try:
+        data = read_record(path)
+    except DataError as err:
+        warn(f"{err}; computing this run again")
+        return None
+    if Task(**data["key"]).filename() != path.name:
+        warn(f"{path}: holds another run ({Task(**data['key']).filename()}); computing this "
+             "run again")  # fmt: skip
+        return None
+    if data.get("key") != _round(task.key()):
         return None
     # Parameters changed since the run was stored (a new version of the experiment).
     if data.get("params") != _round(tracker_params(get(task.experiment), task)):
         return None
     if data.get("scene_digest") != scene_digest(task.preset):
+        return None
+    listed = listed_digest(path, task.seed, task.quick)
+    if listed is not None and listed != content_digest(data):
+        warn(f"{path}: is not the run its results.json was computed from (edited since); "
+             "computing this run again")  # fmt: skip
         return None
     return data
 
@@ -451,7 +473,9 @@ def execute(
                desc=tasks[0].experiment if tasks else "experiment", leave=False)
 
     def store(t: Task, rec: dict[str, Any]) -> None:
-        write_json_atomic(runs_dir / t.filename(), rec)
+        from scenegen.lab.experiments.outputs import write_record
+
+        write_record(runs_dir / t.filename(), rec)
         records[t] = json.loads(json.dumps(rec, sort_keys=True))
         bar.update(1)
         if on_done is not None:

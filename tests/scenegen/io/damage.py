@@ -16,6 +16,7 @@ from __future__ import annotations
 import contextlib
 import hashlib
 import io
+import json
 import os
 import shutil
 from collections.abc import Callable
@@ -317,4 +318,213 @@ def run_case(argvs: list[list[str]], inner_timeout: float) -> list[tuple[int, st
                 code = 99
                 err.write(f"Traceback: {type(exc).__name__}: {exc}\n")
         out.append((code, err.getvalue()))
+    return out
+
+
+# ---------------------------------------------------------------------------------------
+# Experiment outputs: a folder of sealed JSON run records, results.json and table.md
+
+FOLDER_KINDS = ("truncate", "zero", "flip", "edit_value", "edit_unsealed", "edit_badseal",
+                "resealed", "wrong_type", "delete_key", "delete_file", "unsealed", "replaced",
+                "not_object")  # fmt: skip
+"""Damage of one file of an experiment folder. ``edit_value``: a value changed, the old
+digest kept; ``edit_unsealed``: changed and the digest removed; ``edit_badseal``: changed
+and a digest recomputed the wrong way (over indented text); ``resealed``, ``wrong_type``,
+``delete_key``: changed with a correct digest (only the cross-checks of the folder can
+tell); ``unsealed``: only the digest removed (an old file); ``replaced``: a record
+overwritten by another run's sound record; ``not_object``: a sealed JSON array."""
+
+_SEAL = "sha256"
+
+
+def _json_paths(x: Any, prefix: tuple[Any, ...] = ()) -> list[tuple[Any, ...]]:
+    """Paths of every value (containers and leaves) under ``x``, the seal excluded."""
+    out = [prefix] if prefix else []
+    if isinstance(x, dict):
+        for k, v in x.items():
+            if not (prefix == () and k == _SEAL):
+                out += _json_paths(v, (*prefix, k))
+    elif isinstance(x, list):
+        for i, v in enumerate(x):
+            out += _json_paths(v, (*prefix, i))
+    return out
+
+
+def _get(x: Any, path: tuple[Any, ...]) -> Any:
+    for p in path:
+        x = x[p]
+    return x
+
+
+def _put(x: Any, path: tuple[Any, ...], value: Any) -> None:
+    _get(x, path[:-1])[path[-1]] = value
+
+
+def _other_leaf(v: Any, rng: np.random.Generator) -> Any:
+    if isinstance(v, bool):
+        return not v
+    if isinstance(v, int):
+        return v + int(rng.integers(1, 5))
+    if isinstance(v, float):
+        return v + 0.5
+    if isinstance(v, str):
+        return v + "x"
+    if v is None:
+        return 0
+    return None
+
+
+def _other_type(v: Any) -> Any:
+    if isinstance(v, bool):
+        return "true"
+    if isinstance(v, (int, float)):
+        return str(v)
+    if isinstance(v, str):
+        return [v]
+    if isinstance(v, list):
+        return {"0": v[:1]}
+    if isinstance(v, dict):
+        return list(v.values())[:1]
+    return []
+
+
+def _sealed(body: dict[str, Any]) -> dict[str, Any]:
+    from scenegen.io.sealed import seal
+
+    return seal(body)
+
+
+def _write(path: Path, doc: Any, indent: bool) -> None:
+    path.write_text(json.dumps(doc, sort_keys=True, indent=1 if indent else None) + "\n")
+
+
+def _json_variant(kind: str, target: str, rng: np.random.Generator,
+                  others: list[str]) -> Callable[[Path], None]:  # fmt: skip
+    """Damage ``DIR/target`` (a sealed JSON file) of a copied folder."""
+
+    def apply(d: Path) -> None:
+        p = d / target
+        indent = target == "results.json"
+        doc = json.loads(p.read_text())
+        body = {k: v for k, v in doc.items() if k != _SEAL}
+        paths = _json_paths(body)
+        if kind in ("edit_value", "edit_unsealed", "edit_badseal", "resealed"):
+            leaves = [q for q in paths if not isinstance(_get(body, q), (dict, list))]
+            q = leaves[int(rng.integers(len(leaves)))]
+            _put(body, q, _other_leaf(_get(body, q), rng))
+            if kind == "edit_value":
+                body[_SEAL] = doc[_SEAL]
+            elif kind == "edit_badseal":
+                text = json.dumps(body, sort_keys=True, indent=1)
+                body[_SEAL] = hashlib.sha256(text.encode()).hexdigest()
+            elif kind == "resealed":
+                body = _sealed(body)
+            _write(p, body, indent)
+        elif kind == "wrong_type":
+            q = paths[int(rng.integers(len(paths)))]
+            _put(body, q, _other_type(_get(body, q)))
+            _write(p, _sealed(body), indent)
+        elif kind == "delete_key":
+            keyed = [q for q in paths if isinstance(q[-1], str)]
+            q = keyed[int(rng.integers(len(keyed)))]
+            del _get(body, q[:-1])[q[-1]]
+            _write(p, _sealed(body), indent)
+        elif kind == "unsealed":
+            _write(p, body, indent)
+        elif kind == "replaced":
+            shutil.copyfile(d / others[int(rng.integers(len(others)))], p)
+        elif kind == "not_object":
+            p.write_text(json.dumps([body]) + "\n")
+
+    return apply
+
+
+def _file_bytes_variant(kind: str, target: str, rng: np.random.Generator) -> Callable[[Path], None]:
+    seed = int(rng.integers(2**32))
+
+    def apply(d: Path) -> None:
+        p = d / target
+        if kind == "delete_file":
+            p.unlink()
+            return
+        r = np.random.default_rng(seed)
+        data = bytearray(p.read_bytes())
+        if kind == "truncate":
+            data = data[: int(r.integers(0, len(data)))]
+        elif kind == "zero":
+            at = int(r.integers(0, len(data)))
+            n = int(r.choice([1, 8, 64, 512, 4096]))
+            data[at : at + n] = bytes(len(data[at : at + n]))
+        else:  # flip
+            for _ in range(int(r.integers(1, 4))):
+                data[int(r.integers(len(data)))] ^= 1 << int(r.integers(8))
+        p.write_bytes(bytes(data))
+
+    return apply
+
+
+def folder_variants(src: Path, n: int, seed: int,
+                    kinds: tuple[str, ...] = FOLDER_KINDS) -> list[Variant]:  # fmt: skip
+    """``n`` seeded damaged variants of the experiment folder ``src``: each damages one
+    file (``results.json``, a run record or ``table.md``); ``apply(dst)`` writes the
+    damaged copy into the folder ``dst`` (which must not exist)."""
+    rng = np.random.default_rng(seed)
+    runs = sorted(f"runs/{p.name}" for p in (src / "runs").glob("*.json"))
+    out = []
+    for i in range(n):
+        kind = kinds[i % len(kinds)]
+        byte_kind = kind in ("truncate", "zero", "flip", "delete_file")
+        files = ["results.json", *runs, *(["table.md"] if byte_kind else [])]
+        if kind == "replaced":
+            files = runs
+        target = files[int(rng.integers(len(files)))]
+        sub = np.random.default_rng(rng.integers(2**32))
+        if byte_kind:
+            fn = _file_bytes_variant(kind, target, sub)
+        else:
+            fn = _json_variant(kind, target, sub, [r for r in runs if r != target])
+
+        def apply(dst: Path, fn_: Callable[[Path], None] = fn) -> None:
+            shutil.copytree(src, dst)
+            fn_(dst)
+
+        out.append(Variant(f"{i:04d}-{kind}:{target}", kind, apply, kind in (
+            "resealed", "wrong_type", "delete_key")))  # fmt: skip
+    return out
+
+
+def folder_content(folder: str) -> str:
+    """Digest of everything readable in an experiment folder: the parsed content of every
+    JSON file (its raw bytes if it does not parse) and the text of ``table.md``."""
+    h = hashlib.sha256()
+    root = Path(folder)
+    for p in sorted([root / "results.json", root / "table.md", *(root / "runs").glob("*.json")]):
+        h.update(str(p.relative_to(root)).encode())
+        if not p.exists():
+            h.update(b"<missing>")
+            continue
+        raw = p.read_bytes()
+        try:
+            value = json.loads(raw) if p.suffix == ".json" else raw
+        except ValueError:
+            value = raw
+        h.update(repr(value).encode() if p.suffix == ".json" else raw)
+    return h.hexdigest()
+
+
+def run_folder_case(argvs: list[list[str]], report: Path | None) -> list[tuple[int, str]]:
+    """Like :func:`run_case`, then (if ``report``) :func:`scenegen.lab.report.build_report`
+    on that report folder: (0, "") or (1, its DataError line)."""
+    out = run_case(argvs, 3.0)
+    if report is not None:
+        from scenegen.errors import DataError
+        from scenegen.lab.report import build_report
+
+        try:
+            build_report(report)
+            out.append((0, ""))
+        except DataError as err:
+            out.append((1, f"{err}\n"))
+        except BaseException as exc:  # noqa: BLE001 - counted as a traceback
+            out.append((99, f"Traceback: {type(exc).__name__}: {exc}\n"))
     return out

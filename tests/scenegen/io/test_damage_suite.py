@@ -8,8 +8,14 @@ variant whose readable content differs from the original (0 wrong "valid"), and
 ``validate --deep`` every edit whose digests were recomputed. Damage that falls on unused
 bytes changes nothing readable: "valid" is then right ("harmless" below).
 
-The fast suite runs a few dozen variants in this process; ``make test-slow`` runs 1,040,
-each in its own guarded child, and prints the figures kept in the README.
+The same holds for experiment outputs (a folder of sealed run records, ``results.json``
+and ``table.md``): ``validate DIR`` reports every damaged variant, a resumed
+``scenegen experiment`` computes damaged runs again (with a warning) and ends with the
+original ``results.json``, and the report refuses a damaged ``results.json`` in one line.
+
+The fast suite runs a few dozen variants of each in this process; ``make test-slow`` runs
+1,040 file variants and 260 folder variants, each in its own guarded child, and prints the
+figures kept in the README.
 """
 
 from __future__ import annotations
@@ -20,7 +26,18 @@ from collections import Counter
 
 import numpy as np
 import pytest
-from damage import KINDS, RESULT_KINDS, content, old_format, run_case, variants
+from damage import (
+    FOLDER_KINDS,
+    KINDS,
+    RESULT_KINDS,
+    content,
+    folder_content,
+    folder_variants,
+    old_format,
+    run_case,
+    run_folder_case,
+    variants,
+)
 
 from scenegen.config import from_dict
 from scenegen.errors import DataError
@@ -82,6 +99,7 @@ class Tally:
     def __init__(self) -> None:
         self.counts: Counter[str] = Counter()
         self.failures: list[str] = []
+        self.by_kind: Counter[str] = Counter()
 
     def fail(self, what: str, line: str) -> None:
         self.counts[what] += 1
@@ -183,4 +201,125 @@ def test_slow_damaged_variants(sources, tmp_path, capsys):
         for line in tally.failures[:20]:
             print("  " + line)
     assert i == 20 * scale and len(KINDS) == 13
+    assert tally.failures == []
+
+
+# ---------------------------------------------------------------------------------------
+# Experiment outputs
+
+EXP = "shm-depth"
+EXP_ARGS = ["--runs", "1", "--scenes", "1", "--quick", "--jobs", "1", "--method", "kalman",
+            "--method", "shm-fast"]  # fmt: skip
+_RESEALED = ("resealed", "wrong_type", "delete_key", "replaced")
+
+
+@pytest.fixture(scope="module")
+def experiment(tmp_path_factory):
+    """A small experiment folder (4 sealed runs, results.json, table.md) and its content."""
+    from scenegen.cli import main
+
+    d = tmp_path_factory.mktemp("experiment") / EXP
+    assert main(["experiment", EXP, *EXP_ARGS, "-o", str(d)]) == 0
+    assert main(["validate", str(d)]) == 0
+    return d, folder_content(str(d)), (d / "results.json").read_bytes()
+
+
+def _folder_argvs(v, dst, i: int) -> tuple[list[list[str]], bool]:
+    """validate DIR, and in rotation a resumed experiment or the report (True)."""
+    argvs = [["validate", str(dst)]]
+    if i % 3 == 1:
+        argvs.append(["experiment", EXP, *EXP_ARGS, "-o", str(dst)])
+    return argvs, i % 3 == 2
+
+
+def judge_folder(tally, v, dst, results, original, original_results):
+    """Classify one experiment-folder variant's outcome into ``tally``."""
+    path = str(dst)
+    target = v.name.split(":", 1)[1]
+    (vcode, verr), *others = results
+    if vcode not in (0, 1) or "Traceback" in verr or (vcode and not verr.strip()) or any(
+            not ln.startswith(path) for ln in verr.splitlines()):  # fmt: skip
+        tally.fail("traceback or garbled output", f"{v.name}: {results}")
+        return
+    if vcode == 1:
+        tally.counts["reported by validate"] += 1
+        tally.by_kind[v.kind] += 1
+    elif folder_content(path) == original:
+        tally.counts["harmless (no readable change)"] += 1
+        tally.by_kind[f"{v.kind} (harmless)"] += 1
+    else:
+        tally.fail("WRONG VALID", f"{v.name}: {verr.strip()}")
+    for code, err in others:
+        lines = err.splitlines()
+        if code in (99, 2) or "Traceback" in err or len(lines) > 2:
+            tally.fail("traceback or garbled output", f"{v.name}: {code} {err!r}")
+        elif err.startswith("scenegen: warning:") or err.startswith(f"{EXP}:"):  # resumed
+            if code != 0 or (dst / "results.json").read_bytes() != original_results:
+                tally.fail("RESUME WRONG", f"{v.name}: {code} {err!r}")
+            elif target.startswith("runs/") and vcode == 1 and v.kind != "delete_file" and not any(
+                    ln.startswith(f"scenegen: warning: {dst / target}") for ln in lines):
+                # a missing run is simply not done yet; any other damage is said
+                tally.fail("RESUME SILENT", f"{v.name}: {err!r}")  # fmt: skip
+            else:
+                tally.counts["resumed: damaged runs recomputed, same results.json"] += 1
+        elif code == 1:  # the report
+            if not err.startswith(str(dst / "results.json")):
+                tally.fail("REPORT GARBLED", f"{v.name}: {err!r}")
+            else:
+                tally.counts["report refused results.json (one line)"] += 1
+        elif target == "results.json" and vcode == 1 and v.kind not in (
+                *_RESEALED, "delete_file"):  # fmt: skip
+            tally.fail("REPORT ACCEPTED DAMAGE", f"{v.name}")
+        else:
+            tally.counts["report built"] += 1
+
+
+def test_fast_damaged_experiment_outputs(experiment, tmp_path, monkeypatch):
+    """26 variants of an experiment folder, every kind, in this process."""
+    src, original, original_results = experiment
+    tally = Tally()
+    for i, v in enumerate(folder_variants(src, 26, seed=11)):
+        report = tmp_path / f"r{i}"
+        dst = report / "experiments" / EXP
+        v.apply(dst)
+        argvs, with_report = _folder_argvs(v, dst, i)
+        results = run_folder_case(argvs, report if with_report else None)
+        judge_folder(tally, v, dst, results, original, original_results)
+    assert tally.failures == []
+    assert sum(tally.counts[k] for k in ("reported by validate", "harmless (no readable "
+                                         "change)")) == 26  # fmt: skip
+    assert tally.counts["reported by validate"] >= 22
+    assert tally.counts["resumed: damaged runs recomputed, same results.json"] >= 8
+
+
+@pytest.mark.slow
+def test_slow_damaged_experiment_outputs(experiment, tmp_path, capsys):
+    """260 variants of an experiment folder (13 kinds x 20), each in a guarded child with a
+    120 s deadline: validate reports each, a resume repairs it, the report refuses a
+    damaged results.json; no hang, no traceback, no wrong "valid"."""
+    src, original, original_results = experiment
+    tally = Tally()
+    n = int(os.environ.get("SCENEGEN_FOLDER_DAMAGE", "260"))
+    for i, v in enumerate(folder_variants(src, n, seed=2026)):
+        report = tmp_path / f"r{i % 4}"
+        shutil.rmtree(report, ignore_errors=True)
+        dst = report / "experiments" / EXP
+        v.apply(dst)
+        argvs, with_report = _folder_argvs(v, dst, i)
+        try:
+            results = guard.call(run_folder_case, argvs, report if with_report else None,
+                                 label=str(dst), seconds=120)  # fmt: skip
+        except guard.Unreadable as err:
+            tally.fail("HANG", f"{v.name}: {err}")
+        else:
+            judge_folder(tally, v, dst, results, original, original_results)
+    with capsys.disabled():
+        print(f"\nexperiment-folder variants tried: {n}; " + "; ".join(
+            f"{k}: {c}" for k, c in sorted(tally.counts.items())))  # fmt: skip
+        for k in FOLDER_KINDS:
+            tried = sum(1 for i in range(n) if FOLDER_KINDS[i % len(FOLDER_KINDS)] == k)
+            print(f"  {k}: tried {tried}, reported {tally.by_kind[k]}, harmless "
+                  f"{tally.by_kind[k + ' (harmless)']}")
+        for line in tally.failures[:20]:
+            print("  " + line)
     assert tally.failures == []

@@ -8,6 +8,7 @@ metadata becomes a problem line too (``validate`` checks in a child process).
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
 
@@ -514,3 +515,177 @@ def test_old_files_with_variable_length_strings_stay_readable_and_valid(copy):
     assert check_file(p) == []
     seq = read(p)
     assert list(seq.entities.name) == ["a", "b", "wall"] and seq.preset == ""
+
+
+# ---------------------------------------------------------------------------------------
+# Sealed JSON documents and experiment folders (run records, results.json, table.md)
+
+EXP_ARGS = ["shm-depth", "--runs", "1", "--scenes", "1", "--quick", "--jobs", "1",
+            "--method", "kalman"]  # fmt: skip
+CLUTTER = "runs/kalman__shm-clutter__s000__r000.json"
+CROSSING = "runs/kalman__shm-crossing__s000__r000.json"
+
+
+def test_sealed_documents_round_trip_and_name_each_problem(tmp_path, monkeypatch):
+    from scenegen.io import sealed
+
+    p = tmp_path / "doc.json"
+    digest = sealed.write_sealed_json(p, {"b": (1, 2.5), "a": "λ"}, indent=1)
+    assert sealed.read_sealed_json(p) == {"a": "λ", "b": [1, 2.5]}
+    doc = json.loads(p.read_text())
+    assert doc["sha256"] == digest == sealed.content_digest(doc)
+    p.write_text(json.dumps(doc))  # another layout, the same content: still sound
+    assert sealed.check_sealed_json(p) == []
+    cases = {
+        b"": "empty file (truncated?)",
+        b'{"a": 1': "not a readable JSON file (Expecting ',' delimiter at line 1 column 8: "
+                    "truncated or damaged)",
+        b"\xff{}": "not a readable JSON file (not UTF-8 at byte 0)",
+        b'{"a": 1, "a": 2}': "not a readable JSON file (key 'a' appears twice)",
+        b'{"a": NaN}': "not a readable JSON file (NaN is not JSON)",
+        b"[" * 100_000 + b"]" * 100_000: "not a readable JSON file (nested too deeply)",
+        b"[1]": "not a sealed JSON document (a JSON object is expected, found list)",
+        b'{"a": 1, "sha256": "00"}': "malformed sha256 digest (damaged or edited)",
+        b'{"a": 2, "sha256": "%s"}' % digest.encode(): "content does not match its sha256 "
+                                                       "digest (damaged or edited)",
+    }  # fmt: skip
+    for raw, line in cases.items():
+        p.write_bytes(raw)
+        assert sealed.check_sealed_json(p) == [f"{p}: {line}"], raw[:20]
+    p.write_text('{"a": 1}')
+    with pytest.raises(sealed.Unsealed, match="no sha256 digest"):
+        sealed.read_sealed_json(p)
+    monkeypatch.setattr(sealed, "MAX_BYTES", 4)
+    assert sealed.check_sealed_json(p) == [
+        f"{p}: too large for a JSON document (8 bytes, at most 4)"
+    ]
+
+
+@pytest.fixture(scope="module")
+def experiment_dir(tmp_path_factory):
+    d = tmp_path_factory.mktemp("exp") / "shm-depth"
+    assert main(["experiment", *EXP_ARGS, "-o", str(d)]) == 0
+    return d
+
+
+@pytest.fixture
+def exp_copy(experiment_dir, tmp_path):
+    d = tmp_path / "experiments" / "shm-depth"
+    shutil.copytree(experiment_dir, d)
+    return d
+
+
+def _reseal(path, fn):
+    from scenegen.io.sealed import seal
+
+    doc = json.loads(path.read_text())
+    fn(doc)
+    path.write_text(json.dumps(seal(doc), indent=1))
+
+
+def _validate(d, capsys, *extra):
+    code = main(["validate", *extra, str(d)])
+    out, err = capsys.readouterr()
+    return code, err.splitlines(), out
+
+
+def test_a_sound_experiment_folder_is_valid(exp_copy, capsys):
+    code, err, out = _validate(exp_copy, capsys)
+    assert (code, err, out.strip()) == (0, [], f"{exp_copy}: valid experiment folder")
+    doc = json.loads((exp_copy / "results.json").read_text())
+    assert [e.split()[0] for e in doc["records"]] == [CROSSING[5:], CLUTTER[5:]]
+    assert all(len(e.split()[1]) == 64 for e in doc["records"])
+
+
+def test_damaged_or_edited_experiment_files_are_one_line_each(exp_copy, capsys):
+    rec = exp_copy / CLUTTER
+    rec.write_text(rec.read_text().replace('"n_frames":45', '"n_frames":46'))
+    _reseal(exp_copy / CROSSING, lambda d: d.__setitem__("tracker_seed", 1))
+    code, err, _ = _validate(exp_copy, capsys)
+    assert code == 1 and err == [
+        f"{exp_copy / CROSSING}: is not the run results.json was computed from (edited or "
+        "replaced since)",
+        f"{exp_copy / CLUTTER}: content does not match its sha256 digest (damaged or edited)",
+    ]
+
+
+def test_an_edited_results_json_is_found_even_resealed(exp_copy, capsys):
+    res = exp_copy / "results.json"
+    _reseal(res, lambda d: d["summary"].__setitem__("extra", 1))
+    code, err, _ = _validate(exp_copy, capsys)
+    assert code == 1 and err == [f"{res}: summary differs from the summary of its runs (edited)"]
+    _reseal(res, lambda d: d.__setitem__("runs", "1"))
+    code, err, _ = _validate(exp_copy, capsys)
+    assert err == [f"{res}: not an experiment's results (runs is missing or not a int)"]
+
+
+def test_a_damaged_table_md_is_named(exp_copy, capsys):
+    table = exp_copy / "table.md"
+    table.write_text(table.read_text().replace("reproduced", "rEproduced", 1))
+    code, err, _ = _validate(exp_copy, capsys)
+    assert code == 1 and err == [f"{table}: is not the table of results.json (damaged or edited)"]
+    table.unlink()
+    assert _validate(exp_copy, capsys)[1] == [f"{table}: missing"]
+
+
+def test_deep_finds_a_run_forged_everywhere(exp_copy, capsys):
+    """A record edited with its digest and results.json's listing recomputed (a field the
+    summary does not use): only running it again can tell."""
+    from scenegen.io.sealed import content_digest
+
+    rec = exp_copy / CLUTTER
+    _reseal(rec, lambda d: d.__setitem__("tracker_seed", 1))
+    new = content_digest(json.loads(rec.read_text()))
+
+    def relist(doc):
+        doc["records"] = [e if not e.startswith(rec.name) else f"{rec.name} {new}"
+                          for e in doc["records"]]  # fmt: skip
+
+    _reseal(exp_copy / "results.json", relist)
+    assert _validate(exp_copy, capsys)[0] == 0
+    code, err, _ = _validate(exp_copy, capsys, "--deep")
+    assert code == 1 and err == [f"{rec}: differs from the run computed again"]
+
+
+def test_resume_recomputes_damaged_and_old_records_with_a_warning(exp_copy, capsys):
+    from scenegen.io.sealed import SEAL
+
+    original = (exp_copy / "results.json").read_bytes()
+    rec = exp_copy / CLUTTER
+    rec.write_bytes(rec.read_bytes()[:100])
+    old = exp_copy / CROSSING
+    doc = json.loads(old.read_text())
+    del doc[SEAL]  # as the previous version wrote it
+    old.write_text(json.dumps(doc))
+    assert main(["experiment", *EXP_ARGS, "-o", str(exp_copy)]) == 0
+    warnings = [ln for ln in capsys.readouterr().err.splitlines() if "warning" in ln]
+    assert warnings == [
+        f"scenegen: warning: {old}: no sha256 digest (written by an older version of "
+        "scenegen, or edited); computing this run again",
+        f"scenegen: warning: {rec}: not a readable JSON file (Unterminated string starting "
+        "at line 1 column 100: truncated or damaged); computing this run again",
+    ]
+    assert (exp_copy / "results.json").read_bytes() == original
+    assert _validate(exp_copy, capsys)[0] == 0
+
+
+def test_old_results_json_is_refused_by_the_report_with_a_hint(exp_copy, capsys):
+    from scenegen.io.sealed import SEAL
+    from scenegen.lab.report import build_report
+
+    root = exp_copy.parent.parent
+    build_report(root)
+    assert main(["validate", str(root)]) == 0
+    assert capsys.readouterr().out.strip() == f"{root}: valid report folder"
+    res = exp_copy / "results.json"
+    doc = json.loads(res.read_text())
+    del doc[SEAL]
+    res.write_text(json.dumps(doc, indent=1))
+    with pytest.raises(DataError) as err:
+        build_report(root)
+    assert str(err.value) == (
+        f"{res}: no sha256 digest (written by an older version of scenegen, or edited): run "
+        "the experiment again into its folder to recompute it"
+    )
+    code = main(["validate", str(root)])
+    assert code == 1 and capsys.readouterr().err.splitlines() == [str(err.value)]

@@ -1,0 +1,362 @@
+"""The files an experiment writes and reads back, sealed, and the check of its folder.
+
+An experiment folder ``DIR`` holds one run record per finished run (``DIR/runs/*.json``),
+``DIR/results.json`` and ``DIR/table.md`` (plus PNG figures, which nothing reads back).
+Records and ``results.json`` are sealed JSON documents
+(:mod:`scenegen.io.sealed`: a ``sha256`` key over the canonical content, written
+atomically). ``results.json`` also lists, under ``records``, every run file it was
+computed from with that file's digest (``"NAME SHA256"``, in run order): the results are
+tied to exactly those records.
+
+- A resumed sweep (:func:`scenegen.lab.experiments.runner.execute`) treats a record that
+  is damaged, edited, malformed or written by an older version (no digest) as not done:
+  it is computed again, with one warning line on stderr; so is a sealed record that
+  ``results.json`` lists with another digest (edited after the results were computed).
+- :func:`read_results` (the report) raises one :class:`~scenegen.errors.DataError` line
+  naming the file for a damaged, edited, malformed or old ``results.json``.
+- :func:`check_experiment` (``scenegen validate DIR``) checks everything: each listed
+  record reads, matches its digest, its listed digest and its file name, and has the
+  record's fields; ``results.json`` equals the summary recomputed from those records (so
+  an edit whose digest was recomputed is still found); ``table.md`` is the table of
+  ``results.json``. With ``deep``, every run is also computed again and compared.
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+import sys
+from dataclasses import MISSING, fields
+from pathlib import Path
+from typing import Any
+
+from scenegen.errors import DataError
+from scenegen.io.sealed import content_digest, read_sealed_json, write_sealed_json
+
+__all__ = [
+    "RECORDS",
+    "check_experiment",
+    "check_report",
+    "listed_digest",
+    "listing",
+    "read_record",
+    "read_results",
+    "record_problems",
+    "report_entry",
+    "warn",
+    "write_record",
+    "write_results",
+]
+
+RECORDS = "records"
+"""Key of ``results.json``: ``["RUN_FILE SHA256", ...]``, every run it was computed from
+(the file's name under ``runs/`` and its digest), in run order."""
+_PER_FRAME = ("state", "precision", "recall", "iou", "centre_error", "path_error")
+_MAX_LISTED = 5  # problem lines per folder before "and N more"
+
+
+_warned: set[str] = set()
+
+
+def warn(line: str) -> None:
+    """Print one warning line on stderr (once per process: a resumed sweep may look at a
+    damaged record both when it plans its tasks and when it collects them)."""
+    if line in _warned:
+        return
+    _warned.add(line)
+    print(f"scenegen: warning: {line}", file=sys.stderr, flush=True)
+
+
+def write_record(path: Path, record: dict[str, Any]) -> str:
+    """Write a run record sealed and atomically (creating ``runs/``); return its digest."""
+    return write_sealed_json(path, record, parents=True)
+
+
+def _numbers(x: Any, allow_bool: bool = True) -> bool:
+    """True if every leaf of ``x`` (lists and dicts) is a number, None (or a bool)."""
+    if x is None:
+        return True
+    if isinstance(x, bool):
+        return allow_bool
+    if isinstance(x, (int, float)):
+        return True
+    if isinstance(x, list):
+        return all(_numbers(v, allow_bool) for v in x)
+    if isinstance(x, dict):
+        return all(_numbers(v, allow_bool) for v in x.values())
+    return False
+
+
+def record_problems(data: Any) -> list[str]:
+    """What is wrong with the fields of a run record (empty when none is)."""
+    from scenegen.lab.experiments.runner import Task
+
+    if not isinstance(data, dict):
+        return ["not a run record (a JSON object is expected)"]
+    out = []
+    key = data.get("key")
+    names = {f.name for f in fields(Task)}
+    required = {f.name for f in fields(Task) if f.default is MISSING}  # others: optional
+    if not isinstance(key, dict) or not required <= set(key) <= names:
+        out.append("key is not a run key")
+    else:
+        try:
+            Task(**key).filename()
+        except (TypeError, ValueError):
+            out.append("key is not a run key")
+    for name, kind in (("tracker", str), ("params", dict), ("scene_digest", str),
+                       ("scene_seed", int), ("tracker_seed", int), ("n_frames", int)):  # fmt: skip
+        if not isinstance(data.get(name), kind) or isinstance(data.get(name), bool):
+            out.append(f"{name} is missing or not a {kind.__name__}")
+    n = data.get("n_frames")
+    targets = data.get("targets")
+    if not isinstance(targets, list) or not targets:
+        out.append("targets is missing or empty")
+        targets = []
+    for i, t in enumerate(targets):
+        if not isinstance(t, dict) or not isinstance(t.get("name"), str):
+            out.append(f"targets[{i}] is not a target")
+            continue
+        for f in _PER_FRAME:
+            v = t.get(f)
+            if v is None and f == "path_error":
+                continue
+            if not (isinstance(v, list) and len(v) == n and _numbers(v, allow_bool=False)):
+                out.append(f"targets[{i}].{f} is not {n} numbers")
+    for name in ("failure_threshold", "uniqueness", "effective_dynamics", "order_prob",
+                 "orderings", "true_order", "depth_order_accuracy", "overlap"):  # fmt: skip
+        if name in data and not _numbers(data[name]):
+            out.append(f"{name} is not numeric")
+    if "failure_threshold" not in data:
+        out.append("failure_threshold is missing")
+    return out
+
+
+def read_record(path: Path) -> dict[str, Any]:
+    """The run record at ``path`` (without its digest).
+
+    Raises
+    ------
+    DataError
+        One line: missing, damaged, edited, written by an older version
+        (:class:`scenegen.io.sealed.Unsealed`), or not a run record.
+    """
+    data = read_sealed_json(path)
+    problems = record_problems(data)
+    if problems:
+        raise DataError(f"{path}: not a run record ({problems[0]})")
+    return data
+
+
+def listing(records: list[dict[str, Any]]) -> list[str]:
+    """The :data:`RECORDS` entry of ``results.json`` for ``records`` (in run order)."""
+    from scenegen.lab.experiments.runner import Task
+
+    return [f"{Task(**r['key']).filename()} {content_digest(r)}" for r in records]
+
+
+def _entries(results: dict[str, Any]) -> list[tuple[str, str]] | None:
+    entries = results.get(RECORDS)
+    if not isinstance(entries, list) or not entries:
+        return None
+    out = []
+    for e in entries:
+        if not isinstance(e, str) or e.count(" ") != 1:
+            return None
+        name, digest = e.split(" ")
+        out.append((name, digest))
+    return out
+
+
+@functools.lru_cache(maxsize=4)
+def _listed(path: Path, version: tuple[int, int, int]) -> tuple[int, bool, dict[str, str]]:
+    try:
+        res = read_results(path)
+    except DataError:
+        return (-1, False, {})
+    return (res["seed"], res["quick"], dict(_entries(res) or []))
+
+
+def listed_digest(record_path: Path, seed: int, quick: bool) -> str | None:
+    """The digest that ``DIR/results.json`` lists for the run file ``DIR/runs/NAME``, or
+    None (no sound ``results.json`` of that base seed and mode, or the run not listed)."""
+    res = record_path.parent.parent / "results.json"
+    try:
+        st = res.stat()
+    except OSError:
+        return None
+    s, q, listed = _listed(res, (st.st_ino, st.st_size, st.st_mtime_ns))
+    if (s, q) != (seed, quick):
+        return None
+    return listed.get(record_path.name)
+
+
+def write_results(path: Path, results: dict[str, Any]) -> None:
+    """Write ``results.json`` sealed and atomically (indented: users read it)."""
+    write_sealed_json(path, results, indent=1)
+
+
+def read_results(path: Path, name: str | None = None) -> dict[str, Any]:
+    """The content of an experiment's ``results.json`` (without its digest).
+
+    Parameters
+    ----------
+    path : Path
+    name : str, optional
+        The experiment it must belong to.
+
+    Raises
+    ------
+    DataError
+        One line naming the file: missing, damaged, edited, written by an older version
+        (run the experiment again to recompute it), or not an experiment's results.
+    """
+    from scenegen.io.sealed import Unsealed
+
+    try:
+        data = read_sealed_json(path)
+    except Unsealed as err:
+        raise DataError(f"{err}: run the experiment again into its folder to recompute "
+                        "it") from None  # fmt: skip
+    problem = _results_problem(data, name)
+    if problem:
+        raise DataError(f"{path}: not an experiment's results ({problem})")
+    return data
+
+
+def _results_problem(data: dict[str, Any], name: str | None) -> str | None:
+    from scenegen.lab.experiments.definitions import names
+
+    exp = data.get("experiment")
+    if not isinstance(exp, str) or exp not in names():
+        return "experiment is missing or unknown"
+    if name is not None and exp != name:
+        return f"experiment is {exp!r}, expected {name!r}"
+    for key, kind in (("runs", int), ("scenes", int), ("seed", int), ("quick", bool),
+                      ("indicative", bool), ("claims", list), ("summary", dict)):  # fmt: skip
+        if not isinstance(data.get(key), kind):
+            return f"{key} is missing or not a {kind.__name__}"
+    if not all(isinstance(c, dict) and isinstance(c.get("verdict"), str)
+               and c["verdict"] in ("reproduced", "not reproduced", "inconclusive")
+               for c in data["claims"]):  # fmt: skip
+        return "claims has an entry without a verdict"
+    if _entries(data) is None:
+        return f"{RECORDS} is missing or not a list of 'RUN_FILE SHA256'"
+    return None
+
+
+def _more(problems: list[str]) -> list[str]:
+    if len(problems) <= _MAX_LISTED:
+        return problems
+    return [*problems[:_MAX_LISTED], f"... and {len(problems) - _MAX_LISTED} more problems"]
+
+
+def check_experiment(folder: str | Path, *, deep: bool = False) -> list[str]:
+    """Check an experiment folder; one line per problem, empty when it is sound.
+
+    Parameters
+    ----------
+    folder : str or Path
+        A folder written by ``scenegen experiment NAME -o DIR``.
+    deep : bool
+        Also run every listed run again (same seeds) and compare it with its record: finds
+        a record edited with its digests recomputed everywhere.
+
+    Returns
+    -------
+    list of str
+        Each line names the file at fault (at most a few per kind, then a count).
+    """
+    from scenegen.lab.experiments import results_document
+    from scenegen.lab.experiments.definitions import get
+    from scenegen.lab.experiments.runner import Task, run_task
+    from scenegen.lab.experiments.tables import render_table
+    from scenegen.lab.experiments.why import WHY
+
+    root = Path(folder)
+    res_path = root / "results.json"
+    try:
+        results = read_results(res_path)
+    except DataError as err:
+        return [str(err)]
+    exp = get(results["experiment"])
+    problems: list[str] = []
+    records: list[dict[str, Any]] = []
+    entries = _entries(results) or []
+    for name, digest in entries:
+        path = root / "runs" / name
+        if Path(name).name != name or not name.endswith(".json"):
+            problems.append(f"{res_path}: {RECORDS} names {name!r}, not a run file")
+            continue
+        try:
+            rec = read_record(path)
+        except DataError as err:
+            problems.append(str(err))
+            continue
+        if Task(**rec["key"]).filename() != name:
+            problems.append(f"{path}: holds the run {Task(**rec['key']).filename()!r}")
+        elif content_digest(rec) != digest:
+            problems.append(f"{path}: is not the run {res_path.name} was computed from "
+                            "(edited or replaced since)")  # fmt: skip
+        records.append(rec)
+    if problems:
+        return _more(problems)
+    try:
+        fresh = results_document(exp, records)
+    except Exception as err:  # noqa: BLE001 - sound digests, yet contents no summary expects
+        return [f"{res_path}: its runs cannot be summarised ({type(err).__name__}: "
+                f"{str(err)[:80]})"]  # fmt: skip
+    if fresh != results:
+        keys = sorted(k for k in set(fresh) | set(results) if fresh.get(k) != results.get(k))
+        verb = "differs" if len(keys) == 1 else "differ"
+        problems.append(f"{res_path}: {', '.join(keys)} {verb} from the summary of its runs "
+                        "(edited)")  # fmt: skip
+    table = root / "table.md"
+    try:
+        text = table.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        problems.append(f"{table}: missing")
+    except (OSError, UnicodeDecodeError) as err:
+        problems.append(f"{table}: unreadable ({type(err).__name__})")
+    else:
+        if text != render_table(exp, fresh, WHY.get(exp.name, "")):
+            problems.append(f"{table}: is not the table of {res_path.name} (damaged or edited)")
+    if deep and not problems:
+        for (name, _), rec in zip(entries, records, strict=True):
+            again = json.loads(json.dumps(run_task(Task(**rec["key"])), sort_keys=True))
+            if again != rec:
+                problems.append(f"{root / 'runs' / name}: differs from the run computed again")
+    return _more(problems)
+
+
+def check_report(folder: str | Path) -> list[str]:
+    """Check a report folder (``scenegen experiment all -o DIR``): every experiment in
+    ``DIR/experiments/`` (:func:`check_experiment`) and ``DIR/results.json``, which must
+    hold exactly their results."""
+    from scenegen.lab.experiments.definitions import names
+
+    root = Path(folder)
+    problems: list[str] = []
+    expected: dict[str, Any] = {}
+    for name in names():
+        sub = root / "experiments" / name
+        if not (sub / "results.json").exists():
+            continue
+        found = check_experiment(sub)
+        problems += found
+        if not found:
+            expected[name] = report_entry(read_results(sub / "results.json", name))
+    path = root / "results.json"
+    try:
+        doc = read_sealed_json(path)
+    except DataError as err:
+        return [*problems, str(err)]
+    if doc.get("experiments") != expected and not problems:
+        problems.append(f"{path}: does not hold the results of {root / 'experiments'} "
+                        "(edited or stale)")  # fmt: skip
+    return problems
+
+
+def report_entry(results: dict[str, Any]) -> dict[str, Any]:
+    """An experiment's results as the report's ``results.json`` holds them (no listing)."""
+    return {k: v for k, v in results.items() if k != RECORDS}
