@@ -133,14 +133,14 @@ def dps_synthetic() -> SceneConfig:
     and method; base seed 0 was not looked at): the scene is kept as it is, because the PS
     ordering cannot decide object 1's fate on any scene with our PS. The distractor
     overlaps object 1's box for 2–6 frames (median 4); when it captures object 1's
-    particles (object 1 lost in 10–30 % of PS runs, first lost at frames 6–12) the track
-    is gone for good (1 of 24 lost PS runs recovered), and whether that happens is decided
-    by the scene far more than by the sampling (per scene, the PS runs recover 0 % or
-    100 % in 20 of 30 scenes). Six variants of the distractor were run with all nine
-    methods or five of them: an exact copy (colour jitter 0) at (8, 0), (6, 0) and (10, 0)
-    px/frame, and an exact or jitter-2 copy that lingers over object 1 and then
-    accelerates away (AR2 a1 = 2.5–2.6, a2 = −1.5/−1.6 from 2–3 px/frame: 4–8 px apart
-    for two frames, 37–70 px at frame 8). They moved object 1's PS recovery between
+    particles (object 1 lost in 15–33 % of PS runs, mostly first at frames 6–12) the
+    track is gone for good (1 of 24 lost PS runs recovered), and whether that happens is
+    decided by the scene far more than by the sampling (per scene, the PS runs recover
+    0 % or 100 % in 19 of 30 scenes). Five variants of the distractor were run with all
+    nine methods or five of them: an exact copy (colour jitter 0) at (8, 0) and (10, 0)
+    px/frame, and an exact copy that lingers over object 1 and then accelerates away
+    (AR2 a1 = 2.5 or 2.6, a2 = −1.5 or −1.6, from 2 or 3 px/frame: 3–9 px apart at frame
+    4, 37–71 px at frame 8). They moved object 1's PS recovery between
     ~55 % and ~80 %, but in none did the orderings differ (χ² p 0.2–0.95 over the seven
     orderings with 60 runs each; 59 / 66 / 63 % with 150 runs each for object 1 sampled
     first / last / fourth on the lingering copy), nor did DPS lead PS. The reason is
@@ -149,8 +149,9 @@ def dps_synthetic() -> SceneConfig:
     then six resamplings by the other objects' likelihoods, which do not depend on it —
     whatever its place in the ordering; the place only changes at which point of that
     cycle the estimate and the uniqueness are read. The first-stage object's low
-    uniqueness (8–9 % against 100 %) is real but is read after those six resamplings, and
-    the next frame's dynamics re-spread every object alike. A diagnostic variant of PS
+    uniqueness (8–9 % against 100 %) is real but is read after its own resampling and five
+    foreign ones, the last-stage object's right after its dynamics, and the next frame's
+    dynamics re-spread every object alike. A diagnostic variant of PS
     that applies every object's dynamics before the first stage (not committed, not the
     paper's scheme: objects 2–7 then fail half the time) does make the ordering matter
     (28 % sampled last against 57–62 % sampled first or second, χ² p = 0.001), which
