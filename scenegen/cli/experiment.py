@@ -36,6 +36,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="set a tracker parameter on every method run, e.g. kernel=box; VALUE is "
                    "read as JSON when it parses, else as a string (repeatable; not with "
                    "`all`); the runs stay paired with the default ones")
+    p.add_argument("--value", action="append", type=float, default=None, metavar="V",
+                   help="run only this value of the swept parameter, e.g. λ = 20 for "
+                   "dps-synthetic (repeatable; not with `all`)")
     p.add_argument("--quick", action="store_true",
                    help="scaled-down settings (fewer frames/particles), for smoke tests")
     p.add_argument("-o", "--output", required=True, type=Path, help="output folder DIR")
@@ -80,8 +83,9 @@ def cmd_experiment(args: argparse.Namespace) -> int:
     Raises
     ------
     ConfigError
-        Unknown experiment or method (listing the valid ones), bad --runs/--scenes/--jobs/
-        --seed/--param, or an unreachable scheduler (within 10 s, naming the address).
+        Unknown experiment, method or swept value (listing the valid ones), bad
+        --runs/--scenes/--jobs/--seed/--param, or an unreachable scheduler (within 10 s,
+        naming the address).
     """
     from scenegen.errors import ConfigError
     from scenegen.lab.experiments import get, run_experiment
@@ -89,8 +93,8 @@ def cmd_experiment(args: argparse.Namespace) -> int:
     if args.name == "all":
         from scenegen.lab.report import run_all
 
-        if args.method:
-            raise ConfigError("--method cannot be used with `experiment all`")
+        if args.method or args.value:
+            raise ConfigError("--method and --value cannot be used with `experiment all`")
         if args.param:
             raise ConfigError("--param cannot be used with `experiment all`")
         index = run_all(args.output, runs=args.runs, scenes=args.scenes, jobs=args.jobs,
@@ -109,6 +113,7 @@ def cmd_experiment(args: argparse.Namespace) -> int:
         seed=args.seed,
         quick=args.quick,
         methods=args.method,
+        values=args.value,
         progress=sys.stderr.isatty(),
         overrides=parse_overrides(args.param),
     )

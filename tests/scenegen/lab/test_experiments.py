@@ -185,6 +185,9 @@ def test_sweep_values_can_be_restricted(tmp_path):
     assert {t.value for t in tasks} == {30.0} and len(tasks) == 9 * 2
     with pytest.raises(ConfigError, match="valid values: 20, 30, 40, 50"):
         plan_tasks(get("dps-synthetic"), runs=2, seed=0, quick=False, values=[25])
+    # The CLI's --value reaches the same restriction (checked before any run starts).
+    with pytest.raises(ConfigError, match="valid values: 20, 30, 40, 50"):
+        _cli(["experiment", NAME, "--value", "25", "--jobs", "1", "-o", str(tmp_path)])
 
 
 @pytest.mark.slow
@@ -281,6 +284,7 @@ def test_experiment_all_writes_one_report(tmp_path, monkeypatch, capsys):
     doc = json.loads((tmp_path / "results.json").read_text())
     assert doc["experiments"]["shm-depth"]["scenes"] == 1
     assert main(["experiment", "all", "--method", "kalman", "-o", str(tmp_path)]) == 2
+    assert main(["experiment", "all", "--value", "20", "-o", str(tmp_path)]) == 2
 
 
 def test_dps_limitation_pools_the_orderings_the_paper_puts_above_dps():

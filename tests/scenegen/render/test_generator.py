@@ -256,6 +256,23 @@ def test_dps_distractor_starts_on_object1():
     assert seq.gt.depth[3, d] == 0
 
 
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_dps_distractor_overlaps_object1_for_a_few_frames(seed):
+    # The preset's docstring (issue 14) relies on this: the distractor's box meets object
+    # 1's for 2-6 frames from frame 3 (longer than one frame, so a track can be pulled
+    # along), then they are apart until it vanishes at frame 9.
+    seq = scenegen.generate("dps-synthetic", seed=seed)
+    d, o = seq.entities.index_of("distractor1"), seq.entities.index_of("object1")
+    bd, bo = np.asarray(seq.gt.box[:, d], float), np.asarray(seq.gt.box[:, o], float)
+    w = np.minimum(bd[:, 0] + bd[:, 2], bo[:, 0] + bo[:, 2]) - np.maximum(bd[:, 0], bo[:, 0])
+    h = np.minimum(bd[:, 1] + bd[:, 3], bo[:, 1] + bo[:, 3]) - np.maximum(bd[:, 1], bo[:, 1])
+    meet = np.nan_to_num(w) > 0
+    meet &= np.nan_to_num(h) > 0
+    frames = np.flatnonzero(meet)
+    assert 2 <= frames.size <= 6
+    assert frames[0] == 3 and np.all(np.diff(frames) == 1)
+
+
 def test_dps_occlusion_has_total_occlusion():
     seq = scenegen.generate("dps-occlusion", seed=0)
     walker = seq.entities.index_of("walker")
