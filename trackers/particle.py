@@ -49,9 +49,22 @@ from numpy.typing import NDArray
 
 from trackers.base import Estimate, Tracker
 from trackers.filters.diagnostics import effective_dynamics, uniqueness
-from trackers.filters.resampling import RESAMPLERS, resample, weighted_resample_groups
+from trackers.filters.resampling import (
+    RESAMPLE_MODES,
+    RESAMPLERS,
+    resample,
+    weighted_resample_groups,
+)
 from trackers.filters.weights import log_sum_exp_groups, normalised_weights
 from trackers.kernels.histogram import DEFAULT_BOX_LEVELS, KERNELS
+from trackers.kernels.sampling import SYSTEMATIC, count_distinct
+from trackers.kernels.stages import (
+    propagate_objects,
+    stage_log_weights,
+    state_boxes,
+    weighted_mean_states,
+    weighted_resample_gather,
+)
 from trackers.models.dynamics import AR2, boxes_from_states, states_from_boxes
 from trackers.models.observation import (
     MODELS,
@@ -262,6 +275,17 @@ class _ParticleTracker(Tracker):
         out.update(extras or {})
         return Estimate(boxes=boxes_from_states(mean_state, self._sizes), extras=out)
 
+    def _estimate_shared(self, weights: NDArray[np.float64]) -> Estimate:
+        """``_estimate`` for weights (N,) shared by every object, the mean and the
+        variance of the diagnostics in one compiled pass (``weighted_mean_states``)."""
+        mean_state, var = weighted_mean_states(weights, self.particles)
+        sig2 = self.dynamics._sigma ** 2
+        with np.errstate(divide="ignore", invalid="ignore"):
+            eff = np.where(sig2 > 0, var / np.where(sig2 > 0, sig2, 1.0), np.nan)
+        out = {"uniqueness": count_distinct(self.particles) / self.particles.shape[0],
+               "effective_dynamics": eff[:, :2].mean(axis=1)}
+        return Estimate(boxes=boxes_from_states(mean_state, self._sizes), extras=out)
+
 
 class Condensation(_ParticleTracker):
     """Condensation (Isard & Blake 1998): one independent filter of N particles per target.
@@ -337,34 +361,51 @@ class _Partitioned(_ParticleTracker):
     def _partitioned_step(self, frame: NDArray[np.uint8]) -> tuple[Estimate, NDArray]:
         obs: FrameLikelihood = self.model.observe(frame)
         n, m = self.params.n_particles, self.n_targets
-        idx = resample(self.weights, method=self.params.resampler, rng=self.rng)
+        method = self.params.resampler
+        idx = resample(self.weights, method=method, rng=self.rng)
         x, prev, sizes, orderings = self._groups(self.particles[idx], self._prev[idx])
+        x = np.ascontiguousarray(x, dtype=np.float64)
+        prev = np.ascontiguousarray(prev, dtype=np.float64)
         group = np.repeat(np.arange(sizes.size), sizes)
-        rows = np.arange(n)
+        # objects[j, r]: the object particle r moves at stage j (its group's ordering).
+        objects = np.ascontiguousarray(orderings[group].T, dtype=np.int64)
+        mode = RESAMPLE_MODES.get(method)
+        dyn = self.dynamics
         logpi = np.zeros(n)
         ll = np.zeros((n, m))
         log_g = np.zeros(n)
         for j in range(m):
-            obj = orderings[group, j]
-            cur = x[rows, obj]
-            new = self.dynamics.propagate(cur, prev[rows, obj], self._mean[obj], rng=self.rng)
-            prev[rows, obj] = cur
-            x[rows, obj] = new
-            stage = obs.log_likelihoods(self._boxes(new, obj), obj)
-            ll[rows, obj] = stage
-            if j < m - 1:
-                # Weighted resampling (DPS §3) inside each group with the weighting function
-                # g_j = Π_{i<=j} p(Z | X_{o_i}) of the objects placed so far. The carried
-                # weights are π ∝ 1 / g_{j-1}, so ancestors are drawn ∝ p(Z | X_{o_j}) and
-                # the particles stay concentrated where every placed object is likely;
-                # weighting by p(Z | X_{o_j}) alone would undo the earlier stages.
-                # Constant factors of π and g cancel: scale by the largest for range.
-                log_g += stage
-                k, w = weighted_resample_groups(
-                    np.exp(logpi - logpi.max()), np.exp(log_g - log_g.max()), sizes,
-                    method=self.params.resampler, rng=self.rng)
+            obj = objects[j]
+            # AR2 for every particle's stage object (draws the (N, 3) normals of
+            # ``AR2.propagate``), in place, then the boxes and their likelihoods.
+            noise = self.rng.standard_normal((n, 3))
+            new = propagate_objects(x, prev, obj, noise, self._mean, dyn._sigma, dyn.a1, dyn.a2)
+            boxes = state_boxes(new, np.exp(new[:, 2]), self._sizes, obj)
+            stage = np.ascontiguousarray(obs.log_likelihoods(boxes, obj), dtype=np.float64)
+            if j == m - 1:
+                ll[np.arange(n), obj] = stage
+                break
+            # Weighted resampling (DPS §3) inside each group with the weighting function
+            # g_j = Π_{i<=j} p(Z | X_{o_i}) of the objects placed so far. The carried
+            # weights are π ∝ 1 / g_{j-1}, so ancestors are drawn ∝ p(Z | X_{o_j}) and
+            # the particles stay concentrated where every placed object is likely;
+            # weighting by p(Z | X_{o_j}) alone would undo the earlier stages.
+            # Constant factors of π and g cancel: scale by the largest for range.
+            shifted, finite = stage_log_weights(stage, ll, log_g, logpi, obj)
+            pi_g = np.exp(shifted)
+            out = None
+            if mode is not None and finite:
+                uniforms = self.rng.random(sizes.size if mode == SYSTEMATIC else n)
+                out = weighted_resample_gather(pi_g[0], pi_g[1], sizes, uniforms, mode,
+                                               x, prev, ll, log_g)
+            if out is None:
+                # Residual resampling, or weights the checked path rejects (it raises).
+                k, w = weighted_resample_groups(pi_g[0], pi_g[1], sizes, method=method,
+                                                rng=self.rng)
                 x, prev, ll, log_g = x[k], prev[k], ll[k], log_g[k]
-                logpi = np.log(w)
+            else:
+                w, _, x, prev, ll, log_g = out
+            logpi = np.log(w)
         # The set {x, π'} still represents the predicted joint state (weighted resampling
         # preserves it), so π' Π_i p(Z | X_i) are the unnormalised posterior weights w̃.
         logw = logpi + ll.sum(axis=1)
@@ -372,7 +413,7 @@ class _Partitioned(_ParticleTracker):
         self.particles = x
         self._prev = prev
         self.weights = weights
-        est = self._estimate(np.repeat(weights[:, None], m, axis=1))
+        est = self._estimate_shared(weights)
         return est, mixture
 
     @staticmethod

@@ -31,6 +31,7 @@ from trackers.kernels.sampling import MULTINOMIAL, STRATIFIED, SYSTEMATIC, inver
 
 __all__ = [
     "RESAMPLERS",
+    "RESAMPLE_MODES",
     "group_starts",
     "resample",
     "resample_groups",
@@ -47,6 +48,10 @@ _MODES: dict[str, int] = {
     "systematic": SYSTEMATIC,
 }
 
+
+#: The inverse-CDF resamplers' kernel modes (``trackers.kernels.sampling``), by name; the
+#: compiled stages of the particle filters draw their uniforms as ``_draw`` does.
+RESAMPLE_MODES: dict[str, int] = dict(_MODES)
 
 #: Resampler names (``resampler`` parameter of the particle trackers).
 RESAMPLERS: tuple[str, ...] = ("multinomial", "systematic", "stratified", "residual")
