@@ -55,15 +55,17 @@ from trackers.filters.resampling import (
     resample,
     weighted_resample_groups,
 )
-from trackers.filters.weights import log_sum_exp_groups, normalised_weights
+from trackers.filters.weights import normalised_weights
 from trackers.kernels.histogram import DEFAULT_BOX_LEVELS, KERNELS
 from trackers.kernels.sampling import SYSTEMATIC, count_distinct
 from trackers.kernels.stages import (
+    effective_uv,
     propagate_objects,
+    reassemble,
+    resample_propagate,
     stage_log_weights,
     state_boxes,
     weighted_mean_states,
-    weighted_resample_gather,
 )
 from trackers.models.dynamics import AR2, boxes_from_states, states_from_boxes
 from trackers.models.observation import (
@@ -259,6 +261,7 @@ class _ParticleTracker(Tracker):
         self.particles = np.repeat(states[None], n, axis=0)
         self._prev = self.particles.copy()
         self.weights = np.full(n, 1.0 / n)
+        self._objects = np.arange(boxes.shape[0])
 
     def _boxes(self, states: NDArray[np.float64], objects: NDArray[np.int64]
                ) -> NDArray[np.float64]:
@@ -279,12 +282,10 @@ class _ParticleTracker(Tracker):
         """``_estimate`` for weights (N,) shared by every object, the mean and the
         variance of the diagnostics in one compiled pass (``weighted_mean_states``)."""
         mean_state, var = weighted_mean_states(weights, self.particles)
-        sig2 = self.dynamics._sigma ** 2
-        with np.errstate(divide="ignore", invalid="ignore"):
-            eff = np.where(sig2 > 0, var / np.where(sig2 > 0, sig2, 1.0), np.nan)
         out = {"uniqueness": count_distinct(self.particles) / self.particles.shape[0],
-               "effective_dynamics": eff[:, :2].mean(axis=1)}
-        return Estimate(boxes=boxes_from_states(mean_state, self._sizes), extras=out)
+               "effective_dynamics": effective_uv(var, self.dynamics._sigma)}
+        boxes = state_boxes(mean_state, np.exp(mean_state[:, 2]), self._sizes, self._objects)
+        return Estimate(boxes=boxes, extras=out)
 
 
 class Condensation(_ParticleTracker):
@@ -374,12 +375,12 @@ class _Partitioned(_ParticleTracker):
         logpi = np.zeros(n)
         ll = np.zeros((n, m))
         log_g = np.zeros(n)
+        # Stage 0's AR2 (the (N, 3) normals of ``AR2.propagate``); every later stage's
+        # comes with the previous stage's weighted resampling, in one kernel call.
+        new = propagate_objects(x, prev, objects[0], self.rng.standard_normal((n, 3)),
+                                self._mean, dyn._sigma, dyn.a1, dyn.a2)
         for j in range(m):
             obj = objects[j]
-            # AR2 for every particle's stage object (draws the (N, 3) normals of
-            # ``AR2.propagate``), in place, then the boxes and their likelihoods.
-            noise = self.rng.standard_normal((n, 3))
-            new = propagate_objects(x, prev, obj, noise, self._mean, dyn._sigma, dyn.a1, dyn.a2)
             boxes = state_boxes(new, np.exp(new[:, 2]), self._sizes, obj)
             stage = np.ascontiguousarray(obs.log_likelihoods(boxes, obj), dtype=np.float64)
             if j == m - 1:
@@ -396,15 +397,21 @@ class _Partitioned(_ParticleTracker):
             out = None
             if mode is not None and finite:
                 uniforms = self.rng.random(sizes.size if mode == SYSTEMATIC else n)
-                out = weighted_resample_gather(pi_g[0], pi_g[1], sizes, uniforms, mode,
-                                               x, prev, ll, log_g)
+                # The next stage's normals come after the uniforms, as in the numpy step.
+                noise = self.rng.standard_normal((n, 3))
+                out = resample_propagate(pi_g[0], pi_g[1], sizes, uniforms, mode, x, prev,
+                                         ll, log_g, objects[j + 1], noise, self._mean,
+                                         dyn._sigma, dyn.a1, dyn.a2)
             if out is None:
                 # Residual resampling, or weights the checked path rejects (it raises).
                 k, w = weighted_resample_groups(pi_g[0], pi_g[1], sizes, method=method,
                                                 rng=self.rng)
                 x, prev, ll, log_g = x[k], prev[k], ll[k], log_g[k]
+                noise = self.rng.standard_normal((n, 3))
+                new = propagate_objects(x, prev, objects[j + 1], noise, self._mean,
+                                        dyn._sigma, dyn.a1, dyn.a2)
             else:
-                w, _, x, prev, ll, log_g = out
+                w, x, prev, ll, log_g, new = out
             logpi = np.log(w)
         # The set {x, π'} still represents the predicted joint state (weighted resampling
         # preserves it), so π' Π_i p(Z | X_i) are the unnormalised posterior weights w̃.
@@ -430,12 +437,10 @@ class _Partitioned(_ParticleTracker):
         """
         if sizes.size == 1:
             return normalised_weights(logw), np.ones(1)
-        starts = np.cumsum(sizes) - sizes
-        log_total = log_sum_exp_groups(logw, starts, sizes)
-        log_evidence = log_total - log_sum_exp_groups(logpi, starts, sizes)
-        mixture = normalised_weights(np.log(sizes / sizes.sum()) + log_evidence)
-        logw_final = logw + np.repeat(np.log(mixture) - log_total, sizes)
-        return normalised_weights(logw_final), mixture
+        # log_total = LSE_c(logw), log_evidence = log_total − LSE_c(logpi), mixture =
+        # normalised(log(N_c / N) + log_evidence), weights = normalised(logw + log
+        # mixture_c − log_total_c), in compiled glue between numpy's exp and log.
+        return reassemble(logw, logpi, sizes)
 
 
 class PartitionedSampling(_Partitioned):

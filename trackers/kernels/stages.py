@@ -40,10 +40,13 @@ from numpy.typing import NDArray
 from trackers.kernels.sampling import _inverse_cdf_groups
 
 __all__ = [
+    "effective_uv",
     "normalise_groups",
     "numpy_reduceat_sum",
     "numpy_sum",
     "propagate_objects",
+    "reassemble",
+    "resample_propagate",
     "stage_log_weights",
     "state_boxes",
     "weighted_mean_states",
@@ -54,42 +57,83 @@ _BLOCK = 128  # numpy's PW_BLOCKSIZE
 
 
 @njit(cache=True)
-def _pairwise(a, lo, n):
-    """numpy's pairwise summation of a[lo:lo + n] (``pairwise_sum`` in its add loop)."""
+def _pairwise_block(a, lo, n):
+    """numpy's pairwise sum of a[lo:lo + n] for n <= 128: sequential below 8, else eight
+    interleaved accumulators combined as a tree, then the remainder."""
     if n < 8:
         res = 0.0
         for i in range(lo, lo + n):
             res += a[i]
         return res
+    r0 = a[lo]
+    r1 = a[lo + 1]
+    r2 = a[lo + 2]
+    r3 = a[lo + 3]
+    r4 = a[lo + 4]
+    r5 = a[lo + 5]
+    r6 = a[lo + 6]
+    r7 = a[lo + 7]
+    i = 8
+    stop = n - n % 8
+    while i < stop:
+        r0 += a[lo + i]
+        r1 += a[lo + i + 1]
+        r2 += a[lo + i + 2]
+        r3 += a[lo + i + 3]
+        r4 += a[lo + i + 4]
+        r5 += a[lo + i + 5]
+        r6 += a[lo + i + 6]
+        r7 += a[lo + i + 7]
+        i += 8
+    res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+    while i < n:
+        res += a[lo + i]
+        i += 1
+    return res
+
+
+@njit(cache=True)
+def _pairwise(a, lo, n):
+    """numpy's pairwise summation of a[lo:lo + n] (``pairwise_sum`` of its add loop):
+    blocks of at most 128, above that the sum of the halves split at a multiple of 8.
+    The recursion runs on an explicit stack (numba's cache and recursion do not mix)."""
     if n <= _BLOCK:
-        r0 = a[lo]
-        r1 = a[lo + 1]
-        r2 = a[lo + 2]
-        r3 = a[lo + 3]
-        r4 = a[lo + 4]
-        r5 = a[lo + 5]
-        r6 = a[lo + 6]
-        r7 = a[lo + 7]
-        i = 8
-        stop = n - n % 8
-        while i < stop:
-            r0 += a[lo + i]
-            r1 += a[lo + i + 1]
-            r2 += a[lo + i + 2]
-            r3 += a[lo + i + 3]
-            r4 += a[lo + i + 4]
-            r5 += a[lo + i + 5]
-            r6 += a[lo + i + 6]
-            r7 += a[lo + i + 7]
-            i += 8
-        res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
-        while i < n:
-            res += a[lo + i]
-            i += 1
-        return res
-    n2 = n // 2
-    n2 -= n2 % 8
-    return _pairwise(a, lo, n2) + _pairwise(a, lo + n2, n - n2)
+        return _pairwise_block(a, lo, n)
+    f_lo = np.empty(64, dtype=np.int64)
+    f_n = np.empty(64, dtype=np.int64)
+    f_state = np.empty(64, dtype=np.int64)
+    vals = np.empty(64)
+    top = 0
+    vtop = 0
+    f_lo[0] = lo
+    f_n[0] = n
+    f_state[0] = 0
+    while top >= 0:
+        m = f_n[top]
+        if m <= _BLOCK:
+            vals[vtop] = _pairwise_block(a, f_lo[top], m)
+            vtop += 1
+            top -= 1
+            continue
+        n2 = m // 2
+        n2 -= n2 % 8
+        if f_state[top] == 0:  # first the left half
+            f_state[top] = 1
+            f_lo[top + 1] = f_lo[top]
+            f_n[top + 1] = n2
+            f_state[top + 1] = 0
+            top += 1
+        elif f_state[top] == 1:  # then the right half
+            f_state[top] = 2
+            f_lo[top + 1] = f_lo[top] + n2
+            f_n[top + 1] = m - n2
+            f_state[top + 1] = 0
+            top += 1
+        else:  # left + right
+            vals[vtop - 2] = vals[vtop - 2] + vals[vtop - 1]
+            vtop -= 1
+            top -= 1
+    return vals[0]
 
 
 @njit(cache=True)
@@ -282,15 +326,18 @@ def _weighted_resample_gather(a, b, sizes, uniforms, mode, x, prev, ll, log_g):
     for i in range(n):
         new[i] = 1.0 / b[idx[i]]
     w, _ = _normalise_groups(new, sizes)
+    k_obj = x.shape[1]
     x2 = np.empty_like(x)
     prev2 = np.empty_like(prev)
     ll2 = np.empty_like(ll)
     g2 = np.empty_like(log_g)
     for i in range(n):
         k = idx[i]
-        x2[i] = x[k]
-        prev2[i] = prev[k]
-        ll2[i] = ll[k]
+        for o in range(k_obj):
+            for c in range(3):
+                x2[i, o, c] = x[k, o, c]
+                prev2[i, o, c] = prev[k, o, c]
+            ll2[i, o] = ll[k, o]
         g2[i] = log_g[k]
     return w, idx, x2, prev2, ll2, g2
 
@@ -339,6 +386,152 @@ def weighted_resample_gather(
 
 
 @njit(cache=True)
+def _resample_propagate(a, b, sizes, uniforms, mode, x, prev, ll, log_g, obj, noise, mean,
+                        sigma, a1, a2):
+    w, idx, x2, prev2, ll2, g2 = _weighted_resample_gather(a, b, sizes, uniforms, mode, x,
+                                                           prev, ll, log_g)
+    if w.shape[0] == 0:
+        return w, x2, prev2, ll2, g2, np.empty((0, 3))
+    new = _propagate_objects(x2, prev2, obj, noise, mean, sigma, a1, a2)
+    return w, x2, prev2, ll2, g2, new
+
+
+def resample_propagate(
+    a: NDArray[np.float64],
+    b: NDArray[np.float64],
+    sizes: NDArray[np.int64],
+    uniforms: NDArray[np.float64],
+    mode: int,
+    x: NDArray[np.float64],
+    prev: NDArray[np.float64],
+    ll: NDArray[np.float64],
+    log_g: NDArray[np.float64],
+    obj: NDArray[np.int64],
+    noise: NDArray[np.float64],
+    mean: NDArray[np.float64],
+    sigma: NDArray[np.float64],
+    a1: float,
+    a2: float,
+) -> tuple[NDArray[np.float64], ...] | None:
+    """``weighted_resample_gather`` then ``propagate_objects`` of the next stage, one call.
+
+    The arguments are those of the two functions (``noise`` (N, 3) the next stage's
+    normals, drawn after ``uniforms``; ``obj`` (N,) its objects). Returns (new weights
+    (N,), x, prev, ll, log_g gathered, with x and prev propagated, and the new states
+    (N, 3) of the stage's objects), or None where ``weighted_resample_gather`` is None.
+    """
+    out = _resample_propagate(a, b, sizes, uniforms, int(mode), x, prev, ll, log_g, obj,
+                              noise, mean, sigma, float(a1), float(a2))
+    return None if out[0].shape[0] == 0 else out
+
+
+@njit(cache=True)
+def _group_max_shift(x, sizes):
+    """x minus its group's maximum (``x − np.repeat(np.maximum.reduceat(x), sizes)``) and
+    the maxima (C,)."""
+    out = np.empty(x.shape[0])
+    top = np.empty(sizes.shape[0])
+    start = 0
+    for g in range(sizes.shape[0]):
+        m = x[start]
+        for i in range(start + 1, start + sizes[g]):
+            m = max(m, x[i])
+        top[g] = m
+        for i in range(start, start + sizes[g]):
+            out[i] = x[i] - m
+        start += sizes[g]
+    return out, top
+
+
+@njit(cache=True)
+def _reassemble_shift(logw, logpi, sizes):
+    n = logw.shape[0]
+    shifted = np.empty((2, n))
+    sw, top_w = _group_max_shift(logw, sizes)
+    sp, top_p = _group_max_shift(logpi, sizes)
+    shifted[0] = sw
+    shifted[1] = sp
+    return shifted, top_w, top_p
+
+
+@njit(cache=True)
+def _reassemble_sums(e, sizes):
+    c = sizes.shape[0]
+    sums = np.empty((2, c))
+    start = 0
+    for g in range(c):
+        sums[0, g] = _numpy_reduceat_sum(e[0], start, sizes[g])
+        sums[1, g] = _numpy_reduceat_sum(e[1], start, sizes[g])
+        start += sizes[g]
+    return sums
+
+
+@njit(cache=True)
+def _max_shift(x):
+    m = x[0]
+    for i in range(1, x.shape[0]):
+        m = max(m, x[i])
+    out = np.empty(x.shape[0])
+    for i in range(x.shape[0]):
+        out[i] = x[i] - m
+    return out
+
+
+@njit(cache=True)
+def _divide_by_sum(e):
+    total = _numpy_sum(e, 0, e.shape[0])
+    return e / total
+
+
+@njit(cache=True)
+def _final_log_weights(logw, log_mixture, log_total, sizes):
+    out = np.empty(logw.shape[0])
+    start = 0
+    for g in range(sizes.shape[0]):
+        shift = log_mixture[g] - log_total[g]
+        for i in range(start, start + sizes[g]):
+            out[i] = logw[i] + shift
+        start += sizes[g]
+    return _max_shift(out)
+
+
+def reassemble(logw: NDArray[np.float64], logpi: NDArray[np.float64],
+               sizes: NDArray[np.int64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The DPS mixture reassembly (``_Partitioned._reassemble``) with compiled glue.
+
+    Parameters
+    ----------
+    logw, logpi : ndarray of shape (N,)
+        log w̃ and log π' of every particle.
+    sizes : ndarray of shape (C,), int64, C >= 2
+        Group lengths.
+
+    Returns
+    -------
+    weights : ndarray of shape (N,)
+        The posterior weights, summing to 1.
+    mixture : ndarray of shape (C,)
+        The mixture weights π_c,t.
+
+    Notes
+    -----
+    The numpy expression it replaces: log_total = LSE_c(logw), log_evidence = log_total −
+    LSE_c(logpi) (``log_sum_exp_groups``), mixture = normalised(log(N_c / N) +
+    log_evidence), weights = normalised(logw + log mixture_c − log_total_c); the exp and
+    log calls are numpy's, the rest compiled, in the same order.
+    """
+    logw = np.ascontiguousarray(logw, dtype=np.float64)
+    logpi = np.ascontiguousarray(logpi, dtype=np.float64)
+    shifted, top_w, top_p = _reassemble_shift(logw, logpi, sizes)
+    logs = np.log(_reassemble_sums(np.exp(shifted), sizes))
+    log_total = top_w + logs[0]
+    log_evidence = log_total - (top_p + logs[1])
+    mixture = _divide_by_sum(np.exp(_max_shift(np.log(sizes / sizes.sum()) + log_evidence)))
+    final = np.exp(_final_log_weights(logw, np.log(mixture), log_total, sizes))
+    return _divide_by_sum(final), mixture
+
+
+@njit(cache=True)
 def _weighted_mean_states(weights, particles):
     n, k = particles.shape[0], particles.shape[1]
     mean = np.zeros((k, 3))
@@ -357,6 +550,25 @@ def _weighted_mean_states(weights, particles):
                 d = particles[r, o, c] - avg[o, c]
                 var[o, c] += d * d
     return mean, var / n
+
+
+@njit(cache=True)
+def _effective_uv(var, sig2):
+    k = var.shape[0]
+    out = np.empty(k)
+    for o in range(k):
+        e = np.empty(2)
+        for c in range(2):
+            e[c] = var[o, c] / sig2[c] if sig2[c] > 0 else np.nan
+        out[o] = (e[0] + e[1]) / 2
+    return out
+
+
+def effective_uv(var: NDArray[np.float64], sigma: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Mean over (u, v) of the effective dynamics var / σ² (NaN where σ = 0), shape (K,),
+    from the variances ``var`` (K, 3) and σ (3,) (``effective_dynamics(...)[:, :2]
+    .mean(axis=1)``)."""
+    return _effective_uv(var, np.asarray(sigma, dtype=np.float64) ** 2)
 
 
 def weighted_mean_states(weights: NDArray[np.float64], particles: NDArray[np.float64]
