@@ -60,6 +60,7 @@ from trackers.kernels.histogram import DEFAULT_BOX_LEVELS, KERNELS
 from trackers.kernels.sampling import SYSTEMATIC, count_distinct
 from trackers.kernels.stages import (
     effective_uv,
+    gather_pair,
     propagate_objects,
     reassemble,
     resample_propagate,
@@ -353,20 +354,18 @@ class _Partitioned(_ParticleTracker):
     """The partitioned-sampling step shared by PS (one group) and DPS (several)."""
 
     @abstractmethod
-    def _groups(self, x: NDArray[np.float64], prev: NDArray[np.float64]
-                ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64],
-                           NDArray[np.int64]]:
-        """Split the resampled set into groups: (x, prev) reordered so that the groups
-        are contiguous, the group sizes (C,) and each group's ordering (C, M)."""
+    def _groups(self, idx: NDArray[np.int64]
+                ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
+        """Split the resampled set (ancestors ``idx`` (N,)) into groups: the ancestors
+        reordered so that the groups are contiguous, the group sizes (C,) and each
+        group's ordering (C, M)."""
 
     def _partitioned_step(self, frame: NDArray[np.uint8]) -> tuple[Estimate, NDArray]:
         obs: FrameLikelihood = self.model.observe(frame)
         n, m = self.params.n_particles, self.n_targets
         method = self.params.resampler
-        idx = resample(self.weights, method=method, rng=self.rng)
-        x, prev, sizes, orderings = self._groups(self.particles[idx], self._prev[idx])
-        x = np.ascontiguousarray(x, dtype=np.float64)
-        prev = np.ascontiguousarray(prev, dtype=np.float64)
+        idx, sizes, orderings = self._groups(resample(self.weights, method=method, rng=self.rng))
+        x, prev = gather_pair(self.particles, self._prev, idx)
         group = np.repeat(np.arange(sizes.size), sizes)
         # objects[j, r]: the object particle r moves at stage j (its group's ordering).
         objects = np.ascontiguousarray(orderings[group].T, dtype=np.int64)
@@ -440,7 +439,7 @@ class _Partitioned(_ParticleTracker):
         # log_total = LSE_c(logw), log_evidence = log_total − LSE_c(logpi), mixture =
         # normalised(log(N_c / N) + log_evidence), weights = normalised(logw + log
         # mixture_c − log_total_c), in compiled glue between numpy's exp and log.
-        return reassemble(logw, logpi, sizes)
+        return reassemble(logw, logpi, sizes, np.log(sizes / sizes.sum()))
 
 
 class PartitionedSampling(_Partitioned):
@@ -466,10 +465,11 @@ class PartitionedSampling(_Partitioned):
                                  f"targets, got {self.params.ordering}")
             order = circular_shift(k, int(self.params.ordering))
         self._order = order[None, :]
+        self._sizes_c = np.array([self.params.n_particles])
         super()._init(frame, boxes)
 
-    def _groups(self, x, prev):
-        return x, prev, np.array([self.params.n_particles]), self._order
+    def _groups(self, idx):
+        return idx, self._sizes_c, self._order
 
     def _step(self, frame: NDArray[np.uint8]) -> Estimate:
         est, _ = self._partitioned_step(frame)
@@ -510,14 +510,14 @@ class DistributedPartitionedSampling(_Partitioned):
             self._interleave = np.concatenate([np.arange(i, n, c) for i in range(c)])
         super()._init(frame, boxes)
 
-    def _groups(self, x, prev):
+    def _groups(self, idx):
         if self._sizes_c.size > 1:
             if self.params.assignment == "random":
                 order = self.rng.permutation(self.params.n_particles)
             else:
                 order = self._interleave
-            x, prev = x[order], prev[order]
-        return x, prev, self._sizes_c, self._orders
+            idx = idx[order]
+        return idx, self._sizes_c, self._orders
 
     def _step(self, frame: NDArray[np.uint8]) -> Estimate:
         est, mixture = self._partitioned_step(frame)

@@ -28,6 +28,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from trackers.kernels.sampling import MULTINOMIAL, STRATIFIED, SYSTEMATIC, inverse_cdf_groups
+from trackers.kernels.stages import normalise_groups_checked
 
 __all__ = [
     "RESAMPLERS",
@@ -87,6 +88,12 @@ def _checked_weights(weights, name):
 
 
 def _normalise_groups(weights, sizes, name):
+    if (isinstance(weights, np.ndarray) and weights.dtype == np.float64 and weights.ndim == 1
+            and weights.size and weights.flags.c_contiguous):
+        # Compiled: the same checks and the same division by np.add.reduceat, to the bit.
+        out, ok = normalise_groups_checked(weights, sizes)
+        if ok:
+            return out
     w = _checked_weights(weights, name)
     totals = np.add.reduceat(w, group_starts(sizes))
     if totals.min() <= 0:

@@ -41,7 +41,9 @@ from trackers.kernels.sampling import _inverse_cdf_groups
 
 __all__ = [
     "effective_uv",
+    "gather_pair",
     "normalise_groups",
+    "normalise_groups_checked",
     "numpy_reduceat_sum",
     "numpy_sum",
     "propagate_objects",
@@ -305,11 +307,54 @@ def normalise_groups(w: NDArray[np.float64], sizes: NDArray[np.int64]
 
 
 @njit(cache=True)
+def _normalise_groups_checked(w, sizes):
+    # The checks of ``trackers.filters.resampling``: finite, non-negative, a finite total
+    # (numpy's sum) and a positive sum per group; False sends the caller to the checked
+    # numpy path, which raises.
+    if not (_valid(w) and np.isfinite(_numpy_sum(w, 0, w.shape[0]))):
+        return np.empty(0), False
+    return _normalise_groups(w, sizes)
+
+
+def normalise_groups_checked(w: NDArray[np.float64], sizes: NDArray[np.int64]
+                             ) -> tuple[NDArray[np.float64], bool]:
+    """``normalise_groups`` for C-contiguous float64 weights (N,), also False unless every
+    weight is finite and >= 0 and their sum finite."""
+    return _normalise_groups_checked(w, sizes)
+
+
+@njit(cache=True)
 def _valid(a):
     for i in range(a.shape[0]):
         if not (a[i] >= 0.0 and a[i] < np.inf):
             return False
     return True
+
+
+@njit(cache=True)
+def _gather_pair(x, prev, idx):
+    n = idx.shape[0]
+    m = x.shape[1] * x.shape[2]
+    xf = x.reshape(x.shape[0], m)
+    pf = prev.reshape(prev.shape[0], m)
+    x2 = np.empty((n, m))
+    p2 = np.empty((n, m))
+    for i in range(n):
+        k = idx[i]
+        for c in range(m):
+            x2[i, c] = xf[k, c]
+        for c in range(m):
+            p2[i, c] = pf[k, c]
+    return x2.reshape((n, x.shape[1], x.shape[2])), p2.reshape((n, x.shape[1], x.shape[2]))
+
+
+def gather_pair(x: NDArray[np.float64], prev: NDArray[np.float64], idx: NDArray[np.int64]
+                ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """``x[idx]``, ``prev[idx]`` of two (N, K, D) arrays by ancestors ``idx`` (P,), as new
+    C-contiguous float64 arrays (P, K, D)."""
+    return _gather_pair(np.ascontiguousarray(x, dtype=np.float64),
+                        np.ascontiguousarray(prev, dtype=np.float64),
+                        np.ascontiguousarray(idx, dtype=np.int64))
 
 
 @njit(cache=True)
@@ -326,17 +371,13 @@ def _weighted_resample_gather(a, b, sizes, uniforms, mode, x, prev, ll, log_g):
     for i in range(n):
         new[i] = 1.0 / b[idx[i]]
     w, _ = _normalise_groups(new, sizes)
-    k_obj = x.shape[1]
-    x2 = np.empty_like(x)
-    prev2 = np.empty_like(prev)
+    x2, prev2 = _gather_pair(x, prev, idx)
+    m = ll.shape[1]
     ll2 = np.empty_like(ll)
     g2 = np.empty_like(log_g)
     for i in range(n):
         k = idx[i]
-        for o in range(k_obj):
-            for c in range(3):
-                x2[i, o, c] = x[k, o, c]
-                prev2[i, o, c] = prev[k, o, c]
+        for o in range(m):
             ll2[i, o] = ll[k, o]
         g2[i] = log_g[k]
     return w, idx, x2, prev2, ll2, g2
@@ -496,7 +537,8 @@ def _final_log_weights(logw, log_mixture, log_total, sizes):
 
 
 def reassemble(logw: NDArray[np.float64], logpi: NDArray[np.float64],
-               sizes: NDArray[np.int64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+               sizes: NDArray[np.int64], log_prior: NDArray[np.float64] | None = None
+               ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """The DPS mixture reassembly (``_Partitioned._reassemble``) with compiled glue.
 
     Parameters
@@ -505,6 +547,8 @@ def reassemble(logw: NDArray[np.float64], logpi: NDArray[np.float64],
         log w̃ and log π' of every particle.
     sizes : ndarray of shape (C,), int64, C >= 2
         Group lengths.
+    log_prior : ndarray of shape (C,), optional
+        log(N_c / N), ``np.log(sizes / sizes.sum())`` (computed here if None).
 
     Returns
     -------
@@ -526,7 +570,9 @@ def reassemble(logw: NDArray[np.float64], logpi: NDArray[np.float64],
     logs = np.log(_reassemble_sums(np.exp(shifted), sizes))
     log_total = top_w + logs[0]
     log_evidence = log_total - (top_p + logs[1])
-    mixture = _divide_by_sum(np.exp(_max_shift(np.log(sizes / sizes.sum()) + log_evidence)))
+    if log_prior is None:
+        log_prior = np.log(sizes / sizes.sum())
+    mixture = _divide_by_sum(np.exp(_max_shift(log_prior + log_evidence)))
     final = np.exp(_final_log_weights(logw, np.log(mixture), log_total, sizes))
     return _divide_by_sum(final), mixture
 
