@@ -112,43 +112,37 @@ def _count_distinct(particles):
     # row equals it in every component (==); a row with a NaN equals no row, so it is
     # always new and is not stored.
     n, k = particles.shape[0], particles.shape[1]
+    values = particles + 0.0  # −0.0 + 0.0 is 0.0
+    bits = values.view(np.int64)
     out = np.zeros(k, dtype=np.int64)
     size = 16
     while size < 2 * n:
         size *= 2
-    mask = size - 1
+    mask = np.uint64(size - 1)
     table = np.empty(size, dtype=np.int64)
-    keys = np.empty((n, 3))
-    bits = np.empty(3, dtype=np.int64)
     for obj in range(k):
         table[:] = -1
-        stored = 0
         for i in range(n):
-            u = particles[i, obj, 0] + 0.0
-            v = particles[i, obj, 1] + 0.0
-            a = particles[i, obj, 2] + 0.0
+            u = values[i, obj, 0]
+            v = values[i, obj, 1]
+            a = values[i, obj, 2]
             if u != u or v != v or a != a:
                 out[obj] += 1
                 continue
-            keys[stored, 0] = u
-            keys[stored, 1] = v
-            keys[stored, 2] = a
-            bits[:] = keys[stored].view(np.int64)
             h = np.uint64(1469598103934665603)
             for c in range(3):
-                h = (h ^ np.uint64(bits[c])) * np.uint64(1099511628211)
+                h = (h ^ np.uint64(bits[i, obj, c])) * np.uint64(1099511628211)
                 h ^= h >> np.uint64(29)
-            slot = np.int64(h & np.uint64(mask))
+            slot = h & mask
             while True:
                 j = table[slot]
                 if j < 0:
-                    table[slot] = stored
-                    stored += 1
+                    table[slot] = i
                     out[obj] += 1
                     break
-                if keys[j, 0] == u and keys[j, 1] == v and keys[j, 2] == a:
+                if values[j, obj, 0] == u and values[j, obj, 1] == v and values[j, obj, 2] == a:
                     break
-                slot = (slot + 1) & mask
+                slot = (slot + np.uint64(1)) & mask
     return out
 
 
