@@ -48,11 +48,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from trackers.base import Estimate, Tracker
-from trackers.filters.diagnostics import effective_dynamics, uniqueness
 from trackers.filters.resampling import (
     RESAMPLE_MODES,
     RESAMPLERS,
     resample,
+    resample_groups,
     weighted_resample_groups,
 )
 from trackers.filters.weights import normalised_weights
@@ -61,9 +61,11 @@ from trackers.kernels.sampling import SYSTEMATIC, count_distinct
 from trackers.kernels.stages import (
     effective_uv,
     gather_pair,
+    normalise_rows,
     propagate_objects,
     reassemble,
     resample_propagate,
+    row_max_shift,
     stage_log_weights,
     state_boxes,
     weighted_mean_states,
@@ -272,21 +274,16 @@ class _ParticleTracker(Tracker):
     def _estimate(self, weights: NDArray[np.float64], extras: dict | None = None
                   ) -> Estimate:
         """Weighted mean state per object (weights (N, K)) as boxes, with diagnostics."""
-        mean_state = (weights[:, :, None] * self.particles).sum(axis=0)
-        eff = effective_dynamics(self.particles, self.dynamics.sigma)
-        out = {"uniqueness": uniqueness(self.particles),
-               "effective_dynamics": eff[:, :2].mean(axis=1)}
-        out.update(extras or {})
-        return Estimate(boxes=boxes_from_states(mean_state, self._sizes), extras=out)
-
-    def _estimate_shared(self, weights: NDArray[np.float64]) -> Estimate:
-        """``_estimate`` for weights (N,) shared by every object, the mean and the
-        variance of the diagnostics in one compiled pass (``weighted_mean_states``)."""
         mean_state, var = weighted_mean_states(weights, self.particles)
         out = {"uniqueness": count_distinct(self.particles) / self.particles.shape[0],
                "effective_dynamics": effective_uv(var, self.dynamics._sigma)}
+        out.update(extras or {})
         boxes = state_boxes(mean_state, np.exp(mean_state[:, 2]), self._sizes, self._objects)
         return Estimate(boxes=boxes, extras=out)
+
+    def _estimate_shared(self, weights: NDArray[np.float64]) -> Estimate:
+        """``_estimate`` for weights (N,) shared by every object."""
+        return self._estimate(weights[:, None])
 
 
 class Condensation(_ParticleTracker):
@@ -310,18 +307,22 @@ class Condensation(_ParticleTracker):
     def _step(self, frame: NDArray[np.uint8]) -> Estimate:
         obs = self.model.observe(frame)
         n, k = self.params.n_particles, self.n_targets
-        idx = np.column_stack([resample(self.weights[:, i], method=self.params.resampler,
-                                        rng=self.rng) for i in range(k)])
+        # Every target's filter resampled by its own column of weights: the targets as
+        # the groups of one resampling call (the same draws as one call per target, in
+        # target order), the ancestors back to rows of the target's column.
+        groups = resample_groups(np.ascontiguousarray(self.weights.T).ravel(), np.full(k, n),
+                                 method=self.params.resampler, rng=self.rng)
+        idx = (groups.reshape(k, n) - (np.arange(k) * n)[:, None]).T
         cols = np.arange(k)
         x = self.particles[idx, cols]
         prev = self._prev[idx, cols]
         new = self.dynamics.propagate(x, prev, self._mean, rng=self.rng)
         objects = np.tile(cols, n)
         ll = obs.log_likelihoods(self._boxes(new.reshape(-1, 3), objects), objects)
-        ll = ll.reshape(n, k)
         self._prev = x
         self.particles = new
-        self.weights = np.column_stack([normalised_weights(ll[:, i]) for i in range(k)])
+        # normalised_weights of each column, in compiled glue around numpy's exp.
+        self.weights = normalise_rows(np.exp(row_max_shift(ll.reshape(n, k).T))).T
         return self._estimate(self.weights)
 
 
@@ -339,15 +340,14 @@ class JointPF(_ParticleTracker):
         obs = self.model.observe(frame)
         n, k = self.params.n_particles, self.n_targets
         idx = resample(self.weights, method=self.params.resampler, rng=self.rng)
-        x = self.particles[idx]
-        prev = self._prev[idx]
+        x, prev = gather_pair(self.particles, self._prev, idx)
         new = self.dynamics.propagate(x, prev, self._mean, rng=self.rng)
         objects = np.tile(np.arange(k), n)
         ll = obs.log_likelihoods(self._boxes(new.reshape(-1, 3), objects), objects)
         self._prev = x
         self.particles = new
         self.weights = normalised_weights(ll.reshape(n, k).sum(axis=1))
-        return self._estimate(np.repeat(self.weights[:, None], k, axis=1))
+        return self._estimate_shared(self.weights)
 
 
 class _Partitioned(_ParticleTracker):

@@ -44,11 +44,13 @@ __all__ = [
     "gather_pair",
     "normalise_groups",
     "normalise_groups_checked",
+    "normalise_rows",
     "numpy_reduceat_sum",
     "numpy_sum",
     "propagate_objects",
     "reassemble",
     "resample_propagate",
+    "row_max_shift",
     "stage_log_weights",
     "state_boxes",
     "weighted_mean_states",
@@ -580,12 +582,14 @@ def reassemble(logw: NDArray[np.float64], logpi: NDArray[np.float64],
 @njit(cache=True)
 def _weighted_mean_states(weights, particles):
     n, k = particles.shape[0], particles.shape[1]
+    shared = weights.shape[1] == 1
     mean = np.zeros((k, 3))
     total = np.zeros((k, 3))
     for r in range(n):
         for o in range(k):
+            wr = weights[r, 0] if shared else weights[r, o]
             for c in range(3):
-                mean[o, c] += weights[r] * particles[r, o, c]
+                mean[o, c] += wr * particles[r, o, c]
                 total[o, c] += particles[r, o, c]
     # numpy's var: the mean Σx / N, then Σ (x − mean)² / N, sums row by row.
     avg = total / n
@@ -596,6 +600,39 @@ def _weighted_mean_states(weights, particles):
                 d = particles[r, o, c] - avg[o, c]
                 var[o, c] += d * d
     return mean, var / n
+
+
+@njit(cache=True)
+def _row_max_shift(x):
+    out = np.empty(x.shape)
+    for i in range(x.shape[0]):
+        m = x[i, 0]
+        for j in range(1, x.shape[1]):
+            m = max(m, x[i, j])
+        for j in range(x.shape[1]):
+            out[i, j] = x[i, j] - m
+    return out
+
+
+def row_max_shift(x: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Each row of x (K, N) minus its maximum, as a new C-contiguous array (K, N)."""
+    return _row_max_shift(np.asarray(x, dtype=np.float64))
+
+
+@njit(cache=True)
+def _normalise_rows(e):
+    out = np.empty(e.shape)
+    for i in range(e.shape[0]):
+        total = _numpy_sum(e[i], 0, e.shape[1])
+        for j in range(e.shape[1]):
+            out[i, j] = e[i, j] / total
+    return out
+
+
+def normalise_rows(e: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Each row of e (K, N) divided by its ``np.sum``; with ``row_max_shift`` and numpy's
+    exp between them, ``normalised_weights`` of every row."""
+    return _normalise_rows(np.ascontiguousarray(e, dtype=np.float64))
 
 
 @njit(cache=True)
@@ -619,6 +656,11 @@ def effective_uv(var: NDArray[np.float64], sigma: NDArray[np.float64]) -> NDArra
 
 def weighted_mean_states(weights: NDArray[np.float64], particles: NDArray[np.float64]
                          ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Weighted mean (K, 3) of particles (N, K, 3) under weights (N,), shared by all
-    objects, and the unweighted variance (K, 3) over the set (``particles.var(axis=0)``)."""
-    return _weighted_mean_states(weights, particles)
+    """Weighted mean (K, 3) of particles (N, K, 3) and their unweighted variance (K, 3).
+
+    ``weights`` is (N, K) (column k weights object k: ``(weights[:, :, None] *
+    particles).sum(axis=0)``) or (N, 1), one column shared by every object; the variance
+    is ``particles.var(axis=0)``.
+    """
+    return _weighted_mean_states(np.asarray(weights, dtype=np.float64),
+                                 np.ascontiguousarray(particles, dtype=np.float64))
