@@ -184,10 +184,13 @@ def test_weighted_mean_and_diagnostics_are_the_numpy_ones():
     particles = rng.normal(100, 30, (300, 7, 3))
     particles = particles[rng.integers(0, 300, 300)]
     w = normalised_weights(rng.normal(0, 3, 300))
-    mean, var = weighted_mean_states(w, particles)
+    mean, var = weighted_mean_states(w[:, None], particles)
     wk = np.repeat(w[:, None], 7, axis=1)
     assert np.array_equal(mean, (wk[:, :, None] * particles).sum(axis=0))
     assert np.array_equal(var, particles.var(axis=0))
+    wk = normalised_weights(rng.normal(0, 3, (300, 7)), axis=0)  # one column per object
+    mean, _ = weighted_mean_states(wk, particles)
+    assert np.array_equal(mean, (wk[:, :, None] * particles).sum(axis=0))
     for sigma in ([2.0, 2.0, 0.001], [0.0, 3.0, 1.0]):
         want = effective_dynamics(particles, sigma)[:, :2].mean(axis=1)
         assert np.array_equal(effective_uv(var, np.array(sigma)), want, equal_nan=True)
