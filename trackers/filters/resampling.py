@@ -71,6 +71,8 @@ def _finite_non_negative(x):
 
 
 def _check_sizes(sizes, n):
+    if sizes is None and n >= 1:
+        return np.array([n], dtype=np.int64)  # one group: nothing to check
     sizes = np.asarray([n] if sizes is None else sizes, dtype=np.int64)
     if sizes.ndim != 1 or sizes.size < 1 or sizes.min() < 1 or sizes.sum() != n:
         raise ValueError(f"group sizes must be positive and sum to {n}, got {sizes.tolist()}")
