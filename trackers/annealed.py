@@ -54,6 +54,11 @@ def survival_rate(log_w: NDArray[np.float64]) -> NDArray[np.float64]:
     return w.sum(axis=1) ** 2 / (log_w.shape[1] * (w * w).sum(axis=1))
 
 
+# The search grids of ``survival_beta`` (constants, computed once).
+_COARSE = np.logspace(-8.0, 0.0, 65)
+_FINE = np.linspace(0.0, 1.0, 65)
+
+
 def survival_beta(log_lik: NDArray[np.float64], alpha: float) -> NDArray[np.float64]:
     """Largest β in (0, 1] whose weights w^β keep a survival rate of at least ``alpha``.
 
@@ -75,9 +80,9 @@ def survival_beta(log_lik: NDArray[np.float64], alpha: float) -> NDArray[np.floa
     ndarray of shape (K,)
     """
     log_w = log_lik - log_lik.max(axis=1, keepdims=True)
-    coarse = np.broadcast_to(np.logspace(-8.0, 0.0, 65), (log_w.shape[0], 65))
+    coarse = np.broadcast_to(_COARSE, (log_w.shape[0], 65))
     lo, hi = _bracket(log_w, coarse, alpha)
-    fine = lo[:, None] + (hi - lo)[:, None] * np.linspace(0.0, 1.0, 65)
+    fine = lo[:, None] + (hi - lo)[:, None] * _FINE
     lo, _ = _bracket(log_w, fine, alpha)
     return lo
 

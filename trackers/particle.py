@@ -48,10 +48,28 @@ import numpy as np
 from numpy.typing import NDArray
 
 from trackers.base import Estimate, Tracker
-from trackers.filters.diagnostics import effective_dynamics, uniqueness
-from trackers.filters.resampling import RESAMPLERS, resample, weighted_resample_groups
-from trackers.filters.weights import log_sum_exp_groups, normalised_weights
+from trackers.filters.resampling import (
+    RESAMPLE_MODES,
+    RESAMPLERS,
+    resample,
+    resample_groups,
+    weighted_resample_groups,
+)
+from trackers.filters.weights import normalised_weights
 from trackers.kernels.histogram import DEFAULT_BOX_LEVELS, KERNELS
+from trackers.kernels.sampling import SYSTEMATIC, count_distinct
+from trackers.kernels.stages import (
+    effective_uv,
+    gather_pair,
+    normalise_rows,
+    propagate_objects,
+    reassemble,
+    resample_propagate,
+    row_max_shift,
+    stage_log_weights,
+    state_boxes,
+    weighted_mean_states,
+)
 from trackers.models.dynamics import AR2, boxes_from_states, states_from_boxes
 from trackers.models.observation import (
     MODELS,
@@ -246,6 +264,7 @@ class _ParticleTracker(Tracker):
         self.particles = np.repeat(states[None], n, axis=0)
         self._prev = self.particles.copy()
         self.weights = np.full(n, 1.0 / n)
+        self._objects = np.arange(boxes.shape[0])
 
     def _boxes(self, states: NDArray[np.float64], objects: NDArray[np.int64]
                ) -> NDArray[np.float64]:
@@ -255,12 +274,16 @@ class _ParticleTracker(Tracker):
     def _estimate(self, weights: NDArray[np.float64], extras: dict | None = None
                   ) -> Estimate:
         """Weighted mean state per object (weights (N, K)) as boxes, with diagnostics."""
-        mean_state = (weights[:, :, None] * self.particles).sum(axis=0)
-        eff = effective_dynamics(self.particles, self.dynamics.sigma)
-        out = {"uniqueness": uniqueness(self.particles),
-               "effective_dynamics": eff[:, :2].mean(axis=1)}
+        mean_state, var = weighted_mean_states(weights, self.particles)
+        out = {"uniqueness": count_distinct(self.particles) / self.particles.shape[0],
+               "effective_dynamics": effective_uv(var, self.dynamics._sigma)}
         out.update(extras or {})
-        return Estimate(boxes=boxes_from_states(mean_state, self._sizes), extras=out)
+        boxes = state_boxes(mean_state, np.exp(mean_state[:, 2]), self._sizes, self._objects)
+        return Estimate(boxes=boxes, extras=out)
+
+    def _estimate_shared(self, weights: NDArray[np.float64]) -> Estimate:
+        """``_estimate`` for weights (N,) shared by every object."""
+        return self._estimate(weights[:, None])
 
 
 class Condensation(_ParticleTracker):
@@ -284,18 +307,22 @@ class Condensation(_ParticleTracker):
     def _step(self, frame: NDArray[np.uint8]) -> Estimate:
         obs = self.model.observe(frame)
         n, k = self.params.n_particles, self.n_targets
-        idx = np.column_stack([resample(self.weights[:, i], method=self.params.resampler,
-                                        rng=self.rng) for i in range(k)])
+        # Every target's filter resampled by its own column of weights: the targets as
+        # the groups of one resampling call (the same draws as one call per target, in
+        # target order), the ancestors back to rows of the target's column.
+        groups = resample_groups(np.ascontiguousarray(self.weights.T).ravel(), np.full(k, n),
+                                 method=self.params.resampler, rng=self.rng)
+        idx = (groups.reshape(k, n) - (np.arange(k) * n)[:, None]).T
         cols = np.arange(k)
         x = self.particles[idx, cols]
         prev = self._prev[idx, cols]
         new = self.dynamics.propagate(x, prev, self._mean, rng=self.rng)
         objects = np.tile(cols, n)
         ll = obs.log_likelihoods(self._boxes(new.reshape(-1, 3), objects), objects)
-        ll = ll.reshape(n, k)
         self._prev = x
         self.particles = new
-        self.weights = np.column_stack([normalised_weights(ll[:, i]) for i in range(k)])
+        # normalised_weights of each column, in compiled glue around numpy's exp.
+        self.weights = normalise_rows(np.exp(row_max_shift(ll.reshape(n, k).T))).T
         return self._estimate(self.weights)
 
 
@@ -313,58 +340,78 @@ class JointPF(_ParticleTracker):
         obs = self.model.observe(frame)
         n, k = self.params.n_particles, self.n_targets
         idx = resample(self.weights, method=self.params.resampler, rng=self.rng)
-        x = self.particles[idx]
-        prev = self._prev[idx]
+        x, prev = gather_pair(self.particles, self._prev, idx)
         new = self.dynamics.propagate(x, prev, self._mean, rng=self.rng)
         objects = np.tile(np.arange(k), n)
         ll = obs.log_likelihoods(self._boxes(new.reshape(-1, 3), objects), objects)
         self._prev = x
         self.particles = new
         self.weights = normalised_weights(ll.reshape(n, k).sum(axis=1))
-        return self._estimate(np.repeat(self.weights[:, None], k, axis=1))
+        return self._estimate_shared(self.weights)
 
 
 class _Partitioned(_ParticleTracker):
     """The partitioned-sampling step shared by PS (one group) and DPS (several)."""
 
     @abstractmethod
-    def _groups(self, x: NDArray[np.float64], prev: NDArray[np.float64]
-                ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64],
-                           NDArray[np.int64]]:
-        """Split the resampled set into groups: (x, prev) reordered so that the groups
-        are contiguous, the group sizes (C,) and each group's ordering (C, M)."""
+    def _groups(self, idx: NDArray[np.int64]
+                ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
+        """Split the resampled set (ancestors ``idx`` (N,)) into groups: the ancestors
+        reordered so that the groups are contiguous, the group sizes (C,) and each
+        group's ordering (C, M)."""
 
     def _partitioned_step(self, frame: NDArray[np.uint8]) -> tuple[Estimate, NDArray]:
         obs: FrameLikelihood = self.model.observe(frame)
         n, m = self.params.n_particles, self.n_targets
-        idx = resample(self.weights, method=self.params.resampler, rng=self.rng)
-        x, prev, sizes, orderings = self._groups(self.particles[idx], self._prev[idx])
+        method = self.params.resampler
+        idx, sizes, orderings = self._groups(resample(self.weights, method=method, rng=self.rng))
+        x, prev = gather_pair(self.particles, self._prev, idx)
         group = np.repeat(np.arange(sizes.size), sizes)
-        rows = np.arange(n)
+        # objects[j, r]: the object particle r moves at stage j (its group's ordering).
+        objects = np.ascontiguousarray(orderings[group].T, dtype=np.int64)
+        mode = RESAMPLE_MODES.get(method)
+        dyn = self.dynamics
         logpi = np.zeros(n)
         ll = np.zeros((n, m))
         log_g = np.zeros(n)
+        # Stage 0's AR2 (the (N, 3) normals of ``AR2.propagate``); every later stage's
+        # comes with the previous stage's weighted resampling, in one kernel call.
+        new = propagate_objects(x, prev, objects[0], self.rng.standard_normal((n, 3)),
+                                self._mean, dyn._sigma, dyn.a1, dyn.a2)
         for j in range(m):
-            obj = orderings[group, j]
-            cur = x[rows, obj]
-            new = self.dynamics.propagate(cur, prev[rows, obj], self._mean[obj], rng=self.rng)
-            prev[rows, obj] = cur
-            x[rows, obj] = new
-            stage = obs.log_likelihoods(self._boxes(new, obj), obj)
-            ll[rows, obj] = stage
-            if j < m - 1:
-                # Weighted resampling (DPS §3) inside each group with the weighting function
-                # g_j = Π_{i<=j} p(Z | X_{o_i}) of the objects placed so far. The carried
-                # weights are π ∝ 1 / g_{j-1}, so ancestors are drawn ∝ p(Z | X_{o_j}) and
-                # the particles stay concentrated where every placed object is likely;
-                # weighting by p(Z | X_{o_j}) alone would undo the earlier stages.
-                # Constant factors of π and g cancel: scale by the largest for range.
-                log_g += stage
-                k, w = weighted_resample_groups(
-                    np.exp(logpi - logpi.max()), np.exp(log_g - log_g.max()), sizes,
-                    method=self.params.resampler, rng=self.rng)
+            obj = objects[j]
+            boxes = state_boxes(new, np.exp(new[:, 2]), self._sizes, obj)
+            stage = np.ascontiguousarray(obs.log_likelihoods(boxes, obj), dtype=np.float64)
+            if j == m - 1:
+                ll[np.arange(n), obj] = stage
+                break
+            # Weighted resampling (DPS §3) inside each group with the weighting function
+            # g_j = Π_{i<=j} p(Z | X_{o_i}) of the objects placed so far. The carried
+            # weights are π ∝ 1 / g_{j-1}, so ancestors are drawn ∝ p(Z | X_{o_j}) and
+            # the particles stay concentrated where every placed object is likely;
+            # weighting by p(Z | X_{o_j}) alone would undo the earlier stages.
+            # Constant factors of π and g cancel: scale by the largest for range.
+            shifted, finite = stage_log_weights(stage, ll, log_g, logpi, obj)
+            pi_g = np.exp(shifted)
+            out = None
+            if mode is not None and finite:
+                uniforms = self.rng.random(sizes.size if mode == SYSTEMATIC else n)
+                # The next stage's normals come after the uniforms, as in the numpy step.
+                noise = self.rng.standard_normal((n, 3))
+                out = resample_propagate(pi_g[0], pi_g[1], sizes, uniforms, mode, x, prev,
+                                         ll, log_g, objects[j + 1], noise, self._mean,
+                                         dyn._sigma, dyn.a1, dyn.a2)
+            if out is None:
+                # Residual resampling, or weights the checked path rejects (it raises).
+                k, w = weighted_resample_groups(pi_g[0], pi_g[1], sizes, method=method,
+                                                rng=self.rng)
                 x, prev, ll, log_g = x[k], prev[k], ll[k], log_g[k]
-                logpi = np.log(w)
+                noise = self.rng.standard_normal((n, 3))
+                new = propagate_objects(x, prev, objects[j + 1], noise, self._mean,
+                                        dyn._sigma, dyn.a1, dyn.a2)
+            else:
+                w, x, prev, ll, log_g, new = out
+            logpi = np.log(w)
         # The set {x, π'} still represents the predicted joint state (weighted resampling
         # preserves it), so π' Π_i p(Z | X_i) are the unnormalised posterior weights w̃.
         logw = logpi + ll.sum(axis=1)
@@ -372,7 +419,7 @@ class _Partitioned(_ParticleTracker):
         self.particles = x
         self._prev = prev
         self.weights = weights
-        est = self._estimate(np.repeat(weights[:, None], m, axis=1))
+        est = self._estimate_shared(weights)
         return est, mixture
 
     @staticmethod
@@ -389,12 +436,10 @@ class _Partitioned(_ParticleTracker):
         """
         if sizes.size == 1:
             return normalised_weights(logw), np.ones(1)
-        starts = np.cumsum(sizes) - sizes
-        log_total = log_sum_exp_groups(logw, starts, sizes)
-        log_evidence = log_total - log_sum_exp_groups(logpi, starts, sizes)
-        mixture = normalised_weights(np.log(sizes / sizes.sum()) + log_evidence)
-        logw_final = logw + np.repeat(np.log(mixture) - log_total, sizes)
-        return normalised_weights(logw_final), mixture
+        # log_total = LSE_c(logw), log_evidence = log_total − LSE_c(logpi), mixture =
+        # normalised(log(N_c / N) + log_evidence), weights = normalised(logw + log
+        # mixture_c − log_total_c), in compiled glue between numpy's exp and log.
+        return reassemble(logw, logpi, sizes, np.log(sizes / sizes.sum()))
 
 
 class PartitionedSampling(_Partitioned):
@@ -420,10 +465,11 @@ class PartitionedSampling(_Partitioned):
                                  f"targets, got {self.params.ordering}")
             order = circular_shift(k, int(self.params.ordering))
         self._order = order[None, :]
+        self._sizes_c = np.array([self.params.n_particles])
         super()._init(frame, boxes)
 
-    def _groups(self, x, prev):
-        return x, prev, np.array([self.params.n_particles]), self._order
+    def _groups(self, idx):
+        return idx, self._sizes_c, self._order
 
     def _step(self, frame: NDArray[np.uint8]) -> Estimate:
         est, _ = self._partitioned_step(frame)
@@ -464,14 +510,14 @@ class DistributedPartitionedSampling(_Partitioned):
             self._interleave = np.concatenate([np.arange(i, n, c) for i in range(c)])
         super()._init(frame, boxes)
 
-    def _groups(self, x, prev):
+    def _groups(self, idx):
         if self._sizes_c.size > 1:
             if self.params.assignment == "random":
                 order = self.rng.permutation(self.params.n_particles)
             else:
                 order = self._interleave
-            x, prev = x[order], prev[order]
-        return x, prev, self._sizes_c, self._orders
+            idx = idx[order]
+        return idx, self._sizes_c, self._orders
 
     def _step(self, frame: NDArray[np.uint8]) -> Estimate:
         est, mixture = self._partitioned_step(frame)

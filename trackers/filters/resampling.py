@@ -28,9 +28,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from trackers.kernels.sampling import MULTINOMIAL, STRATIFIED, SYSTEMATIC, inverse_cdf_groups
+from trackers.kernels.stages import normalise_groups_checked
 
 __all__ = [
     "RESAMPLERS",
+    "RESAMPLE_MODES",
     "group_starts",
     "resample",
     "resample_groups",
@@ -47,6 +49,10 @@ _MODES: dict[str, int] = {
     "systematic": SYSTEMATIC,
 }
 
+
+#: The inverse-CDF resamplers' kernel modes (``trackers.kernels.sampling``), by name; the
+#: compiled stages of the particle filters draw their uniforms as ``_draw`` does.
+RESAMPLE_MODES: dict[str, int] = dict(_MODES)
 
 #: Resampler names (``resampler`` parameter of the particle trackers).
 RESAMPLERS: tuple[str, ...] = ("multinomial", "systematic", "stratified", "residual")
@@ -65,6 +71,8 @@ def _finite_non_negative(x):
 
 
 def _check_sizes(sizes, n):
+    if sizes is None and n >= 1:
+        return np.array([n], dtype=np.int64)  # one group: nothing to check
     sizes = np.asarray([n] if sizes is None else sizes, dtype=np.int64)
     if sizes.ndim != 1 or sizes.size < 1 or sizes.min() < 1 or sizes.sum() != n:
         raise ValueError(f"group sizes must be positive and sum to {n}, got {sizes.tolist()}")
@@ -82,6 +90,12 @@ def _checked_weights(weights, name):
 
 
 def _normalise_groups(weights, sizes, name):
+    if (isinstance(weights, np.ndarray) and weights.dtype == np.float64 and weights.ndim == 1
+            and weights.size and weights.flags.c_contiguous):
+        # Compiled: the same checks and the same division by np.add.reduceat, to the bit.
+        out, ok = normalise_groups_checked(weights, sizes)
+        if ok:
+            return out
     w = _checked_weights(weights, name)
     totals = np.add.reduceat(w, group_starts(sizes))
     if totals.min() <= 0:

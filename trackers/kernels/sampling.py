@@ -6,7 +6,8 @@ compiled call:
 
 - ``inverse_cdf_groups``: ancestor indices of every group of a weighted set at once, from
   uniforms drawn by the caller (so randomness stays with the caller's Generator);
-- ``count_distinct``: distinct sub-states per object of a particle set.
+- ``count_distinct``: distinct sub-states per object of a particle set (a hash set per
+  object, O(N)).
 """
 
 from __future__ import annotations
@@ -106,30 +107,42 @@ def inverse_cdf_groups(
 
 @njit(cache=True)
 def _count_distinct(particles):
+    # Open-addressing hash set of the rows (u, v, a) of each object, on the bits of the
+    # values with −0.0 taken as 0.0 (they compare equal). A row is new unless an earlier
+    # row equals it in every component (==); a row with a NaN equals no row, so it is
+    # always new and is not stored.
     n, k = particles.shape[0], particles.shape[1]
+    values = particles + 0.0  # −0.0 + 0.0 is 0.0
+    bits = values.view(np.int64)
     out = np.zeros(k, dtype=np.int64)
+    size = 16
+    while size < 2 * n:
+        size *= 2
+    mask = np.uint64(size - 1)
+    table = np.empty(size, dtype=np.int64)
     for obj in range(k):
-        u = particles[:, obj, 0].copy()
-        order = np.argsort(u)
-        start = 0
-        while start < n:
-            stop = start + 1
-            while stop < n and u[order[stop]] == u[order[start]]:
-                stop += 1
-            # Inside a run of equal u, count distinct (v, a) by comparing each row with
-            # the earlier rows of the run (runs are copies of one particle in practice).
-            for i in range(start, stop):
-                a = order[i]
-                new = True
-                for j in range(start, i):
-                    b = order[j]
-                    if (particles[a, obj, 1] == particles[b, obj, 1]
-                            and particles[a, obj, 2] == particles[b, obj, 2]):
-                        new = False
-                        break
-                if new:
+        table[:] = -1
+        for i in range(n):
+            u = values[i, obj, 0]
+            v = values[i, obj, 1]
+            a = values[i, obj, 2]
+            if u != u or v != v or a != a:
+                out[obj] += 1
+                continue
+            h = np.uint64(1469598103934665603)
+            for c in range(3):
+                h = (h ^ np.uint64(bits[i, obj, c])) * np.uint64(1099511628211)
+                h ^= h >> np.uint64(29)
+            slot = h & mask
+            while True:
+                j = table[slot]
+                if j < 0:
+                    table[slot] = i
                     out[obj] += 1
-            start = stop
+                    break
+                if values[j, obj, 0] == u and values[j, obj, 1] == v and values[j, obj, 2] == a:
+                    break
+                slot = (slot + np.uint64(1)) & mask
     return out
 
 

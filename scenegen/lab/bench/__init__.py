@@ -18,6 +18,7 @@ __all__ = ["MODULES", "BenchRow", "median_time", "run_all"]
 MODULES = (
     "scenegen.lab.bench.generation",
     "scenegen.lab.bench.particle",
+    "scenegen.lab.bench.stepshare",
     "scenegen.lab.bench.meanshift",
     "scenegen.lab.bench.shm",
     "scenegen.lab.bench.reliability",

@@ -1,0 +1,311 @@
+"""The compiled stages of the particle filters equal the numpy code they replace, exactly.
+
+``trackers.kernels.stages`` promises the same floating-point results to the last bit (same
+operations in the same order, numpy's pairwise summation replicated, exp/log left to
+numpy). Each kernel is compared here with its numpy expression with ``array_equal``, and
+a PS/DPS step with a pure-numpy reference step (the partitioned-sampling step as it was
+written before it was compiled) on the same seeds: particles, weights, estimates and the
+state of the random stream all equal.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from trackers.filters.diagnostics import effective_dynamics, uniqueness
+from trackers.filters.resampling import (
+    RESAMPLE_MODES,
+    RESAMPLERS,
+    resample,
+    weighted_resample_groups,
+)
+from trackers.filters.weights import log_sum_exp_groups, normalised_weights
+from trackers.kernels.sampling import SYSTEMATIC, count_distinct
+from trackers.kernels.stages import (
+    effective_uv,
+    gather_pair,
+    normalise_groups_checked,
+    numpy_reduceat_sum,
+    numpy_sum,
+    propagate_objects,
+    reassemble,
+    resample_propagate,
+    stage_log_weights,
+    state_boxes,
+    weighted_mean_states,
+    weighted_resample_gather,
+)
+from trackers.models.dynamics import AR2, boxes_from_states
+from trackers.particle import DistributedPartitionedSampling, PartitionedSampling
+
+SIZES = [1, 2, 7, 8, 9, 15, 16, 17, 127, 128, 129, 130, 255, 256, 257, 300, 1000, 2100, 9001]
+
+
+def _values(rng, n):
+    # Wide dynamic range, so that any change of summation order shows in the last bits.
+    return rng.random(n) * rng.choice([1e-6, 1.0, 1e6], n)
+
+
+@pytest.mark.parametrize("n", SIZES)
+def test_sums_replicate_numpy_to_the_bit(n):
+    rng = np.random.default_rng(n)
+    x = _values(rng, n)
+    assert numpy_sum(x) == np.sum(x)
+    cuts = np.sort(rng.choice(np.arange(1, n), min(5, n - 1), replace=False)) if n > 1 else []
+    starts = np.concatenate([[0], cuts]).astype(np.int64)
+    sizes = np.diff(np.append(starts, n))
+    assert np.array_equal(numpy_reduceat_sum(x, sizes), np.add.reduceat(x, starts))
+
+
+def test_a_naive_sum_would_fail_the_comparison():
+    # The test above can fail: a left-to-right sum differs from numpy's in the last bit.
+    x = _values(np.random.default_rng(0), 1000)
+    naive = 0.0
+    for v in x:
+        naive += v
+    assert naive != np.sum(x) and numpy_sum(x) == np.sum(x)
+
+
+def _set(rng, n=300, k=4):
+    return (rng.normal(50, 10, (n, k, 3)), rng.normal(50, 10, (n, k, 3)),
+            rng.integers(0, k, n).astype(np.int64))
+
+
+@pytest.mark.parametrize("a1,a2", [(2.0, -1.0), (1.3, -0.45)])
+def test_propagate_objects_is_ar2_propagate(a1, a2):
+    rng = np.random.default_rng(1)
+    x, prev, obj = _set(rng)
+    mean = rng.normal(40, 5, (x.shape[1], 3))
+    dyn = AR2(sigma=(2.0, 3.0, 0.01), a1=a1, a2=a2)
+    rows = np.arange(x.shape[0])
+    ref_x, ref_prev = x.copy(), prev.copy()
+    cur = ref_x[rows, obj]
+    want = dyn.propagate(cur, ref_prev[rows, obj], mean[obj], rng=np.random.default_rng(5))
+    ref_prev[rows, obj] = cur
+    ref_x[rows, obj] = want
+    noise = np.random.default_rng(5).standard_normal((x.shape[0], 3))
+    got = propagate_objects(x, prev, obj, noise, mean, dyn._sigma, a1, a2)
+    assert np.array_equal(got, want)
+    assert np.array_equal(x, ref_x) and np.array_equal(prev, ref_prev)
+
+
+def test_state_boxes_are_boxes_from_states():
+    rng = np.random.default_rng(2)
+    states = np.column_stack([rng.normal(50, 20, (500, 2)), rng.normal(0, 0.3, 500)])
+    sizes = rng.uniform(3, 40, (5, 2))
+    obj = rng.integers(0, 5, 500).astype(np.int64)
+    want = boxes_from_states(states, sizes[obj])
+    assert np.array_equal(state_boxes(states, np.exp(states[:, 2]), sizes, obj), want)
+
+
+@pytest.mark.parametrize("method", ["systematic", "multinomial", "stratified"])
+@pytest.mark.parametrize("sizes", [[300], [43, 43, 43, 43, 43, 43, 42], [1, 5, 94]])
+def test_weighted_resample_gather_is_weighted_resample_groups(method, sizes):
+    rng = np.random.default_rng(3)
+    sizes = np.array(sizes, dtype=np.int64)
+    n = int(sizes.sum())
+    x, prev, _ = _set(rng, n)
+    ll = rng.normal(size=(n, 4))
+    log_g = rng.normal(size=n)
+    pi_g = np.exp(np.stack([rng.normal(size=n), rng.normal(0, 3, n)]))
+    k, w = weighted_resample_groups(pi_g[0], pi_g[1], sizes, method=method,
+                                    rng=np.random.default_rng(7))
+    mode = RESAMPLE_MODES[method]
+    uniforms = np.random.default_rng(7).random(sizes.size if mode == SYSTEMATIC else n)
+    out = weighted_resample_gather(pi_g[0], pi_g[1], sizes, uniforms, mode, x, prev, ll,
+                                   log_g)
+    assert out is not None
+    got_w, got_k, gx, gp, gll, gg = out
+    assert np.array_equal(got_k, k) and np.array_equal(got_w, w)
+    for a, b in ((gx, x[k]), (gp, prev[k]), (gll, ll[k]), (gg, log_g[k])):
+        assert np.array_equal(a, b)
+    # Fused with the next stage's AR2:
+    obj = rng.integers(0, 4, n).astype(np.int64)
+    noise = rng.standard_normal((n, 3))
+    mean = np.zeros((4, 3))
+    sig = np.array([2.0, 2.0, 0.001])
+    fused = resample_propagate(pi_g[0], pi_g[1], sizes, uniforms, mode, x, prev, ll, log_g,
+                               obj, noise, mean, sig, 2.0, -1.0)
+    gx2, gp2 = x[k], prev[k]
+    new = propagate_objects(gx2, gp2, obj, noise, mean, sig, 2.0, -1.0)
+    assert np.array_equal(fused[0], w) and np.array_equal(fused[5], new)
+    assert np.array_equal(fused[1], gx2) and np.array_equal(fused[2], gp2)
+
+
+def test_invalid_weights_leave_the_kernels_for_the_checked_path():
+    a = np.array([1.0, np.nan, 1.0])
+    out = weighted_resample_gather(a, np.ones(3), np.array([3]), np.array([0.5]), SYSTEMATIC,
+                                   np.zeros((3, 1, 3)), np.zeros((3, 1, 3)), np.zeros((3, 1)),
+                                   np.zeros(3))
+    assert out is None
+    assert not normalise_groups_checked(np.array([1.0, -1.0]), np.array([2]))[1]
+    assert not normalise_groups_checked(np.array([1e308, 1e308]), np.array([2]))[1]
+    assert not normalise_groups_checked(np.array([0.0, 1.0]), np.array([1, 1]))[1]
+    with pytest.raises(ValueError, match="finite"), np.errstate(over="ignore"):
+        resample(np.array([1e308, 1e308]), rng=np.random.default_rng(0))
+    shifted, finite = stage_log_weights(np.zeros(2), np.zeros((2, 1)), np.zeros(2),
+                                        np.array([0.0, np.nan]), np.zeros(2, dtype=np.int64))
+    assert not finite
+
+
+def test_normalise_groups_checked_is_the_numpy_division():
+    rng = np.random.default_rng(4)
+    w = _values(rng, 300)
+    sizes = np.array([100, 57, 143], dtype=np.int64)
+    starts = np.cumsum(sizes) - sizes
+    out, ok = normalise_groups_checked(w, sizes)
+    assert ok and np.array_equal(out, w / np.repeat(np.add.reduceat(w, starts), sizes))
+
+
+def _reassemble_numpy(logw, logpi, sizes):
+    starts = np.cumsum(sizes) - sizes
+    log_total = log_sum_exp_groups(logw, starts, sizes)
+    log_evidence = log_total - log_sum_exp_groups(logpi, starts, sizes)
+    mixture = normalised_weights(np.log(sizes / sizes.sum()) + log_evidence)
+    logw_final = logw + np.repeat(np.log(mixture) - log_total, sizes)
+    return normalised_weights(logw_final), mixture
+
+
+@pytest.mark.parametrize("sizes", [[150, 150], [43, 43, 43, 43, 43, 43, 42], [1, 2, 297]])
+def test_reassemble_is_the_numpy_mixture_reassembly(sizes):
+    rng = np.random.default_rng(5)
+    sizes = np.array(sizes, dtype=np.int64)
+    n = int(sizes.sum())
+    logpi = rng.normal(0, 2, n)
+    logw = logpi + rng.normal(-30, 10, n)
+    want_w, want_m = _reassemble_numpy(logw, logpi, sizes)
+    got_w, got_m = reassemble(logw, logpi, sizes)
+    assert np.array_equal(got_w, want_w) and np.array_equal(got_m, want_m)
+
+
+def test_weighted_mean_and_diagnostics_are_the_numpy_ones():
+    rng = np.random.default_rng(6)
+    particles = rng.normal(100, 30, (300, 7, 3))
+    particles = particles[rng.integers(0, 300, 300)]
+    w = normalised_weights(rng.normal(0, 3, 300))
+    mean, var = weighted_mean_states(w[:, None], particles)
+    wk = np.repeat(w[:, None], 7, axis=1)
+    assert np.array_equal(mean, (wk[:, :, None] * particles).sum(axis=0))
+    assert np.array_equal(var, particles.var(axis=0))
+    wk = normalised_weights(rng.normal(0, 3, (300, 7)), axis=0)  # one column per object
+    mean, _ = weighted_mean_states(wk, particles)
+    assert np.array_equal(mean, (wk[:, :, None] * particles).sum(axis=0))
+    for sigma in ([2.0, 2.0, 0.001], [0.0, 3.0, 1.0]):
+        want = effective_dynamics(particles, sigma)[:, :2].mean(axis=1)
+        assert np.array_equal(effective_uv(var, np.array(sigma)), want, equal_nan=True)
+    x2, p2 = gather_pair(particles, particles * 2, np.array([3, 3, 0], dtype=np.int64))
+    assert np.array_equal(x2, particles[[3, 3, 0]])
+    assert np.array_equal(p2, (particles * 2)[[3, 3, 0]])
+
+
+def _distinct_brute(p):
+    out = []
+    for o in range(p.shape[1]):
+        rows = []
+        for r in p[:, o]:
+            if not any(np.array_equal(r, q) for q in rows):  # NaN equals nothing
+                rows.append(r)
+        out.append(len(rows))
+    return np.array(out)
+
+
+def test_count_distinct_against_brute_force():
+    rng = np.random.default_rng(7)
+    for _ in range(100):
+        n, k = rng.integers(1, 50), rng.integers(1, 4)
+        p = rng.choice([0.0, -0.0, 1.0, 2.5, np.nan], size=(n, k, 3),
+                       p=[0.3, 0.2, 0.2, 0.2, 0.1])
+        assert np.array_equal(count_distinct(p), _distinct_brute(p))
+    p = rng.normal(size=(300, 3, 3))[rng.integers(0, 300, 300)]
+    assert np.array_equal(uniqueness(p) * 300, _distinct_brute(p))
+
+
+# --- the whole step against a pure-numpy reference -------------------------------------
+
+
+def _scene(n_frames=6, seed=2):
+    """Three two-colour 20x20 squares drifting on noise; frames (T, H, W, 3), boxes (3, 4)."""
+    rng = np.random.default_rng(seed)
+    start = np.array([[15.0, 15.0], [70.0, 20.0], [30.0, 50.0]])
+    vel = rng.uniform(-1.5, 1.5, (3, 2))
+    colours = [((220, 40, 40), (40, 60, 200)), ((30, 160, 60), (250, 220, 60)),
+               ((200, 40, 200), (90, 230, 230))]
+    frames = []
+    for t in range(n_frames):
+        f = rng.integers(0, 256, (80, 110, 3), dtype=np.uint8)
+        for k, (x, y) in enumerate(np.round(start + t * vel).astype(int)):
+            f[y:y + 10, x:x + 20] = colours[k][0]
+            f[y + 10:y + 20, x:x + 20] = colours[k][1]
+        frames.append(f)
+    return np.stack(frames), np.column_stack([start, np.full((3, 2), 20.0)])
+
+
+def _reference_step(tr, frame):
+    """The partitioned-sampling step of ``tr`` (PS or DPS) in numpy, as before compiling."""
+    obs = tr.model.observe(frame)
+    n, m = tr.params.n_particles, tr.n_targets
+    idx = resample(tr.weights, method=tr.params.resampler, rng=tr.rng)
+    x, prev = tr.particles[idx], tr._prev[idx]
+    sizes = tr._sizes_c
+    orderings = tr._order if isinstance(tr, PartitionedSampling) else tr._orders
+    if sizes.size > 1:
+        order = (tr.rng.permutation(n) if tr.params.assignment == "random"
+                 else tr._interleave)
+        x, prev = x[order], prev[order]
+    group = np.repeat(np.arange(sizes.size), sizes)
+    rows = np.arange(n)
+    logpi = np.zeros(n)
+    ll = np.zeros((n, m))
+    log_g = np.zeros(n)
+    for j in range(m):
+        obj = orderings[group, j]
+        cur = x[rows, obj]
+        new = tr.dynamics.propagate(cur, prev[rows, obj], tr._mean[obj], rng=tr.rng)
+        prev[rows, obj] = cur
+        x[rows, obj] = new
+        stage = obs.log_likelihoods(boxes_from_states(new, tr._sizes[obj]), obj)
+        ll[rows, obj] = stage
+        if j < m - 1:
+            log_g += stage
+            k, w = weighted_resample_groups(
+                np.exp(logpi - logpi.max()), np.exp(log_g - log_g.max()), sizes,
+                method=tr.params.resampler, rng=tr.rng)
+            x, prev, ll, log_g = x[k], prev[k], ll[k], log_g[k]
+            logpi = np.log(w)
+    logw = logpi + ll.sum(axis=1)
+    if sizes.size == 1:
+        weights = normalised_weights(logw)
+    else:
+        weights, _ = _reassemble_numpy(logw, logpi, sizes)
+    tr.particles, tr._prev, tr.weights = x, prev, weights
+    wk = np.repeat(weights[:, None], m, axis=1)
+    mean_state = (wk[:, :, None] * x).sum(axis=0)
+    return boxes_from_states(mean_state, tr._sizes)
+
+
+@pytest.mark.parametrize("name,params", [
+    ("dps", {}),
+    ("dps", {"n_groups": 3, "assignment": "interleaved", "resampler": "stratified"}),
+    ("dps", {"resampler": "residual"}),
+    ("ps", {"ordering": 1, "resampler": "multinomial", "a1": 1.5, "a2": -0.6}),
+])
+def test_compiled_step_equals_the_numpy_reference_step(name, params):
+    frames, boxes0 = _scene()
+    cls = DistributedPartitionedSampling if name == "dps" else PartitionedSampling
+    kw = dict(n_particles=97, rng=11, model="rgb", bins=6, **params)
+    fast, ref = cls(**kw), cls(**kw)
+    fast.init(frames[0], boxes0)
+    ref.init(frames[0], boxes0)
+    for f in frames[1:]:
+        est = fast._step(f)
+        want = _reference_step(ref, f)
+        assert np.array_equal(est.boxes, want)
+        assert np.array_equal(fast.particles, ref.particles)
+        assert np.array_equal(fast._prev, ref._prev)
+        assert np.array_equal(fast.weights, ref.weights)
+    assert fast.rng.random() == ref.rng.random()  # the same draws, in the same order
+
+
+def test_every_resampler_is_covered():
+    assert set(RESAMPLE_MODES) | {"residual"} == set(RESAMPLERS)

@@ -1,0 +1,666 @@
+"""Compiled stages of the particle filters' step: dynamics, weighted resampling, estimate.
+
+A partitioned-sampling step (PS, DPS) runs one sampling stage per object; done with numpy,
+each stage's gathers, AR2 propagation, box conversion and weighted resampling took about
+twenty small array calls, as much time as the stage's histograms. Here each stage is a
+few compiled calls over all particles at once (docs/algorithms.md, implementation notes):
+
+- ``propagate_objects``: AR2 step of one object per particle (the stage's object of each
+  particle's group), in place;
+- ``state_boxes``: boxes of those states;
+- ``stage_log_weights``: record a stage's log-likelihoods and return the shifted
+  log-weights whose exponentials the weighted resampling needs;
+- ``weighted_resample_gather``: weighted resampling of every group and the gather of the
+  particle arrays by the drawn ancestors;
+- ``normalise_groups``: weights normalised per group (the plain resamplers' first step);
+- ``weighted_mean_states``: the weighted mean state per object, and the unweighted
+  variance of the set (the diagnostics), for the estimate.
+
+**Bit-identical to the numpy code they replace.** The results are the ones the numpy
+expressions give, to the last bit, because every operation is the same IEEE operation in
+the same order: elementwise arithmetic as written; sums in numpy's own order
+(``_numpy_sum`` is numpy's pairwise summation, 8 accumulators in blocks of up to 128,
+halving above; ``np.sum`` adds it to 0, ``np.add.reduceat`` adds it to the group's
+first element); reductions over the particle axis of an (N, K, 3) array run row by row as
+numpy's iterator does. Transcendental functions are *not* compiled: numpy's ``exp`` and
+``log`` (SIMD on AVX-512 machines) and the C library's, which numba calls, differ in the
+last bit for a few percent of arguments, so the callers take exp/log with numpy between
+kernel calls. Randomness stays with the caller's Generator: the kernels take the
+uniforms and normals the numpy code drew, in the same order.
+tests/trackers/test_stage_kernels.py compares every kernel with its numpy expression
+exactly, and the trackers' steps with a numpy reference step.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+from numpy.typing import NDArray
+
+from trackers.kernels.sampling import _inverse_cdf_groups
+
+__all__ = [
+    "effective_uv",
+    "gather_pair",
+    "normalise_groups",
+    "normalise_groups_checked",
+    "normalise_rows",
+    "numpy_reduceat_sum",
+    "numpy_sum",
+    "propagate_objects",
+    "reassemble",
+    "resample_propagate",
+    "row_max_shift",
+    "stage_log_weights",
+    "state_boxes",
+    "weighted_mean_states",
+    "weighted_resample_gather",
+]
+
+_BLOCK = 128  # numpy's PW_BLOCKSIZE
+
+
+@njit(cache=True)
+def _pairwise_block(a, lo, n):
+    """numpy's pairwise sum of a[lo:lo + n] for n <= 128: sequential below 8, else eight
+    interleaved accumulators combined as a tree, then the remainder."""
+    if n < 8:
+        res = 0.0
+        for i in range(lo, lo + n):
+            res += a[i]
+        return res
+    r0 = a[lo]
+    r1 = a[lo + 1]
+    r2 = a[lo + 2]
+    r3 = a[lo + 3]
+    r4 = a[lo + 4]
+    r5 = a[lo + 5]
+    r6 = a[lo + 6]
+    r7 = a[lo + 7]
+    i = 8
+    stop = n - n % 8
+    while i < stop:
+        r0 += a[lo + i]
+        r1 += a[lo + i + 1]
+        r2 += a[lo + i + 2]
+        r3 += a[lo + i + 3]
+        r4 += a[lo + i + 4]
+        r5 += a[lo + i + 5]
+        r6 += a[lo + i + 6]
+        r7 += a[lo + i + 7]
+        i += 8
+    res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+    while i < n:
+        res += a[lo + i]
+        i += 1
+    return res
+
+
+@njit(cache=True)
+def _pairwise(a, lo, n):
+    """numpy's pairwise summation of a[lo:lo + n] (``pairwise_sum`` of its add loop):
+    blocks of at most 128, above that the sum of the halves split at a multiple of 8.
+    The recursion runs on an explicit stack (numba's cache and recursion do not mix)."""
+    if n <= _BLOCK:
+        return _pairwise_block(a, lo, n)
+    f_lo = np.empty(64, dtype=np.int64)
+    f_n = np.empty(64, dtype=np.int64)
+    f_state = np.empty(64, dtype=np.int64)
+    vals = np.empty(64)
+    top = 0
+    vtop = 0
+    f_lo[0] = lo
+    f_n[0] = n
+    f_state[0] = 0
+    while top >= 0:
+        m = f_n[top]
+        if m <= _BLOCK:
+            vals[vtop] = _pairwise_block(a, f_lo[top], m)
+            vtop += 1
+            top -= 1
+            continue
+        n2 = m // 2
+        n2 -= n2 % 8
+        if f_state[top] == 0:  # first the left half
+            f_state[top] = 1
+            f_lo[top + 1] = f_lo[top]
+            f_n[top + 1] = n2
+            f_state[top + 1] = 0
+            top += 1
+        elif f_state[top] == 1:  # then the right half
+            f_state[top] = 2
+            f_lo[top + 1] = f_lo[top] + n2
+            f_n[top + 1] = m - n2
+            f_state[top + 1] = 0
+            top += 1
+        else:  # left + right
+            vals[vtop - 2] = vals[vtop - 2] + vals[vtop - 1]
+            vtop -= 1
+            top -= 1
+    return vals[0]
+
+
+@njit(cache=True)
+def _numpy_sum(a, lo, n):
+    """``np.sum(a[lo:lo + n])`` of a contiguous float64 slice, to the bit."""
+    return 0.0 + _pairwise(a, lo, n)
+
+
+@njit(cache=True)
+def _numpy_reduceat_sum(a, lo, n):
+    """One group of ``np.add.reduceat``: the first element plus the rest's pairwise sum."""
+    res = a[lo]
+    if n > 1:
+        res += _pairwise(a, lo + 1, n - 1)
+    return res
+
+
+def numpy_sum(a: NDArray[np.float64]) -> float:
+    """``np.sum`` of a 1-D float64 array computed by the compiled replica (tests)."""
+    a = np.ascontiguousarray(a, dtype=np.float64)
+    return float(_numpy_sum(a, 0, a.shape[0]))
+
+
+def numpy_reduceat_sum(a: NDArray[np.float64], sizes: NDArray[np.integer]
+                       ) -> NDArray[np.float64]:
+    """``np.add.reduceat(a, starts)`` of contiguous groups of lengths ``sizes`` (C,), shape
+    (C,), computed by the compiled replica (tests)."""
+    a = np.ascontiguousarray(a, dtype=np.float64)
+    sizes = np.asarray(sizes, dtype=np.int64)
+    out = np.empty(sizes.shape[0])
+    start = 0
+    for g, s in enumerate(sizes):
+        out[g] = _numpy_reduceat_sum(a, start, int(s))
+        start += int(s)
+    return out
+
+
+@njit(cache=True)
+def _propagate_objects(x, prev, obj, noise, mean, sigma, a1, a2):
+    n = x.shape[0]
+    out = np.empty((n, 3))
+    for r in range(n):
+        o = obj[r]
+        for c in range(3):
+            cur = x[r, o, c]
+            mu = mean[o, c]
+            # numpy: mean + a1 (x − mean) + a2 (x_prev − mean) + noise σ, left to right.
+            new = mu + a1 * (cur - mu) + a2 * (prev[r, o, c] - mu) + noise[r, c] * sigma[c]
+            prev[r, o, c] = cur
+            x[r, o, c] = new
+            out[r, c] = new
+    return out
+
+
+def propagate_objects(
+    x: NDArray[np.float64],
+    prev: NDArray[np.float64],
+    obj: NDArray[np.int64],
+    noise: NDArray[np.float64],
+    mean: NDArray[np.float64],
+    sigma: NDArray[np.float64],
+    a1: float,
+    a2: float,
+) -> NDArray[np.float64]:
+    """AR2 step of object ``obj[r]`` of every particle r, in place (``AR2.propagate``).
+
+    Parameters
+    ----------
+    x, prev : ndarray of shape (N, K, 3), C-contiguous float64
+        X_{t−1} and X_{t−2} of every particle; on return x[r, obj[r]] holds the new state
+        and prev[r, obj[r]] the old x[r, obj[r]].
+    obj : ndarray of shape (N,), int64
+        The object each particle moves.
+    noise : ndarray of shape (N, 3)
+        Standard normals, as ``AR2.propagate`` draws them for an (N, 3) state.
+    mean : ndarray of shape (K, 3)
+        X̄ per object.
+    sigma : ndarray of shape (3,)
+        σ of (u, v, a).
+    a1, a2 : float
+        AR2 coefficients.
+
+    Returns
+    -------
+    ndarray of shape (N, 3)
+        The new states x[r, obj[r]].
+    """
+    return _propagate_objects(x, prev, obj, noise, mean, sigma, float(a1), float(a2))
+
+
+@njit(cache=True)
+def _state_boxes(states, scale, sizes, obj):
+    n = states.shape[0]
+    out = np.empty((n, 4))
+    for r in range(n):
+        w = sizes[obj[r], 0] * scale[r]
+        h = sizes[obj[r], 1] * scale[r]
+        out[r, 0] = states[r, 0] - w / 2
+        out[r, 1] = states[r, 1] - h / 2
+        out[r, 2] = w
+        out[r, 3] = h
+    return out
+
+
+def state_boxes(states: NDArray[np.float64], scale: NDArray[np.float64],
+                sizes: NDArray[np.float64], obj: NDArray[np.int64]) -> NDArray[np.float64]:
+    """Boxes (N, 4) of states (N, 3) of objects ``obj`` (N,) (``boxes_from_states``).
+
+    ``scale`` (N,) is exp(a) of each state, taken by the caller with numpy's exp;
+    ``sizes`` (K, 2) the objects' base (w0, h0).
+    """
+    return _state_boxes(states, scale, sizes, obj)
+
+
+@njit(cache=True)
+def _stage_log_weights(stage, ll, log_g, logpi, obj):
+    n = stage.shape[0]
+    out = np.empty((2, n))
+    top_pi = -np.inf
+    top_g = -np.inf
+    ok = True
+    for r in range(n):
+        ll[r, obj[r]] = stage[r]
+        log_g[r] += stage[r]
+        if logpi[r] != logpi[r] or log_g[r] != log_g[r]:
+            ok = False
+        top_pi = max(top_pi, logpi[r])
+        top_g = max(top_g, log_g[r])
+    for r in range(n):
+        out[0, r] = logpi[r] - top_pi
+        out[1, r] = log_g[r] - top_g
+    return out, ok
+
+
+def stage_log_weights(stage: NDArray[np.float64], ll: NDArray[np.float64],
+                      log_g: NDArray[np.float64], logpi: NDArray[np.float64],
+                      obj: NDArray[np.int64]) -> tuple[NDArray[np.float64], bool]:
+    """Record a stage's log-likelihoods and shift the log-weights for exponentiation.
+
+    Sets ll[r, obj[r]] = stage[r] and log_g += stage in place, and returns the (2, N)
+    array [logpi − max logpi, log_g − max log_g] (the exponents of the weighted
+    resampling, DPS §3), and False if a log-weight is NaN (the caller then takes the
+    checked numpy path, which raises). Shapes: stage, log_g, logpi (N,), ll (N, K).
+    """
+    return _stage_log_weights(stage, ll, log_g, logpi, obj)
+
+
+@njit(cache=True)
+def _normalise_groups(w, sizes):
+    n = w.shape[0]
+    out = np.empty(n)
+    start = 0
+    for g in range(sizes.shape[0]):
+        s = sizes[g]
+        total = _numpy_reduceat_sum(w, start, s)
+        if not total > 0.0:
+            return out, False
+        for i in range(start, start + s):
+            out[i] = w[i] / total
+        start += s
+    return out, True
+
+
+def normalise_groups(w: NDArray[np.float64], sizes: NDArray[np.int64]
+                     ) -> tuple[NDArray[np.float64], bool]:
+    """Weights (N,) divided by their group's sum (``np.add.reduceat``), and whether every
+    group's sum was positive. ``sizes`` (C,) are the contiguous groups' lengths."""
+    return _normalise_groups(w, sizes)
+
+
+@njit(cache=True)
+def _normalise_groups_checked(w, sizes):
+    # The checks of ``trackers.filters.resampling``: finite, non-negative, a finite total
+    # (numpy's sum) and a positive sum per group; False sends the caller to the checked
+    # numpy path, which raises.
+    if not (_valid(w) and np.isfinite(_numpy_sum(w, 0, w.shape[0]))):
+        return np.empty(0), False
+    return _normalise_groups(w, sizes)
+
+
+def normalise_groups_checked(w: NDArray[np.float64], sizes: NDArray[np.int64]
+                             ) -> tuple[NDArray[np.float64], bool]:
+    """``normalise_groups`` for C-contiguous float64 weights (N,), also False unless every
+    weight is finite and >= 0 and their sum finite."""
+    return _normalise_groups_checked(w, sizes)
+
+
+@njit(cache=True)
+def _valid(a):
+    for i in range(a.shape[0]):
+        if not (a[i] >= 0.0 and a[i] < np.inf):
+            return False
+    return True
+
+
+@njit(cache=True)
+def _gather_pair(x, prev, idx):
+    n = idx.shape[0]
+    m = x.shape[1] * x.shape[2]
+    xf = x.reshape(x.shape[0], m)
+    pf = prev.reshape(prev.shape[0], m)
+    x2 = np.empty((n, m))
+    p2 = np.empty((n, m))
+    for i in range(n):
+        k = idx[i]
+        for c in range(m):
+            x2[i, c] = xf[k, c]
+        for c in range(m):
+            p2[i, c] = pf[k, c]
+    return x2.reshape((n, x.shape[1], x.shape[2])), p2.reshape((n, x.shape[1], x.shape[2]))
+
+
+def gather_pair(x: NDArray[np.float64], prev: NDArray[np.float64], idx: NDArray[np.int64]
+                ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """``x[idx]``, ``prev[idx]`` of two (N, K, D) arrays by ancestors ``idx`` (P,), as new
+    C-contiguous float64 arrays (P, K, D)."""
+    return _gather_pair(np.ascontiguousarray(x, dtype=np.float64),
+                        np.ascontiguousarray(prev, dtype=np.float64),
+                        np.ascontiguousarray(idx, dtype=np.int64))
+
+
+@njit(cache=True)
+def _weighted_resample_gather(a, b, sizes, uniforms, mode, x, prev, ll, log_g):
+    n = a.shape[0]
+    if not (_valid(a) and _valid(b)):
+        return np.empty(0), np.empty(0, dtype=np.int64), x, prev, ll, log_g
+    rho = a * b
+    rho_n, ok = _normalise_groups(rho, sizes)
+    if not ok:
+        return np.empty(0), np.empty(0, dtype=np.int64), x, prev, ll, log_g
+    idx = _inverse_cdf_groups(rho_n, sizes, sizes, uniforms, mode)
+    new = np.empty(n)
+    for i in range(n):
+        new[i] = 1.0 / b[idx[i]]
+    w, _ = _normalise_groups(new, sizes)
+    x2, prev2 = _gather_pair(x, prev, idx)
+    m = ll.shape[1]
+    ll2 = np.empty_like(ll)
+    g2 = np.empty_like(log_g)
+    for i in range(n):
+        k = idx[i]
+        for o in range(m):
+            ll2[i, o] = ll[k, o]
+        g2[i] = log_g[k]
+    return w, idx, x2, prev2, ll2, g2
+
+
+def weighted_resample_gather(
+    a: NDArray[np.float64],
+    b: NDArray[np.float64],
+    sizes: NDArray[np.int64],
+    uniforms: NDArray[np.float64],
+    mode: int,
+    x: NDArray[np.float64],
+    prev: NDArray[np.float64],
+    ll: NDArray[np.float64],
+    log_g: NDArray[np.float64],
+) -> tuple[NDArray[np.float64], NDArray[np.int64], NDArray[np.float64], NDArray[np.float64],
+           NDArray[np.float64], NDArray[np.float64]] | None:
+    """Weighted resampling of every group (``weighted_resample_groups``) and the gather.
+
+    Parameters
+    ----------
+    a : ndarray of shape (N,)
+        Current weights π (any positive scale per group).
+    b : ndarray of shape (N,)
+        The weighting function g at each particle.
+    sizes : ndarray of shape (C,), int64
+        Lengths of the contiguous groups.
+    uniforms : ndarray
+        The uniforms ``trackers.filters.resampling`` draws for ``mode``: one per group
+        (systematic) or one per particle (multinomial, stratified).
+    mode : int
+        ``trackers.kernels.sampling`` MULTINOMIAL, STRATIFIED or SYSTEMATIC.
+    x, prev : ndarray of shape (N, K, 3)
+    ll : ndarray of shape (N, K)
+    log_g : ndarray of shape (N,)
+        Per-particle arrays to gather by the drawn ancestors.
+
+    Returns
+    -------
+    tuple or None
+        (new weights (N,) normalised per group, ancestors (N,), x, prev, ll, log_g
+        gathered); None if ``a`` or ``b`` is negative or not finite or a group's π g sums
+        to zero (the caller then takes the checked numpy path, which raises).
+    """
+    out = _weighted_resample_gather(a, b, sizes, uniforms, int(mode), x, prev, ll, log_g)
+    return None if out[0].shape[0] == 0 else out
+
+
+@njit(cache=True)
+def _resample_propagate(a, b, sizes, uniforms, mode, x, prev, ll, log_g, obj, noise, mean,
+                        sigma, a1, a2):
+    w, idx, x2, prev2, ll2, g2 = _weighted_resample_gather(a, b, sizes, uniforms, mode, x,
+                                                           prev, ll, log_g)
+    if w.shape[0] == 0:
+        return w, x2, prev2, ll2, g2, np.empty((0, 3))
+    new = _propagate_objects(x2, prev2, obj, noise, mean, sigma, a1, a2)
+    return w, x2, prev2, ll2, g2, new
+
+
+def resample_propagate(
+    a: NDArray[np.float64],
+    b: NDArray[np.float64],
+    sizes: NDArray[np.int64],
+    uniforms: NDArray[np.float64],
+    mode: int,
+    x: NDArray[np.float64],
+    prev: NDArray[np.float64],
+    ll: NDArray[np.float64],
+    log_g: NDArray[np.float64],
+    obj: NDArray[np.int64],
+    noise: NDArray[np.float64],
+    mean: NDArray[np.float64],
+    sigma: NDArray[np.float64],
+    a1: float,
+    a2: float,
+) -> tuple[NDArray[np.float64], ...] | None:
+    """``weighted_resample_gather`` then ``propagate_objects`` of the next stage, one call.
+
+    The arguments are those of the two functions (``noise`` (N, 3) the next stage's
+    normals, drawn after ``uniforms``; ``obj`` (N,) its objects). Returns (new weights
+    (N,), x, prev, ll, log_g gathered, with x and prev propagated, and the new states
+    (N, 3) of the stage's objects), or None where ``weighted_resample_gather`` is None.
+    """
+    out = _resample_propagate(a, b, sizes, uniforms, int(mode), x, prev, ll, log_g, obj,
+                              noise, mean, sigma, float(a1), float(a2))
+    return None if out[0].shape[0] == 0 else out
+
+
+@njit(cache=True)
+def _group_max_shift(x, sizes):
+    """x minus its group's maximum (``x − np.repeat(np.maximum.reduceat(x), sizes)``) and
+    the maxima (C,)."""
+    out = np.empty(x.shape[0])
+    top = np.empty(sizes.shape[0])
+    start = 0
+    for g in range(sizes.shape[0]):
+        m = x[start]
+        for i in range(start + 1, start + sizes[g]):
+            m = max(m, x[i])
+        top[g] = m
+        for i in range(start, start + sizes[g]):
+            out[i] = x[i] - m
+        start += sizes[g]
+    return out, top
+
+
+@njit(cache=True)
+def _reassemble_shift(logw, logpi, sizes):
+    n = logw.shape[0]
+    shifted = np.empty((2, n))
+    sw, top_w = _group_max_shift(logw, sizes)
+    sp, top_p = _group_max_shift(logpi, sizes)
+    shifted[0] = sw
+    shifted[1] = sp
+    return shifted, top_w, top_p
+
+
+@njit(cache=True)
+def _reassemble_sums(e, sizes):
+    c = sizes.shape[0]
+    sums = np.empty((2, c))
+    start = 0
+    for g in range(c):
+        sums[0, g] = _numpy_reduceat_sum(e[0], start, sizes[g])
+        sums[1, g] = _numpy_reduceat_sum(e[1], start, sizes[g])
+        start += sizes[g]
+    return sums
+
+
+@njit(cache=True)
+def _max_shift(x):
+    m = x[0]
+    for i in range(1, x.shape[0]):
+        m = max(m, x[i])
+    out = np.empty(x.shape[0])
+    for i in range(x.shape[0]):
+        out[i] = x[i] - m
+    return out
+
+
+@njit(cache=True)
+def _divide_by_sum(e):
+    total = _numpy_sum(e, 0, e.shape[0])
+    return e / total
+
+
+@njit(cache=True)
+def _final_log_weights(logw, log_mixture, log_total, sizes):
+    out = np.empty(logw.shape[0])
+    start = 0
+    for g in range(sizes.shape[0]):
+        shift = log_mixture[g] - log_total[g]
+        for i in range(start, start + sizes[g]):
+            out[i] = logw[i] + shift
+        start += sizes[g]
+    return _max_shift(out)
+
+
+def reassemble(logw: NDArray[np.float64], logpi: NDArray[np.float64],
+               sizes: NDArray[np.int64], log_prior: NDArray[np.float64] | None = None
+               ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The DPS mixture reassembly (``_Partitioned._reassemble``) with compiled glue.
+
+    Parameters
+    ----------
+    logw, logpi : ndarray of shape (N,)
+        log w̃ and log π' of every particle.
+    sizes : ndarray of shape (C,), int64, C >= 2
+        Group lengths.
+    log_prior : ndarray of shape (C,), optional
+        log(N_c / N), ``np.log(sizes / sizes.sum())`` (computed here if None).
+
+    Returns
+    -------
+    weights : ndarray of shape (N,)
+        The posterior weights, summing to 1.
+    mixture : ndarray of shape (C,)
+        The mixture weights π_c,t.
+
+    Notes
+    -----
+    The numpy expression it replaces: log_total = LSE_c(logw), log_evidence = log_total −
+    LSE_c(logpi) (``log_sum_exp_groups``), mixture = normalised(log(N_c / N) +
+    log_evidence), weights = normalised(logw + log mixture_c − log_total_c); the exp and
+    log calls are numpy's, the rest compiled, in the same order.
+    """
+    logw = np.ascontiguousarray(logw, dtype=np.float64)
+    logpi = np.ascontiguousarray(logpi, dtype=np.float64)
+    shifted, top_w, top_p = _reassemble_shift(logw, logpi, sizes)
+    logs = np.log(_reassemble_sums(np.exp(shifted), sizes))
+    log_total = top_w + logs[0]
+    log_evidence = log_total - (top_p + logs[1])
+    if log_prior is None:
+        log_prior = np.log(sizes / sizes.sum())
+    mixture = _divide_by_sum(np.exp(_max_shift(log_prior + log_evidence)))
+    final = np.exp(_final_log_weights(logw, np.log(mixture), log_total, sizes))
+    return _divide_by_sum(final), mixture
+
+
+@njit(cache=True)
+def _weighted_mean_states(weights, particles):
+    n, k = particles.shape[0], particles.shape[1]
+    shared = weights.shape[1] == 1
+    mean = np.zeros((k, 3))
+    total = np.zeros((k, 3))
+    for r in range(n):
+        for o in range(k):
+            wr = weights[r, 0] if shared else weights[r, o]
+            for c in range(3):
+                mean[o, c] += wr * particles[r, o, c]
+                total[o, c] += particles[r, o, c]
+    # numpy's var: the mean Σx / N, then Σ (x − mean)² / N, sums row by row.
+    avg = total / n
+    var = np.zeros((k, 3))
+    for r in range(n):
+        for o in range(k):
+            for c in range(3):
+                d = particles[r, o, c] - avg[o, c]
+                var[o, c] += d * d
+    return mean, var / n
+
+
+@njit(cache=True)
+def _row_max_shift(x):
+    out = np.empty(x.shape)
+    for i in range(x.shape[0]):
+        m = x[i, 0]
+        for j in range(1, x.shape[1]):
+            m = max(m, x[i, j])
+        for j in range(x.shape[1]):
+            out[i, j] = x[i, j] - m
+    return out
+
+
+def row_max_shift(x: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Each row of x (K, N) minus its maximum, as a new C-contiguous array (K, N)."""
+    return _row_max_shift(np.asarray(x, dtype=np.float64))
+
+
+@njit(cache=True)
+def _normalise_rows(e):
+    out = np.empty(e.shape)
+    for i in range(e.shape[0]):
+        total = _numpy_sum(e[i], 0, e.shape[1])
+        for j in range(e.shape[1]):
+            out[i, j] = e[i, j] / total
+    return out
+
+
+def normalise_rows(e: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Each row of e (K, N) divided by its ``np.sum``; with ``row_max_shift`` and numpy's
+    exp between them, ``normalised_weights`` of every row."""
+    return _normalise_rows(np.ascontiguousarray(e, dtype=np.float64))
+
+
+@njit(cache=True)
+def _effective_uv(var, sig2):
+    k = var.shape[0]
+    out = np.empty(k)
+    for o in range(k):
+        e = np.empty(2)
+        for c in range(2):
+            e[c] = var[o, c] / sig2[c] if sig2[c] > 0 else np.nan
+        out[o] = (e[0] + e[1]) / 2
+    return out
+
+
+def effective_uv(var: NDArray[np.float64], sigma: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Mean over (u, v) of the effective dynamics var / σ² (NaN where σ = 0), shape (K,),
+    from the variances ``var`` (K, 3) and σ (3,) (``effective_dynamics(...)[:, :2]
+    .mean(axis=1)``)."""
+    return _effective_uv(var, np.asarray(sigma, dtype=np.float64) ** 2)
+
+
+def weighted_mean_states(weights: NDArray[np.float64], particles: NDArray[np.float64]
+                         ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Weighted mean (K, 3) of particles (N, K, 3) and their unweighted variance (K, 3).
+
+    ``weights`` is (N, K) (column k weights object k: ``(weights[:, :, None] *
+    particles).sum(axis=0)``) or (N, 1), one column shared by every object; the variance
+    is ``particles.var(axis=0)``.
+    """
+    return _weighted_mean_states(np.asarray(weights, dtype=np.float64),
+                                 np.ascontiguousarray(particles, dtype=np.float64))
