@@ -114,6 +114,30 @@ def test_shared_workers_give_the_same_records_as_one_process(reference, tmp_path
         assert (b / t.filename()).read_bytes() == (plain / t.filename()).read_bytes()
 
 
+def test_experiment_all_starts_its_workers_once(tmp_path, monkeypatch):
+    from scenegen.lab import report
+    from scenegen.lab.experiments import runner
+
+    started = []
+
+    class Counting(runner.ProcessPoolExecutor):
+        def __init__(self, *args, **kwargs):
+            started.append(kwargs.get("max_workers"))
+            super().__init__(*args, **kwargs)
+
+    monkeypatch.setattr(runner, "ProcessPoolExecutor", Counting)
+    monkeypatch.setattr(report, "names", lambda: ["shm-depth", "kams-accuracy"])
+    plan = {"shm-depth": (1, 1, True), "kams-accuracy": (1, 1, True)}
+    report.run_all(tmp_path / "two", jobs=2, plan=plan)
+    assert started == [2]
+    report.run_all(tmp_path / "one", jobs=1, plan=plan)
+    assert started == [2]  # in this process
+    for name in plan:
+        for f in ("results.json", "table.md"):
+            a = tmp_path / "two" / "experiments" / name / f
+            assert a.read_bytes() == (tmp_path / "one" / "experiments" / name / f).read_bytes()
+
+
 def test_same_bytes_on_a_dask_cluster(reference, tmp_path):
     distributed = pytest.importorskip("distributed")
     with distributed.LocalCluster(
@@ -121,6 +145,23 @@ def test_same_bytes_on_a_dask_cluster(reference, tmp_path):
     ) as cluster:
         run_experiment(NAME, tmp_path, scheduler=cluster.scheduler_address, **KW)
     assert (tmp_path / "results.json").read_bytes() == (reference / "results.json").read_bytes()
+
+
+def test_experiment_all_on_a_dask_cluster(tmp_path, monkeypatch):
+    distributed = pytest.importorskip("distributed")
+    from scenegen.lab import report
+
+    monkeypatch.setattr(report, "names", lambda: ["shm-depth", NAME])
+    plan = {"shm-depth": (1, 1, True), NAME: (1, 1, True)}
+    with distributed.LocalCluster(
+        n_workers=2, processes=True, threads_per_worker=1, dashboard_address=None
+    ) as cluster:
+        report.run_all(tmp_path / "dask", scheduler=cluster.scheduler_address, plan=plan)
+    report.run_all(tmp_path / "local", jobs=1, plan=plan)
+    for name in plan:
+        a = tmp_path / "dask" / "experiments" / name / "results.json"
+        assert a.read_bytes() == (tmp_path / "local" / "experiments" / name
+                                  / "results.json").read_bytes()
 
 
 def test_lost_dask_worker_loses_no_results(reference, tmp_path):
