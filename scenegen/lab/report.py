@@ -78,16 +78,27 @@ def run_all(
     Path
         The ``index.html`` written.
     """
+    from scenegen.lab.experiments.runner import plan_tasks, workers
+
     out = Path(out_dir) / "experiments"
-    for name in names():
-        s, r, q = plan[name] if plan else (scenes, runs, quick)
-        folder = out / name
-        if progress:
-            print(f"  experiment {name}", file=sys.stderr, flush=True)
-        res = run_experiment(name, folder, runs=r, scenes=s, jobs=jobs, scheduler=scheduler,
-                             seed=seed, quick=q, progress=progress)
-        if say is not None:
-            say(name, res, folder / "table.md")
+    # One set of workers for every experiment, given every experiment's tasks at once: they
+    # run the next experiment's tasks while this process summarises the previous one.
+    with workers(jobs=jobs, scheduler=scheduler) as pool:
+        for name in names():
+            s, r, q = plan[name] if plan else (scenes, runs, quick)
+            exp = get(name)
+            tasks = plan_tasks(exp, runs=exp.runs if r is None else r,
+                               scenes=exp.scenes if s is None else s, seed=seed, quick=q)
+            pool.start(tasks, out / name / "runs")
+        for name in names():
+            s, r, q = plan[name] if plan else (scenes, runs, quick)
+            folder = out / name
+            if progress:
+                print(f"  experiment {name}", file=sys.stderr, flush=True)
+            res = run_experiment(name, folder, runs=r, scenes=s, jobs=jobs,
+                                 scheduler=scheduler, seed=seed, quick=q, progress=progress)
+            if say is not None:
+                say(name, res, folder / "table.md")
     return build_report(out_dir)
 
 

@@ -17,7 +17,10 @@ From the command line::
 
 Dask workers need this package installed; each run generates its own sequence, so only
 the small task key and the run's record travel over the network. Numba kernels run on one
-thread per task, so one worker thread per core is the right setting.
+thread per task, so one worker thread per core is the right setting. Local workers run a
+scene's tasks in batches (the sequence is generated once and kept for the next batch);
+``scenegen experiment all`` starts its workers once and hands them every experiment's tasks
+at once, so they run the next experiment while this process summarises the previous one.
 
 Example
 -------

@@ -33,14 +33,19 @@ from scenegen.errors import ConfigError
 from scenegen.lab.experiments.definitions import Experiment, get
 
 __all__ = [
+    "BATCH",
     "SCHEDULER_TIMEOUT",
     "Task",
+    "Workers",
+    "batches",
     "derive_seed",
     "execute",
     "load_record",
     "plan_tasks",
+    "run_batch",
     "run_task",
     "tracker_params",
+    "workers",
     "write_json_atomic",
 ]
 
@@ -431,6 +436,10 @@ def execute(
 ) -> list[dict[str, Any]]:
     """Run the tasks not yet stored under ``runs_dir`` and return every task's record.
 
+    Inside :func:`workers` with the same ``jobs`` and ``scheduler``, the tasks run on that
+    block's workers (and tasks it has already started are collected, not started again);
+    otherwise on workers started for this call.
+
     Parameters
     ----------
     tasks : list of Task
@@ -461,10 +470,12 @@ def execute(
     if jobs is not None and jobs < 1:
         raise ConfigError(f"jobs must be >= 1, got {jobs}")
     runs_dir.mkdir(parents=True, exist_ok=True)
+    shared = _ACTIVE[-1] if _ACTIVE and _ACTIVE[-1].serves(jobs, scheduler) else None
     records: dict[Task, dict[str, Any]] = {}
     todo = []
     for t in tasks:
-        rec = load_record(runs_dir / t.filename(), t)
+        rec = None if shared and shared.started(runs_dir, t) else load_record(
+            runs_dir / t.filename(), t)
         if rec is None:
             todo.append(t)
         else:
@@ -482,47 +493,187 @@ def execute(
             on_done(t)
 
     try:
-        if todo and scheduler is not None:
-            _run_dask(todo, scheduler, store)
-        elif todo and (jobs or os.cpu_count() or 1) > 1 and len(todo) > 1:
-            _run_pool(todo, jobs or os.cpu_count() or 1, store)
-        else:
-            for t in todo:
-                store(t, run_task(t))
+        if shared is not None:
+            shared.collect(todo, runs_dir, store)
+        elif todo:
+            with Workers(jobs, scheduler) as own:
+                own.collect(todo, runs_dir, store)
     finally:
         bar.close()
     return [records[t] for t in tasks]
 
 
-def _run_pool(todo: list[Task], jobs: int, store: Callable[[Task, dict[str, Any]], None]) -> None:
-    # forkserver: never fork a parent whose numba threads may already be running.
-    ctx = get_context("forkserver")
-    with ProcessPoolExecutor(max_workers=min(jobs, len(todo)), mp_context=ctx) as pool:
-        futures = {pool.submit(run_task, t): t for t in todo}
+BATCH = 8
+"""Most tasks of one scene that a local worker runs per call (it generates the scene once)."""
+
+# Imported by the fork server before it forks a worker, so that workers start with them.
+_PRELOAD = (
+    "numpy",
+    "numba",
+    "scenegen",
+    "scenegen.lab.experiments.runner",
+    "scenegen.lab.run",
+    "scenegen.evaluation.evaluate",
+    "scenegen.evaluation.metrics",
+    "trackers",
+)
+
+
+def batches(tasks: list[Task], size: int = BATCH) -> list[list[Task]]:
+    """``tasks`` grouped by scene (in order of first appearance), in chunks of at most
+    ``size``: a worker running a chunk generates its sequence once (and keeps the last few
+    in memory, so the next chunk of the same scene reuses it).
+
+    Example
+    -------
+    >>> from scenegen.lab.experiments.definitions import get
+    >>> tasks = plan_tasks(get("shm-depth"), runs=1, scenes=2, seed=0, quick=True)
+    >>> [[(t.preset, t.scene) for t in b][0] for b in batches(tasks)]
+    [('shm-crossing', 0), ('shm-crossing', 1), ('shm-clutter', 0), ('shm-clutter', 1)]
+    """
+    if size < 1:
+        raise ConfigError(f"batch size must be >= 1, got {size}")
+    groups: dict[tuple[Any, ...], list[Task]] = {}
+    for t in tasks:
+        groups.setdefault((t.experiment, t.preset, t.scene, t.seed, t.quick), []).append(t)
+    return [g[i:i + size] for g in groups.values() for i in range(0, len(g), size)]
+
+
+def run_batch(tasks: list[Task]) -> list[dict[str, Any]]:
+    """:func:`run_task` of each task, in order (what a local worker runs per call)."""
+    return [run_task(t) for t in tasks]
+
+
+_ACTIVE: list[Workers] = []
+
+
+def workers(jobs: int | None = None, scheduler: str | None = None) -> Workers:
+    """Workers that stay up for every :func:`execute` in a ``with`` block.
+
+    ``scenegen experiment all`` starts its worker processes once (instead of once per
+    experiment) and starts every experiment's tasks at once, so that the workers run the
+    next experiment's tasks while this process summarises the previous one::
+
+        with workers(jobs=2) as w:
+            for tasks, runs_dir in plans:
+                w.start(tasks, runs_dir)
+            for tasks, runs_dir in plans:
+                records = execute(tasks, runs_dir, jobs=2)   # collects what was started
+
+    Records are the same as without the block (each task derives its seeds from its key).
+
+    Raises
+    ------
+    ConfigError
+        For jobs < 1 or an unreachable scheduler (when the block starts).
+    """
+    if jobs is not None and jobs < 1:
+        raise ConfigError(f"jobs must be >= 1, got {jobs}")
+    return Workers(jobs, scheduler, active=True)
+
+
+class Workers:
+    """A local process pool, a Dask client, or this process (``jobs`` 1), started once.
+
+    Local workers run :data:`BATCH` tasks of one scene per call (:func:`batches`); a Dask
+    client gets one task per call (retried up to 3 times if its worker is lost). Use
+    :func:`workers`.
+    """
+
+    def __init__(self, jobs: int | None, scheduler: str | None, *, active: bool = False):
+        self.jobs = jobs
+        self.scheduler = scheduler
+        self._n = 1 if scheduler is None and jobs == 1 else (jobs or os.cpu_count() or 1)
+        self._active = active
+        self._pool: Any = None
+        self._client: Any = None
+        self._pending: dict[tuple[Path, Task], tuple[Any, int | None]] = {}
+
+    def serves(self, jobs: int | None, scheduler: str | None) -> bool:
+        """Whether :func:`execute` with these settings runs on these workers."""
+        return (jobs, scheduler) == (self.jobs, self.scheduler)
+
+    def __enter__(self) -> Workers:
+        if self.scheduler is not None:
+            self._client = connect(self.scheduler)
+        if self._active:
+            _ACTIVE.append(self)
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        if self._active:
+            _ACTIVE.remove(self)
+        for fut, _ in self._pending.values():
+            fut.cancel()
+        self._pending.clear()
+        if self._pool is not None:
+            self._pool.shutdown(wait=True, cancel_futures=True)
+            self._pool = None
+        if self._client is not None:
+            self._client.close()
+            self._client = None
+
+    def started(self, runs_dir: Path, task: Task) -> bool:
+        """Whether ``task`` (stored under ``runs_dir``) was started and not yet collected."""
+        return (runs_dir, task) in self._pending
+
+    def start(self, tasks: list[Task], runs_dir: Path) -> None:
+        """Start the tasks not yet stored under ``runs_dir`` (nor started); their records
+        are stored by the :func:`execute` that collects them. In this process (``jobs``
+        1) nothing starts early: the tasks run when collected."""
+        todo = [t for t in tasks if not self.started(runs_dir, t)
+                and load_record(runs_dir / t.filename(), t) is None]
+        if self._client is not None or self._n > 1:
+            self._submit(todo, runs_dir)
+
+    def _submit(self, todo: list[Task], runs_dir: Path) -> None:
+        if self._client is not None:
+            for t in (t for b in batches(todo) for t in b):  # scene by scene
+                fut = self._client.submit(
+                    run_task, t, key=f"scenegen-{t.experiment}-{t.filename()}", retries=3,
+                    pure=False,
+                )
+                self._pending[runs_dir, t] = (fut, None)
+            return
+        if self._pool is None:
+            # forkserver: never fork a parent whose numba threads may already be running;
+            # the server imports the heavy modules once, and every worker forks from it.
+            ctx = get_context("forkserver")
+            ctx.set_forkserver_preload(["__main__", *_PRELOAD])
+            self._pool = ProcessPoolExecutor(max_workers=self._n, mp_context=ctx)
+        for b in batches(todo):
+            fut = self._pool.submit(run_batch, b)
+            for i, t in enumerate(b):
+                self._pending[runs_dir, t] = (fut, i)
+
+    def collect(
+        self, todo: list[Task], runs_dir: Path, store: Callable[[Task, dict[str, Any]], None]
+    ) -> None:
+        """Run (or wait for) every task of ``todo`` and ``store`` each record as it
+        arrives."""
+        if self._client is None and self._pool is None and (self._n == 1 or len(todo) < 2):
+            for t in todo:
+                store(t, run_task(t))
+            return
+        self._submit([t for t in todo if not self.started(runs_dir, t)], runs_dir)
+        by_future: dict[Any, list[tuple[Task, int | None]]] = {}
+        for t in todo:
+            fut, i = self._pending[runs_dir, t]
+            by_future.setdefault(fut, []).append((t, i))
         try:
-            for fut in as_completed(futures):
-                store(futures[fut], fut.result())
+            for fut in self._completed(list(by_future)):
+                out = fut.result()
+                for t, i in by_future[fut]:
+                    del self._pending[runs_dir, t]
+                    store(t, out if i is None else out[i])
         except BaseException:
-            for fut in futures:
+            for fut, _ in self._pending.values():
                 fut.cancel()
             raise
 
+    def _completed(self, futures: list[Any]) -> Iterable[Any]:
+        if self._client is not None:
+            from distributed import as_completed as dask_completed
 
-def _run_dask(
-    todo: list[Task], address: str, store: Callable[[Task, dict[str, Any]], None]
-) -> None:
-    from distributed import as_completed as dask_completed
-
-    client = connect(address)
-    try:
-        futures = {}
-        for t in todo:
-            fut = client.submit(
-                run_task, t, key=f"scenegen-{t.experiment}-{t.filename()}", retries=3,
-                pure=False,
-            )
-            futures[fut.key] = (fut, t)
-        for fut in dask_completed([f for f, _ in futures.values()], loop=client.loop):
-            store(futures[fut.key][1], fut.result())
-    finally:
-        client.close()
+            return dask_completed(futures, loop=self._client.loop)
+        return as_completed(futures)

@@ -14,7 +14,16 @@ import pytest
 from scenegen.cli import experiment as cli_experiment
 from scenegen.errors import ConfigError
 from scenegen.lab.experiments import derive_seed, get, names, run_experiment
-from scenegen.lab.experiments.runner import Task, execute, plan_tasks
+from scenegen.lab.experiments.runner import (
+    BATCH,
+    Task,
+    batches,
+    execute,
+    plan_tasks,
+    run_batch,
+    run_task,
+    workers,
+)
 
 # A small stochastic sweep: two scenes, one seeded run each, of two particle filters
 # (quick: fewer particles, λ = 20 only).
@@ -54,6 +63,81 @@ def test_same_bytes_with_two_local_processes(reference, tmp_path):
     assert (tmp_path / "table.md").read_bytes() == (reference / "table.md").read_bytes()
 
 
+def test_batches_group_a_scene_s_tasks_and_keep_every_task_once():
+    tasks = plan_tasks(get("dps-occlusion"), runs=3, scenes=2, seed=0, quick=True)
+    out = batches(tasks)
+    flat = [t for b in out for t in b]
+    assert len(flat) == len(tasks) and set(flat) == set(tasks)
+    for b in out:
+        assert 1 <= len(b) <= BATCH and len({(t.preset, t.scene) for t in b}) == 1
+    # Scene by scene: a scene's batches are consecutive.
+    scenes = [(b[0].preset, b[0].scene) for b in out]
+    assert [k for i, k in enumerate(scenes) if i == 0 or scenes[i - 1] != k] == list(
+        dict.fromkeys(scenes))
+    with pytest.raises(ConfigError, match="batch size"):
+        batches(tasks, 0)
+
+
+def test_a_batch_gives_the_records_of_its_tasks_run_alone():
+    # Scene 1's tasks after scene 0's, with the sequence cache warm: the same records as
+    # each task run on its own after a different scene.
+    tasks = plan_tasks(get("shm-depth"), runs=2, scenes=2, seed=0, quick=True,
+                       methods=["kalman", "shm-fast"])
+    tasks = [t for t in tasks if t.preset == "shm-crossing"]
+    alone = {}
+    for t in reversed(tasks):
+        alone[t] = json.dumps(run_task(t), sort_keys=True)
+    for b in batches(tasks, 3):
+        for t, rec in zip(b, run_batch(b), strict=True):
+            assert json.dumps(rec, sort_keys=True) == alone[t]
+
+
+def test_shared_workers_give_the_same_records_as_one_process(reference, tmp_path):
+    # Two sweeps started at once on one pool (what `experiment all` does), collected in
+    # the other order: every run file has the bytes of the plain in-process path.
+    mine = plan_tasks(get(NAME), runs=1, scenes=2, seed=0, quick=True, methods=METHODS)
+    shm = plan_tasks(get("shm-depth"), runs=1, scenes=2, seed=0, quick=True,
+                     methods=["kalman"])
+    a, b, plain = tmp_path / "a" / "runs", tmp_path / "b" / "runs", tmp_path / "plain"
+    with workers(jobs=2) as pool:
+        pool.start(mine, a)
+        pool.start(shm, b)
+        assert pool.started(a, mine[0]) and pool.started(b, shm[-1])
+        got_shm = execute(shm, b, jobs=2, progress=False)
+        got = execute(mine, a, jobs=2, progress=False)
+        assert not pool.started(a, mine[0])
+    assert got_shm == execute(shm, plain, jobs=1, progress=False)
+    assert got == execute(mine, reference / "runs", jobs=1, progress=False)
+    for t in mine:
+        assert (a / t.filename()).read_bytes() == (reference / "runs" / t.filename()).read_bytes()
+    for t in shm:
+        assert (b / t.filename()).read_bytes() == (plain / t.filename()).read_bytes()
+
+
+def test_experiment_all_starts_its_workers_once(tmp_path, monkeypatch):
+    from scenegen.lab import report
+    from scenegen.lab.experiments import runner
+
+    started = []
+
+    class Counting(runner.ProcessPoolExecutor):
+        def __init__(self, *args, **kwargs):
+            started.append(kwargs.get("max_workers"))
+            super().__init__(*args, **kwargs)
+
+    monkeypatch.setattr(runner, "ProcessPoolExecutor", Counting)
+    monkeypatch.setattr(report, "names", lambda: ["shm-depth", "kams-accuracy"])
+    plan = {"shm-depth": (1, 1, True), "kams-accuracy": (1, 1, True)}
+    report.run_all(tmp_path / "two", jobs=2, plan=plan)
+    assert started == [2]
+    report.run_all(tmp_path / "one", jobs=1, plan=plan)
+    assert started == [2]  # in this process
+    for name in plan:
+        for f in ("results.json", "table.md"):
+            a = tmp_path / "two" / "experiments" / name / f
+            assert a.read_bytes() == (tmp_path / "one" / "experiments" / name / f).read_bytes()
+
+
 def test_same_bytes_on_a_dask_cluster(reference, tmp_path):
     distributed = pytest.importorskip("distributed")
     with distributed.LocalCluster(
@@ -61,6 +145,23 @@ def test_same_bytes_on_a_dask_cluster(reference, tmp_path):
     ) as cluster:
         run_experiment(NAME, tmp_path, scheduler=cluster.scheduler_address, **KW)
     assert (tmp_path / "results.json").read_bytes() == (reference / "results.json").read_bytes()
+
+
+def test_experiment_all_on_a_dask_cluster(tmp_path, monkeypatch):
+    distributed = pytest.importorskip("distributed")
+    from scenegen.lab import report
+
+    monkeypatch.setattr(report, "names", lambda: ["shm-depth", NAME])
+    plan = {"shm-depth": (1, 1, True), NAME: (1, 1, True)}
+    with distributed.LocalCluster(
+        n_workers=2, processes=True, threads_per_worker=1, dashboard_address=None
+    ) as cluster:
+        report.run_all(tmp_path / "dask", scheduler=cluster.scheduler_address, plan=plan)
+    report.run_all(tmp_path / "local", jobs=1, plan=plan)
+    for name in plan:
+        a = tmp_path / "dask" / "experiments" / name / "results.json"
+        assert a.read_bytes() == (tmp_path / "local" / "experiments" / name
+                                  / "results.json").read_bytes()
 
 
 def test_lost_dask_worker_loses_no_results(reference, tmp_path):
