@@ -23,7 +23,13 @@ Every step starts by resampling the set by the previous step's weights, so after
 ``self.particles`` (N, K, 3) and ``self.weights`` are the weighted set that represents
 the posterior; its weighted mean per object is the estimate. ``Estimate.extras`` carries
 ``uniqueness`` (K,) and ``effective_dynamics`` (K,) (``trackers.filters.diagnostics``; the
-latter averages u and v). Initialisation: the reference histograms are taken from the
+latter averages u and v). A diagnostic hook, ``propagation_hook`` (None by default), is
+called as ``hook(before, after, objects)`` after every propagation of ``joint-pf``,
+``ps`` and ``dps``: row r moved object ``objects[r]`` (N,) from state ``before[r]`` to
+``after[r]`` (both (N, 3); joint-pf moves every object of every row: one call per
+object). It tells how many distinct hypotheses each object's dynamics spread from, and
+how far (docs/experiments.md, "DPS Table 3"). The arrays are the hook's to keep.
+Initialisation: the reference histograms are taken from the
 frame-0 boxes and every particle starts on its initial box with zero velocity.
 
 Example
@@ -42,6 +48,7 @@ True
 from __future__ import annotations
 
 from abc import abstractmethod
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -255,6 +262,8 @@ class _ParticleTracker(Tracker):
         self.dynamics = AR2(sigma=params.sigma, a1=params.a1, a2=params.a2)
         self.particles = np.empty((0, 0, 3))
         self.weights = np.empty(0)
+        self.propagation_hook: Callable[[NDArray, NDArray, NDArray], None] | None
+        self.propagation_hook = None
 
     def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
         self.model.set_references(frame, boxes)
@@ -342,6 +351,10 @@ class JointPF(_ParticleTracker):
         idx = resample(self.weights, method=self.params.resampler, rng=self.rng)
         x, prev = gather_pair(self.particles, self._prev, idx)
         new = self.dynamics.propagate(x, prev, self._mean, rng=self.rng)
+        if self.propagation_hook is not None:
+            for i in range(k):
+                self.propagation_hook(x[:, i].copy(), new[:, i].copy(),
+                                      np.full(n, i, dtype=np.int64))
         objects = np.tile(np.arange(k), n)
         ll = obs.log_likelihoods(self._boxes(new.reshape(-1, 3), objects), objects)
         self._prev = x
@@ -374,10 +387,15 @@ class _Partitioned(_ParticleTracker):
         logpi = np.zeros(n)
         ll = np.zeros((n, m))
         log_g = np.zeros(n)
+        hook = self.propagation_hook
+        rows = np.arange(n)
         # Stage 0's AR2 (the (N, 3) normals of ``AR2.propagate``); every later stage's
         # comes with the previous stage's weighted resampling, in one kernel call.
         new = propagate_objects(x, prev, objects[0], self.rng.standard_normal((n, 3)),
                                 self._mean, dyn._sigma, dyn.a1, dyn.a2)
+        if hook is not None:
+            # Propagation is in place: the moved objects' old states are now in prev.
+            hook(prev[rows, objects[0]], new.copy(), objects[0].copy())
         for j in range(m):
             obj = objects[j]
             boxes = state_boxes(new, np.exp(new[:, 2]), self._sizes, obj)
@@ -411,6 +429,8 @@ class _Partitioned(_ParticleTracker):
                                         dyn._sigma, dyn.a1, dyn.a2)
             else:
                 w, x, prev, ll, log_g, new = out
+            if hook is not None:
+                hook(prev[rows, objects[j + 1]], new.copy(), objects[j + 1].copy())
             logpi = np.log(w)
         # The set {x, π'} still represents the predicted joint state (weighted resampling
         # preserves it), so π' Π_i p(Z | X_i) are the unnormalised posterior weights w̃.

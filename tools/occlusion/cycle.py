@@ -16,9 +16,8 @@ For each method of the ``dps-occlusion`` experiment it prints, averaged over fra
 The end-of-step uniqueness depends on where the walker sits in the ordering; the first two
 are measured at the walker's own propagation, the same point of the cycle for every
 method (docs/experiments.md, "DPS Table 3: why the orderings cannot differ").
-It wraps ``trackers.models.dynamics.AR2.propagate`` to see the propagated rows and reads the
-PS/DPS orderings and group sizes from the tracker's private attributes (a diagnostic, not
-an interface).
+It reads the walker's states before each propagation through the trackers'
+``propagation_hook`` (tested in ``tests/trackers/test_ps_cycle.py``).
 """
 
 from __future__ import annotations
@@ -32,16 +31,6 @@ import scenegen
 import trackers
 from scenegen.lab.experiments.definitions import get
 from scenegen.lab.experiments.runner import derive_seed, scene_seed
-from trackers.models import dynamics
-
-_CALLS: list[tuple[np.ndarray, np.ndarray]] = []
-_propagate = dynamics.AR2.propagate
-
-
-def _recording(self, x, prev, mean, rng):
-    new = _propagate(self, x, prev, mean, rng=rng)
-    _CALLS.append((np.array(x, copy=True), np.array(new, copy=True)))
-    return new
 
 
 def measure(preset: str, base: int, scene: int, slug: str, run: int) -> np.ndarray:
@@ -55,21 +44,19 @@ def measure(preset: str, base: int, scene: int, slug: str, run: int) -> np.ndarr
     tr.init(np.asarray(frames[0]), seq.init_boxes(0))
     walker = 0  # the walker is the first target of both presets
     vis = np.asarray(seq.gt.visibility[:, seq.initial_targets(0)[walker]])
+    moved: list[tuple[np.ndarray, np.ndarray]] = []
+
+    def hook(before: np.ndarray, after: np.ndarray, objects: np.ndarray) -> None:
+        moved.append((before[objects == walker], after[objects == walker]))
+
+    tr.propagation_hook = hook
     rows = []
     for t in range(1, len(frames)):
-        _CALLS.clear()
+        moved.clear()
         est = tr.step(np.asarray(frames[t]))
-        if method.tracker == "joint-pf":
-            x, new = _CALLS[0]
-            xw, nw = x[:, walker], new[:, walker]
-        else:
-            orders = tr._orders if hasattr(tr, "_orders") else tr._order
-            sizes = tr._sizes_c if hasattr(tr, "_sizes_c") else np.array([tr.params.n_particles])
-            group = np.repeat(np.arange(sizes.size), sizes)
-            sel = [orders[group, j] == walker for j in range(len(_CALLS))]
-            xw = np.concatenate([c[0][s] for c, s in zip(_CALLS, sel, strict=True)])
-            nw = np.concatenate([c[1][s] for c, s in zip(_CALLS, sel, strict=True)])
-        rows.append((np.unique(xw, axis=0).shape[0] / xw.shape[0], nw[:, 0].std(),
+        old = np.concatenate([b for b, _ in moved])
+        new = np.concatenate([a for _, a in moved])  # the walker's propagated candidates
+        rows.append((np.unique(old, axis=0).shape[0] / old.shape[0], new[:, 0].std(),
                      est.extras["uniqueness"][walker]))
     rows_a = np.asarray(rows)
     hidden = vis[1:] < 0.05
@@ -85,7 +72,6 @@ def main() -> None:
     args = ap.parse_args()
     bases = [int(b) for b in args.seeds.split(",")]
     numba.set_num_threads(1)
-    dynamics.AR2.propagate = _recording
     print("method   ancestors %  spread px  end uniq. %  | hidden: ancestors %  spread px")
     for m in get("dps-occlusion").methods:
         v = np.mean([measure(args.preset, b, s, m.slug, r) for b in bases
