@@ -415,7 +415,8 @@ class Background:
                 _fail("source", str(err))
         _check_color("color", self.color)
         if not 0 <= self.low <= self.high <= 255:
-            _fail("low", f"need 0 <= low <= high <= 255, got low={self.low} high={self.high}")
+            _fail("low", f"need 0 <= low <= high <= 255, got low={_short(self.low)} "
+                         f"high={_short(self.high)}")
         if not 0 < self.scale <= MAX_BLUR:
             _fail("scale", f"must be in (0, {MAX_BLUR:g}], got {_short(self.scale)}")
 

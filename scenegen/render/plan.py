@@ -27,7 +27,7 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
-from scenegen.config import Background, EntitySpec, SceneConfig
+from scenegen.config import Background, EntitySpec, SceneConfig, _short
 from scenegen.errors import ConfigError
 from scenegen.render import compose as kernels
 from scenegen.render import photometric, textures
@@ -55,7 +55,7 @@ def resolve_seed(seed: int | np.integer | None) -> int:
     if seed is None:
         return int(np.random.SeedSequence().generate_state(1, dtype=np.uint64)[0] >> 1)
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise ConfigError(f"seed must be a non-negative integer, got {seed!r}")
+        raise ConfigError(f"seed must be a non-negative integer, got {_short(seed)}")
     return int(seed)
 
 
@@ -788,7 +788,7 @@ def generate(
     cfg, preset = _resolve(config)
     if frames is not None:
         if frames < 1:
-            raise ConfigError(f"frames must be >= 1, got {frames}")
+            raise ConfigError(f"frames must be >= 1, got {_short(frames)}")
         cfg = replace(cfg, n_frames=int(frames))
     scn = plan(cfg, seed, preset=preset)
     chunk = scn.render()

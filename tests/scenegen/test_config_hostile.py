@@ -258,3 +258,22 @@ def test_hostile_configs_through_yaml_files(tmp_path_factory, data):
         load_config(path)
     except ConfigError as err:
         one_line(str(err))
+
+
+def test_huge_numbers_in_messages_are_cut_short():
+    # Found by the slow fuzz run: background.low/high echoed a 300-digit integer in full.
+    import scenegen
+
+    huge = 10**300
+    for cfg in ({"width": 64, "height": 48, "n_frames": 2,
+                 "background": {"low": 0, "high": huge}},):
+        try:
+            from_dict(cfg)
+        except ConfigError as err:
+            assert len(str(err)) < 300 and "background.low" in str(err)
+        else:
+            raise AssertionError("accepted a high of 10**300")
+    for kwargs in ({"seed": -huge}, {"seed": 0, "frames": -huge}):
+        with pytest.raises(ConfigError) as info:
+            scenegen.generate("kams-a", **kwargs)
+        assert len(str(info.value)) < 300
