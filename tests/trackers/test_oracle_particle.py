@@ -61,6 +61,7 @@ Each one-line error below fails the fast test in every configuration it touches
 
 from __future__ import annotations
 
+import linear_gaussian
 import numpy as np
 import pytest
 from filterpy.kalman import KalmanFilter
@@ -77,16 +78,7 @@ K = len(START)
 
 def measurements(zseed: int) -> np.ndarray:
     """z (T, K, 2): a constant-velocity track with noise sigma, measured with noise r."""
-    rng = np.random.default_rng([zseed, 2024])
-    truth = np.empty((T, K, 2))
-    truth[0] = START
-    prev = START.copy()
-    for t in range(1, T):
-        truth[t] = 2 * truth[t - 1] - prev + SIGMA * rng.standard_normal((K, 2))
-        prev = truth[t - 1]
-    z = truth + R_STD * rng.standard_normal(truth.shape)
-    z[0] = START
-    return z
+    return linear_gaussian.measurements(zseed, START, T, SIGMA, R_STD, salt=2024)
 
 
 def kalman_posterior(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

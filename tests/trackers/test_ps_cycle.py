@@ -13,6 +13,7 @@ the trackers' ``propagation_hook``.
 
 from __future__ import annotations
 
+import linear_gaussian
 import numpy as np
 import pytest
 
@@ -24,22 +25,9 @@ SIGMA, R_STD = 2.0, 2.0
 START = np.array([[60.0, 50.0], [120.0, 70.0], [90.0, 130.0]])
 
 
-def _measurements(zseed: int) -> np.ndarray:
-    rng = np.random.default_rng([zseed, 77])
-    truth = np.empty((T, K, 2))
-    truth[0] = START
-    prev = START.copy()
-    for t in range(1, T):
-        truth[t] = 2 * truth[t - 1] - prev + SIGMA * rng.standard_normal((K, 2))
-        prev = truth[t - 1]
-    z = truth + R_STD * rng.standard_normal(truth.shape)
-    z[0] = START
-    return z
-
-
 def _diversity(name: str, params: dict, seed: int) -> tuple[np.ndarray, np.ndarray]:
     """Per object: distinct ancestors / N at its own propagation, and end-of-step uniqueness."""
-    z = _measurements(1)
+    z = linear_gaussian.measurements(1, START, T, SIGMA, R_STD, salt=77)
     tracker = trackers.make(name, n_particles=N, sigma=(SIGMA, SIGMA, 0.0),
                             observation=PositionModel(z, np.eye(2) * R_STD**2), rng=seed,
                             **params)
