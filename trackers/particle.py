@@ -94,12 +94,17 @@ __all__ = [
     "JointPF",
     "PSParams",
     "ParticleParams",
+    "PartitionedParams",
     "PartitionedSampling",
+    "WEIGHTINGS",
     "circular_shift",
 ]
 
 #: Rules that assign particles to the DPS mixture components (``assignment``).
 ASSIGNMENTS: tuple[str, ...] = ("random", "interleaved")
+
+#: Weighting functions of PS's weighted resampling stages (``weighting``).
+WEIGHTINGS: tuple[str, ...] = ("stage", "placed", "g-only")
 
 
 def circular_shift(n_objects: int, k: int) -> NDArray[np.int64]:
@@ -170,8 +175,37 @@ class ParticleParams(TrackerParams):
 
 
 @dataclass(frozen=True)
-class PSParams(ParticleParams):
-    """Parameters of partitioned sampling: ``ParticleParams`` and ``ordering``.
+class PartitionedParams(ParticleParams):
+    """Parameters shared by PS and DPS: ``ParticleParams`` and ``weighting``.
+
+    Parameters
+    ----------
+    weighting : {"stage", "placed", "g-only"}, optional
+        **(open)** The weighting function g_j of stage j's weighted resampling, which
+        draws ancestors ∝ π g_j with π the weights carried from stage j − 1 (∝ 1 / g_{j−1})
+        and gives them the weight π / ρ. "stage" (default): g_j = p(Z | X_{o_j}), the
+        stage's object alone, as DPS §3 and MacCormick & Blake write it; ancestors are then
+        drawn ∝ p(Z | X_{o_j}) / p(Z | X_{o_{j−1}}), which thins the previous object's good
+        hypotheses, and the final weights keep p(Z | X_{o_i}) of every object but
+        o_{M−1}, so the ordering decides how many distinct hypotheses an object moves from.
+        "placed": g_j = Π_{i<=j} p(Z | X_{o_i}), the objects placed so far, so ancestors
+        are drawn ∝ p(Z | X_{o_j}) and every object gets the same selections per step
+        whatever its place. "g-only": ρ ∝ g_j = Π_{i<=j} p(Z | X_{o_i}) without π (the
+        first object is selected at every stage, then penalised by the final weights).
+        All three keep the set a correct weighted sample of the same posterior
+        (docs/algorithms.md §2.5).
+    """
+
+    weighting: str = "stage"
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        check_choice(self, "weighting", WEIGHTINGS, what="weighting")
+
+
+@dataclass(frozen=True)
+class PSParams(PartitionedParams):
+    """Parameters of partitioned sampling: ``PartitionedParams`` and ``ordering``.
 
     Parameters
     ----------
@@ -200,8 +234,8 @@ class PSParams(ParticleParams):
 
 
 @dataclass(frozen=True)
-class DPSParams(ParticleParams):
-    """Parameters of distributed partitioned sampling: ``ParticleParams`` and the groups.
+class DPSParams(PartitionedParams):
+    """Parameters of distributed partitioned sampling: ``PartitionedParams`` and the groups.
 
     Parameters
     ----------
@@ -389,6 +423,8 @@ class _Partitioned(_ParticleTracker):
         log_g = np.zeros(n)
         hook = self.propagation_hook
         rows = np.arange(n)
+        stage_only = self.params.weighting == "stage"
+        g_only = self.params.weighting == "g-only"
         # Stage 0's AR2 (the (N, 3) normals of ``AR2.propagate``); every later stage's
         # comes with the previous stage's weighted resampling, in one kernel call.
         new = propagate_objects(x, prev, objects[0], self.rng.standard_normal((n, 3)),
@@ -403,13 +439,18 @@ class _Partitioned(_ParticleTracker):
             if j == m - 1:
                 ll[np.arange(n), obj] = stage
                 break
-            # Weighted resampling (DPS §3) inside each group with the weighting function
-            # g_j = Π_{i<=j} p(Z | X_{o_i}) of the objects placed so far. The carried
-            # weights are π ∝ 1 / g_{j-1}, so ancestors are drawn ∝ p(Z | X_{o_j}) and
-            # the particles stay concentrated where every placed object is likely;
-            # weighting by p(Z | X_{o_j}) alone would undo the earlier stages.
+            # Weighted resampling (DPS §3) inside each group: ancestors ∝ π g_j, weights
+            # π / ρ. "stage": g_j = p(Z | X_{o_j}); "placed": g_j = Π_{i<=j} p(Z | X_{o_i}),
+            # the objects placed so far (with π ∝ 1 / g_{j-1}, ancestors ∝ p(Z | X_{o_j}));
+            # "g-only": ρ ∝ g_j of the placed objects, π ignored.
             # Constant factors of π and g cancel: scale by the largest for range.
+            if stage_only:
+                log_g.fill(0.0)
             shifted, finite = stage_log_weights(stage, ll, log_g, logpi, obj)
+            if g_only:
+                # ρ ∝ g_j alone (π π'/π = g): pass g / π as the weighting function.
+                d = shifted[1] - shifted[0]
+                shifted[1] = d - d.max()
             pi_g = np.exp(shifted)
             out = None
             if mode is not None and finite:

@@ -167,6 +167,8 @@ def test_bad_boxes_and_frames_raise(name):
     ("ps", {"orderings": 1}, "unknown parameter 'orderings' for tracker 'ps'; valid: .*ordering"),
     ("dps", {"n_groups": 0}, "n_groups"),
     ("dps", {"assignment": "greedy"}, "unknown assignment 'greedy'; valid: random, interleaved"),
+    ("ps", {"weighting": "joint"}, "unknown weighting 'joint'; valid: stage, placed, g-only"),
+    ("joint-pf", {"weighting": "stage"}, "unknown parameter 'weighting' for tracker 'joint-pf'"),
     ("joint-pf", {"n_particles": 0}, "n_particles"),
     ("condensation", {"resampler": "best"}, "unknown resampler 'best'"),
     ("ps", {"model": "lab"}, "unknown observation model 'lab'"),

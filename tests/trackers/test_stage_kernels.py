@@ -267,10 +267,12 @@ def _reference_step(tr, frame):
         stage = obs.log_likelihoods(boxes_from_states(new, tr._sizes[obj]), obj)
         ll[rows, obj] = stage
         if j < m - 1:
-            log_g += stage
-            k, w = weighted_resample_groups(
-                np.exp(logpi - logpi.max()), np.exp(log_g - log_g.max()), sizes,
-                method=tr.params.resampler, rng=tr.rng)
+            log_g = stage.copy() if tr.params.weighting == "stage" else log_g + stage
+            a, b = logpi - logpi.max(), log_g - log_g.max()
+            if tr.params.weighting == "g-only":  # ρ ∝ g: weighting function g / π
+                b = (b - a) - (b - a).max()
+            k, w = weighted_resample_groups(np.exp(a), np.exp(b), sizes,
+                                            method=tr.params.resampler, rng=tr.rng)
             x, prev, ll, log_g = x[k], prev[k], ll[k], log_g[k]
             logpi = np.log(w)
     logw = logpi + ll.sum(axis=1)
@@ -289,6 +291,10 @@ def _reference_step(tr, frame):
     ("dps", {"n_groups": 3, "assignment": "interleaved", "resampler": "stratified"}),
     ("dps", {"resampler": "residual"}),
     ("ps", {"ordering": 1, "resampler": "multinomial", "a1": 1.5, "a2": -0.6}),
+    ("ps", {"weighting": "placed"}),
+    ("dps", {"weighting": "placed", "resampler": "residual"}),
+    ("ps", {"weighting": "g-only", "ordering": 2}),
+    ("dps", {"weighting": "g-only", "n_groups": 2}),
 ])
 def test_compiled_step_equals_the_numpy_reference_step(name, params):
     frames, boxes0 = _scene()
