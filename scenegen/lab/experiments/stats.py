@@ -2,9 +2,12 @@
 
 Intervals: :func:`wilson` for rates, :func:`newcombe_diff` for the difference of two rates,
 :func:`bootstrap_mean` and :func:`bootstrap_paired_diff` (percentile bootstrap, seeded) for
-means. Tests (one-sided, in the paper's direction): :func:`two_proportion_z` (independent
+means, and :func:`bootstrap_clustered_diff` for the difference of two rates over paired
+scenes (runs on one scene are not independent: the scene is resampled, not the run).
+Tests (one-sided, in the paper's direction): :func:`two_proportion_z` (independent
 samples), :func:`mcnemar_exact` (paired cases), :func:`chi2_homogeneity` (k rates equal?),
-:func:`binomial_greater` (one rate above a level). :func:`verdict` turns a p-value and an
+:func:`cochran_q` (k methods on the same cases equal?), :func:`binomial_greater` (one rate
+above a level). :func:`verdict` turns a p-value and an
 interval for the effect into "reproduced", "not reproduced" or "inconclusive":
 
 - **reproduced**: p < ``alpha`` in the paper's direction;
@@ -22,6 +25,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -33,9 +37,11 @@ __all__ = [
     "Test",
     "binomial_greater",
     "bootstrap_mean",
+    "bootstrap_clustered_diff",
     "bootstrap_paired_diff",
     "chi2_homogeneity",
     "chi2_sf",
+    "cochran_q",
     "mcnemar_exact",
     "newcombe_diff",
     "norm_ppf",
@@ -67,11 +73,15 @@ class Test:
         Its statistic (z, χ², or the discordant count), NaN where none.
     p_value : float
         One-sided p-value in the paper's direction (χ²: upper tail).
+    min_n : int
+        Fewest cases for the p-value to be trusted: 0 for exact tests, :data:`MIN_RUNS`
+        for resampling tests (a bootstrap over two scenes proves nothing).
     """
 
     name: str
     statistic: float
     p_value: float
+    min_n: int = 0
 
 
 def norm_sf(z: float) -> float:
@@ -182,6 +192,54 @@ def chi2_homogeneity(successes: Sequence[int], totals: Sequence[int]) -> Test:
     return Test(f"Pearson χ² homogeneity (df {s.size - 1})", chi2, chi2_sf(chi2, s.size - 1))
 
 
+def cochran_q(outcomes: ArrayLike) -> Test:
+    """Cochran's Q test that k methods succeed equally often on the same cases.
+
+    ``outcomes`` (n, k) of 0/1: case i (a row: the same scene and run for every method)
+    and method j. Q = (k − 1) (k Σ_j C_j² − T²) / (k T − Σ_i R_i²) with column totals C,
+    row totals R and total T, referred to χ² with k − 1 degrees of freedom. Cases where
+    every method agrees carry no information and drop out, so the scene's own difficulty,
+    shared by the methods run on it, does not count as a difference between them.
+    Q = 0, p = 1 when no case is discordant.
+    """
+    x = np.asarray(outcomes, dtype=np.float64)
+    if x.ndim != 2 or x.shape[1] < 2:
+        raise ValueError(f"need (cases, k >= 2) outcomes, got shape {x.shape}")
+    k = x.shape[1]
+    name = f"Cochran's Q over paired cases (df {k - 1})"
+    rows, cols, total = x.sum(axis=1), x.sum(axis=0), x.sum()
+    den = k * total - float(np.sum(rows**2))
+    if den <= 0:
+        return Test(name, 0.0, 1.0)
+    q = (k - 1) * (k * float(np.sum(cols**2)) - total**2) / den
+    return Test(name, float(q), chi2_sf(float(q), k - 1))
+
+
+def bootstrap_clustered_diff(a: dict[Any, Sequence[float]], b: dict[Any, Sequence[float]],
+                             rng: int | np.random.Generator, *, n_boot: int = N_BOOT,
+                             level: float = LEVEL) -> tuple[float, tuple[float, float], Test]:
+    """Difference of two rates (or means) over paired clusters, resampling the clusters.
+
+    ``a`` and ``b`` map a cluster (a scene) to its outcomes (0/1 or values) under the two
+    arms; only clusters in both count. The effect is the mean over clusters of
+    mean(a_c) − mean(b_c) (with equal runs per cluster, the difference of the overall
+    rates); its interval and the one-sided test (share of resampled effects <= 0) come
+    from resampling clusters with replacement, so runs that share a scene are not taken
+    as independent evidence.
+
+    Returns
+    -------
+    effect : float
+    interval : (float, float)
+    test : Test
+    """
+    keys = sorted(set(a) & set(b))  # type: ignore[type-var]
+    d = np.array([np.mean(a[c]) - np.mean(b[c]) for c in keys], dtype=np.float64)
+    mean, ci, test = bootstrap_paired_diff(d, np.zeros(d.size), rng, n_boot=n_boot, level=level)
+    return mean, ci, Test("paired bootstrap over scenes (one-sided)", test.statistic,
+                          test.p_value, MIN_RUNS)
+
+
 def _rng(seed: int | np.random.Generator) -> np.random.Generator:
     return seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
 
@@ -220,18 +278,20 @@ def bootstrap_paired_diff(a: ArrayLike, b: ArrayLike, rng: int | np.random.Gener
     d = d[np.isfinite(d)]
     if d.size == 0:
         nan = float("nan")
-        return nan, (nan, nan), Test("paired bootstrap of the mean difference", nan, 1.0)
+        return nan, (nan, nan), Test("paired bootstrap of the mean difference", nan, 1.0,
+                                     MIN_RUNS)
     idx = _rng(rng).integers(0, d.size, size=(n_boot, d.size))
     means = d[idx].mean(axis=1)
     al = (1.0 - level) / 2.0
     p = max(float(np.mean(means <= 0.0)), 1.0 / n_boot)
     return (float(d.mean()),
             (float(np.quantile(means, al)), float(np.quantile(means, 1.0 - al))),
-            Test("paired bootstrap of the mean difference (one-sided)", float(d.mean()), p))
+            Test("paired bootstrap of the mean difference (one-sided)", float(d.mean()), p,
+                 MIN_RUNS))
 
 
 def verdict(p_value: float, interval: tuple[float, float], delta: float, n: int,
-            alpha: float = ALPHA) -> str:
+            alpha: float = ALPHA, *, min_n: int = 0) -> str:
     """Judge a claim "effect > 0" from its one-sided p-value and an interval for the effect.
 
     Parameters
@@ -246,16 +306,18 @@ def verdict(p_value: float, interval: tuple[float, float], delta: float, n: int,
     n : int
         Runs (or paired cases) of the smaller compared arm.
     alpha : float
+    min_n : int
+        Fewest cases for a significant p-value to count (``Test.min_n``).
 
     Returns
     -------
     str
-        ``"reproduced"`` (p < alpha), ``"not reproduced"`` (n >= :data:`MIN_RUNS` and the
+        ``"reproduced"`` (p < alpha and n >= min_n), ``"not reproduced"`` (n >= :data:`MIN_RUNS` and the
         interval lies below delta, i.e. an effect that large is ruled out, or wholly below
         0), else ``"inconclusive"`` (too few runs to tell).
     """
     lo, hi = interval
-    if p_value < alpha:
+    if p_value < alpha and n >= min_n:
         return "reproduced"
     if n >= MIN_RUNS and math.isfinite(hi) and (hi < delta or hi < 0):
         return "not reproduced"

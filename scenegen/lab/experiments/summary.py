@@ -175,7 +175,7 @@ def _claim(out: list[dict[str, Any]], claim: str, test: stats.Test, effect: floa
         "claim": claim, "ours": ours, "test": test.name, "statistic": test.statistic,
         "p_value": test.p_value, "effect": effect, "interval": list(interval),
         "delta": delta, "delta_source": delta_source, "n": n,
-        "verdict": stats.verdict(test.p_value, interval, delta, n),
+        "verdict": stats.verdict(test.p_value, interval, delta, n, min_n=test.min_n),
     })
 
 
@@ -203,15 +203,56 @@ def _mcnemar_claim(out: list[dict[str, Any]], claim: str, a: Records, b: Records
            f"runs (discordant {n_sf}/{n_fs})", delta_source=delta_source, n=n)
 
 
-def _z_claim(out: list[dict[str, Any]], claim: str, ka: int, na: int, kb: int, nb: int,
-             delta: float, label_a: str, label_b: str, *, delta_source: str) -> None:
-    if not na or not nb:
+def _scene_claim(out: list[dict[str, Any]], claim: str, a: Records, b: Records, ok: Any,
+                 delta: float, label_a: str, label_b: str, key: tuple[Any, ...], *,
+                 delta_source: str) -> None:
+    """Claim rate(a) > rate(b) for two pools of runs on the same scenes.
+
+    A pool may hold several methods (e.g. every PS ordering). Runs on one scene share its
+    difficulty, so the test resamples scenes (``stats.bootstrap_clustered_diff``), not
+    runs: the effect is the mean over scenes of the two pools' success rates' difference.
+    """
+    by_a: dict[Any, list[float]] = defaultdict(list)
+    by_b: dict[Any, list[float]] = defaultdict(list)
+    for recs, by in ((a, by_a), (b, by_b)):
+        for r in recs:
+            by[_case(r)[:2]].append(100.0 * bool(ok(r)))
+    scenes = sorted(set(by_a) & set(by_b))
+    if not scenes:
         return
-    lo, hi = stats.newcombe_diff(ka, na, kb, nb)
-    _claim(out, claim, stats.two_proportion_z(ka, na, kb, nb),
-           100.0 * (ka / na - kb / nb), (100.0 * lo, 100.0 * hi), delta,
-           f"{label_a} {100 * ka / na:.0f}% of {na} vs {label_b} {100 * kb / nb:.0f}% of {nb}",
-           delta_source=delta_source, n=min(na, nb))
+    mean, ci, test = stats.bootstrap_clustered_diff(by_a, by_b, derive_seed("scenes", *key))
+    na = sum(len(by_a[c]) for c in scenes)
+    nb = sum(len(by_b[c]) for c in scenes)
+    ra = sum(sum(by_a[c]) for c in scenes) / na
+    rb = sum(sum(by_b[c]) for c in scenes) / nb
+    _claim(out, claim, test, mean, ci, delta,
+           f"{label_a} {ra:.0f}% of {na} vs {label_b} {rb:.0f}% of {nb} runs on "
+           f"{len(scenes)} scenes", delta_source=delta_source, n=len(scenes))
+
+
+def _orderings_claim(out: list[dict[str, Any]], claim: str, recs: dict[str, Records],
+                     rates: dict[str, dict[str, Any]], ok: Any, delta: float, *,
+                     delta_source: str) -> None:
+    """Claim that the PS orderings (``recs``: label -> runs) differ in rate ``ok``.
+
+    Cochran's Q over the cases (preset, scene, run) that every ordering ran: each case is
+    a block, so what the scene decides for every ordering alike is not counted as a
+    difference. The effect is the best ordering's rate minus the worst's (``rates``:
+    label -> rate with k, n, pct), with Newcombe's interval.
+    """
+    flags = {m: {_case(r): bool(ok(r)) for r in rs} for m, rs in recs.items()}
+    cases = sorted(set.intersection(*(set(f) for f in flags.values())))
+    if len(recs) < 2 or not cases:
+        return
+    test = stats.cochran_q([[flags[m][c] for m in recs] for c in cases])
+    best = max(recs, key=lambda m: (rates[m]["pct"], m))
+    worst = min(recs, key=lambda m: (rates[m]["pct"], m))
+    b, w = rates[best], rates[worst]
+    lo, hi = stats.newcombe_diff(b["k"], b["n"], w["k"], w["n"])
+    _claim(out, claim, test, b["pct"] - w["pct"], (100 * lo, 100 * hi), delta,
+           f"best {best} {b['pct']:.0f}%, worst {worst} {w['pct']:.0f}% of {b['n']} runs; "
+           f"Q = {test.statistic:.1f} over {len(cases)} paired cases",
+           delta_source=delta_source, n=min(r["n"] for r in rates.values()))
 
 
 def _boot_claim(out: list[dict[str, Any]], claim: str, a: dict[Any, float],
@@ -362,30 +403,28 @@ def _dps_synthetic(exp: Experiment, records: Records) -> dict[str, Any]:
                 _compare(comparisons, f"Table 2 {lam} {label} object 1 recall %",
                          t2["pr"][i][1], st["recall"])
         if ps and t2:
-            pr = row["ps_mean"]["hard"]["recovery"]
+            pool = [r for s_ in ps for r in recs[s_]]
+
+            def rec_ok(r: dict[str, Any]) -> bool:
+                return _recovered(r["targets"][hard])
+
             if "dps" in per:
-                d = per["dps"]["hard"]["recovery"]
-                _z_claim(claims, f"{lam}: object 1 recovery of DPS above the PS orderings'",
-                         d["k"], d["n"], pr["k"], pr["n"], t2["recovery"][3] - t2["recovery"][1],
-                         "DPS", "PS (all orderings)", delta_source="paper's difference")
+                _scene_claim(claims, f"{lam}: object 1 recovery of DPS above the PS orderings'",
+                             recs["dps"], pool, rec_ok,
+                             t2["recovery"][3] - t2["recovery"][1], "DPS", "PS (all orderings)",
+                             (exp.name, "claim-dps-ps", v), delta_source="paper's difference")
             if "nonps" in per:
-                n_ = per["nonps"]["hard"]["recovery"]
-                _z_claim(claims, f"{lam}: object 1 recovery of the PS orderings above "
-                         "Non-PS's", pr["k"], pr["n"], n_["k"], n_["n"],
-                         t2["recovery"][1] - t2["recovery"][0], "PS (all orderings)",
-                         "Non-PS", delta_source="paper's difference")
+                _scene_claim(claims, f"{lam}: object 1 recovery of the PS orderings above "
+                             "Non-PS's", pool, recs["nonps"], rec_ok,
+                             t2["recovery"][1] - t2["recovery"][0], "PS (all orderings)",
+                             "Non-PS", (exp.name, "claim-ps-nonps", v),
+                             delta_source="paper's difference")
             if len(ps) > 1:
-                rs = [per[s]["hard"]["recovery"] for s in ps]
-                test = stats.chi2_homogeneity([r["k"] for r in rs], [r["n"] for r in rs])
-                b, w = per[best]["hard"]["recovery"], per[worst]["hard"]["recovery"]
-                lo, hi = stats.newcombe_diff(b["k"], b["n"], w["k"], w["n"])
-                _claim(claims, f"{lam}: the PS orderings differ in object 1 recovery "
-                       "(the ordering matters)", test, b["pct"] - w["pct"],
-                       (100 * lo, 100 * hi), 2.0 * (t2["recovery"][1] - t2["recovery"][2]),
-                       f"best {best} {b['pct']:.0f}%, worst {worst} {w['pct']:.0f}%, "
-                       f"χ² = {test.statistic:.1f}",
-                       delta_source="twice the paper's PS mean − PS worst",
-                       n=min(r["n"] for r in rs))
+                _orderings_claim(claims, f"{lam}: the PS orderings differ in object 1 recovery "
+                                 "(the ordering matters)", {s_: recs[s_] for s_ in ps},
+                                 {s_: per[s_]["hard"]["recovery"] for s_ in ps}, rec_ok,
+                                 2.0 * (t2["recovery"][1] - t2["recovery"][2]),
+                                 delta_source="twice the paper's PS mean − PS worst")
         if t1 and "nonps" in recs:
             base = {_case(r): _other_mean(r, hard, "precision") for r in recs["nonps"]}
             for label, col, i in (("DPS", "dps", 2), ("PS", None, 1)):
@@ -544,55 +583,52 @@ def _dps_real(exp: Experiment, records: Records) -> dict[str, Any]:
                     claims, f"{preset}: occluded object's success of {a} above {b}'s",
                     recs[a], recs[b], lambda r: _success(r["targets"][hard]), abs(gap), a, b,
                     delta_source="paper's difference")
-            _pooled_ps_claims(claims, exp, preset, rows, paper)
+            _pooled_ps_claims(claims, exp, preset, rows, recs, paper, hard)
     return {"summary": {"hard_target": exp.hard_target, "presets": by_preset},
             "comparisons": comparisons, "claims": claims}
 
 
 def _pooled_ps_claims(claims: list[dict[str, Any]], exp: Experiment, preset: str,
-                      rows: dict[str, Any], paper: dict[str, Any]) -> None:
+                      rows: dict[str, Any], recs: dict[str, Records], paper: dict[str, Any],
+                      hard: int) -> None:
     """DPS against the pooled PS orderings, and whether the orderings differ (success)."""
     ps = [m.label for m in exp.methods if m.group == "PS" and m.label in rows
           and m.label in paper]
     if not ps or "DPS" not in rows:
         return
-    k = sum(rows[m]["hard"]["success"]["k"] for m in ps)
-    n = sum(rows[m]["hard"]["success"]["n"] for m in ps)
-    d = rows["DPS"]["hard"]["success"]
+
+    def ok(r: dict[str, Any]) -> bool:
+        return _success(r["targets"][hard])
+
+    pool = [r for m in ps for r in recs[m]]
     gap = paper["DPS"][0] - float(np.mean([paper[m][0] for m in ps]))
     if gap >= 0:
-        _z_claim(claims, f"{preset}: occluded object's success of DPS above the PS orderings' "
-                 "(pooled)", d["k"], d["n"], k, n, gap, "DPS", "PS (all orderings)",
-                 delta_source="paper's DPS − PS mean")
+        _scene_claim(claims, f"{preset}: occluded object's success of DPS above the PS "
+                     "orderings' (pooled)", recs["DPS"], pool, ok, gap, "DPS",
+                     "PS (all orderings)", (exp.name, preset, "dps-ps"),
+                     delta_source="paper's DPS − PS mean")
     else:
-        _z_claim(claims, f"{preset}: occluded object's success of the PS orderings (pooled) "
-                 "above DPS's (the paper's limitation of DPS)", k, n, d["k"], d["n"], -gap,
-                 "PS (all orderings)", "DPS", delta_source="paper's PS mean − DPS")
+        _scene_claim(claims, f"{preset}: occluded object's success of the PS orderings (pooled) "
+                     "above DPS's (the paper's limitation of DPS)", pool, recs["DPS"], ok, -gap,
+                     "PS (all orderings)", "DPS", (exp.name, preset, "ps-dps"),
+                     delta_source="paper's PS mean − DPS")
         # dps-dancers (Table 4): the limitation is that DPS falls below the orderings the
         # paper finds clearly better; the pool is fixed by the paper's numbers, not ours.
         above = [m for m in ps if paper[m][0] - paper["DPS"][0] >= _CLAIM_GAP]
         if 1 < len(above) < len(ps):
-            ka = sum(rows[m]["hard"]["success"]["k"] for m in above)
-            na = sum(rows[m]["hard"]["success"]["n"] for m in above)
             gap_a = float(np.mean([paper[m][0] for m in above])) - paper["DPS"][0]
-            pool = "PS(" + "), PS(".join(m[3:-1] for m in above) + ")"
-            _z_claim(claims, f"{preset}: occluded object's success of the PS orderings the "
-                     f"paper finds above DPS ({pool}, pooled) above DPS's", ka, na, d["k"],
-                     d["n"], gap_a, "those PS orderings", "DPS",
-                     delta_source="paper's mean of those orderings − DPS")
+            names = "PS(" + "), PS(".join(m[3:-1] for m in above) + ")"
+            _scene_claim(claims, f"{preset}: occluded object's success of the PS orderings the "
+                         f"paper finds above DPS ({names}, pooled) above DPS's",
+                         [r for m in above for r in recs[m]], recs["DPS"], ok, gap_a,
+                         "those PS orderings", "DPS", (exp.name, preset, "above-dps"),
+                         delta_source="paper's mean of those orderings − DPS")
     spread = max(paper[m][0] for m in ps) - min(paper[m][0] for m in ps)
     if len(ps) > 1 and spread >= _CLAIM_GAP:
-        rs = [rows[m]["hard"]["success"] for m in ps]
-        best = max(ps, key=lambda m: rows[m]["hard"]["success"]["pct"])
-        worst = min(ps, key=lambda m: rows[m]["hard"]["success"]["pct"])
-        b, w = rows[best]["hard"]["success"], rows[worst]["hard"]["success"]
-        lo, hi = stats.newcombe_diff(b["k"], b["n"], w["k"], w["n"])
-        test = stats.chi2_homogeneity([r["k"] for r in rs], [r["n"] for r in rs])
-        _claim(claims, f"{preset}: the PS orderings differ in the occluded object's success "
-               "(the ordering matters)", test, b["pct"] - w["pct"], (100 * lo, 100 * hi),
-               spread, f"best {best} {b['pct']:.0f}%, worst {worst} {w['pct']:.0f}%, "
-               f"χ² = {test.statistic:.1f}", delta_source="paper's best − worst ordering",
-               n=min(r["n"] for r in rs))
+        _orderings_claim(claims, f"{preset}: the PS orderings differ in the occluded object's "
+                         "success (the ordering matters)", {m: recs[m] for m in ps},
+                         {m: rows[m]["hard"]["success"] for m in ps}, ok, spread,
+                         delta_source="paper's best − worst ordering")
 
 
 def _table_dps_real(res: dict[str, Any], exp_name: str) -> list[str]:

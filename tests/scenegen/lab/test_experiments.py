@@ -388,30 +388,68 @@ def test_experiment_all_writes_one_report(tmp_path, monkeypatch, capsys):
     assert main(["experiment", "all", "--value", "20", "-o", str(tmp_path)]) == 2
 
 
+def _pool_records(successes: dict[str, int], n: int = 50, scenes: int = 10) -> tuple[dict, dict]:
+    """Fake runs: method label -> ``successes[label]`` successful runs of ``n`` on
+    ``scenes`` scenes (n / scenes runs each, the successes on the first runs), and the
+    rows of their success rates."""
+    recs, rows = {}, {}
+    per = n // scenes
+    for label, k in successes.items():
+        recs[label] = [{"key": {"preset": "p", "scene": i // per, "run": i % per},
+                        "targets": [{"state": [i < k] * 5}]} for i in range(n)]
+        rows[label] = {"hard": {"success": {"k": k, "n": n, "pct": 100.0 * k / n}}}
+    return recs, rows
+
+
 def test_dps_limitation_pools_the_orderings_the_paper_puts_above_dps():
     """dps-dancers (Table 4): the pool of PS orderings set by the paper's numbers
     (PS(2,3,4,1), PS(3,4,1,2), PS(4,1,2,3), >= 10 points above DPS) against DPS, by the
-    two-proportion test; dps-occlusion, where DPS is above every ordering, has no such
+    bootstrap over scenes; dps-occlusion, where DPS is above every ordering, has no such
     claim."""
     from scenegen.lab.experiments import summary
     from scenegen.lab.experiments.definitions import PAPER
 
-    def row(k):
-        return {"hard": {"success": {"k": k, "n": 50, "pct": 2.0 * k}}}
-
-    rows = {"PS(1,2,3,4)": row(10), "PS(2,3,4,1)": row(40), "PS(3,4,1,2)": row(42),
-            "PS(4,1,2,3)": row(35), "DPS": row(18)}
+    recs, rows = _pool_records({"PS(1,2,3,4)": 10, "PS(2,3,4,1)": 40, "PS(3,4,1,2)": 42,
+                                "PS(4,1,2,3)": 35, "DPS": 18})
     claims: list = []
-    summary._pooled_ps_claims(claims, get("dps-dancers"), "dps-dancers", rows,
-                              PAPER["dps-dancers"]["dps-dancers"])
+    summary._pooled_ps_claims(claims, get("dps-dancers"), "dps-dancers", rows, recs,
+                              PAPER["dps-dancers"]["dps-dancers"], 0)
     pool = [c for c in claims if "the paper finds above DPS" in c["claim"]]
     assert len(pool) == 1
     assert "PS(2,3,4,1), PS(3,4,1,2), PS(4,1,2,3)" in pool[0]["claim"]
-    assert pool[0]["test"].startswith("two-proportion") and pool[0]["verdict"] == "reproduced"
-    assert "78% of 150 vs DPS 36% of 50" in pool[0]["ours"]
+    assert pool[0]["test"] == "paired bootstrap over scenes (one-sided)"
+    assert pool[0]["verdict"] == "reproduced" and pool[0]["n"] == 10
+    assert "78% of 150 vs DPS 36% of 50 runs on 10 scenes" in pool[0]["ours"]
+    assert pool[0]["effect"] == pytest.approx(78.0 - 36.0)
 
-    rows = {f"PS({o})": row(20) for o in ("1,2,3", "2,3,1", "3,1,2")} | {"DPS": row(30)}
+    recs, rows = _pool_records({f"PS({o})": 20 for o in ("1,2,3", "2,3,1", "3,1,2")}
+                               | {"DPS": 30})
     claims = []
-    summary._pooled_ps_claims(claims, get("dps-occlusion"), "dps-occlusion", rows,
-                              PAPER["dps-occlusion"]["dps-occlusion"])
+    summary._pooled_ps_claims(claims, get("dps-occlusion"), "dps-occlusion", rows, recs,
+                              PAPER["dps-occlusion"]["dps-occlusion"], 0)
     assert claims and not [c for c in claims if "the paper finds above DPS" in c["claim"]]
+    order = [c for c in claims if "the ordering matters" in c["claim"]]
+    # Every ordering succeeds on the same runs: no discordant case, Q = 0.
+    assert order[0]["test"].startswith("Cochran's Q") and order[0]["p_value"] == 1.0
+
+
+def test_clustered_claims_count_scenes_not_runs():
+    """Five runs per scene that all agree are one scene's worth of evidence: the same
+    rates on 10 scenes are significant, on 2 scenes (25 runs each) they are not."""
+    from scenegen.lab.experiments import summary
+
+    def ok(r):
+        return r["targets"][0]["state"][0]
+
+    def fake(k, n, scenes):
+        per = n // scenes
+        # success on whole scenes: the first k // per scenes succeed in every run
+        return [{"key": {"preset": "p", "scene": i // per, "run": i % per},
+                 "targets": [{"state": [i < k]}]} for i in range(n)]
+
+    for scenes, verdict in ((10, "reproduced"), (2, "inconclusive")):
+        out: list = []
+        summary._scene_claim(out, "a above b", fake(40, 50, scenes), fake(10, 50, scenes), ok,
+                             30.0, "A", "B", ("t", scenes), delta_source="stated")
+        assert out[0]["effect"] == pytest.approx(60.0)
+        assert out[0]["verdict"] == verdict, out[0]

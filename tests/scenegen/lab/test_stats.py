@@ -90,3 +90,54 @@ def test_verdicts():
     assert stats.verdict(0.4, (-0.1, 0.1), 0.3, 9) == "inconclusive"  # too few runs
     assert stats.verdict(0.4, (-0.5, -0.2), 0.1, 20) == "not reproduced"  # the other way
     assert stats.verdict(0.2, (-0.1, 0.6), 0.3, 50) == "inconclusive"
+
+
+def test_cochran_q_by_hand():
+    # C = (5, 3, 1), T = 9, Σ R² = 19: Q = 2 (3·35 − 81) / (27 − 19) = 6, p = e^−3.
+    rows = [[1, 1, 0], [1, 0, 0], [1, 1, 1], [0, 0, 0], [1, 0, 0], [1, 1, 0]]
+    t = stats.cochran_q(rows)
+    assert t.statistic == pytest.approx(6.0)
+    assert t.p_value == pytest.approx(math.exp(-3.0))
+    assert "df 2" in t.name
+
+
+@pytest.mark.parametrize(("b", "c", "same"), [(9, 3, 20), (4, 4, 0), (0, 7, 5)])
+def test_cochran_q_of_two_methods_is_mcnemars_chi2(b, c, same):
+    rows = [[1, 0]] * b + [[0, 1]] * c + [[1, 1]] * same + [[0, 0]] * same
+    assert stats.cochran_q(rows).statistic == pytest.approx((b - c) ** 2 / (b + c))
+
+
+def test_cochran_q_ignores_cases_every_method_agrees_on():
+    rows = [[1, 0, 0], [0, 1, 1], [1, 1, 0]]
+    more = rows + [[1, 1, 1]] * 30 + [[0, 0, 0]] * 30
+    assert stats.cochran_q(more).statistic == pytest.approx(stats.cochran_q(rows).statistic)
+    assert stats.cochran_q([[1, 1], [0, 0]]).p_value == 1.0
+    with pytest.raises(ValueError, match="k >= 2"):
+        stats.cochran_q([[1], [0]])
+
+
+def test_clustered_bootstrap_does_not_count_repeated_runs_as_evidence():
+    rng = np.random.default_rng(4)
+    a = {s: [float(v)] for s, v in enumerate(rng.random(12) < 0.7)}
+    b = {s: [float(v)] for s, v in enumerate(rng.random(12) < 0.4)}
+    one = stats.bootstrap_clustered_diff(a, b, 11)
+    five = stats.bootstrap_clustered_diff({s: v * 5 for s, v in a.items()},
+                                          {s: v * 5 for s, v in b.items()}, 11)
+    assert one == five  # five identical runs per scene: no more evidence than one
+    mean, ci, t = one
+    d = [a[s][0] - b[s][0] for s in range(12)]
+    ref = stats.bootstrap_paired_diff(d, [0.0] * 12, 11)
+    assert (mean, ci, t.p_value) == (ref[0], ref[1], ref[2].p_value)
+    assert t.name == "paired bootstrap over scenes (one-sided)"
+    # Unpaired scenes are dropped; per-scene means are compared, not pooled runs.
+    m, _, _ = stats.bootstrap_clustered_diff({0: [1, 1, 1, 0], 1: [0, 0], 2: [1]},
+                                             {0: [0, 0], 1: [1, 0]}, 0)
+    assert m == pytest.approx(((0.75 - 0.0) + (0.0 - 0.5)) / 2)
+
+
+def test_a_resampling_test_needs_enough_cases_to_reproduce():
+    assert stats.verdict(0.001, (5.0, 20.0), 10.0, 9) == "reproduced"        # exact tests
+    assert stats.verdict(0.001, (5.0, 20.0), 10.0, 9, min_n=10) == "inconclusive"
+    assert stats.verdict(0.001, (5.0, 20.0), 10.0, 10, min_n=10) == "reproduced"
+    _, _, t = stats.bootstrap_paired_diff([1.0, 2.0], [0.0, 0.0], 0)
+    assert t.min_n == stats.MIN_RUNS and stats.mcnemar_exact(5, 0).min_n == 0
