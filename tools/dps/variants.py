@@ -1,0 +1,99 @@
+"""The DPS experiments on variants of their scenes and trackers, for analyses.
+
+Usage::
+
+    python tools/dps/variants.py dps-synthetic --seeds 1,2,3 -o /tmp/v --astray
+    python tools/dps/variants.py dps-synthetic --seeds 1,2,3 -o /tmp/v --lam 150
+    python tools/dps/variants.py dps-occlusion --seeds 7 -o /tmp/v --lam 150 \\
+        --method ps-123 --method ps-231 --method ps-312 --method dps --param weighting=stage
+
+It runs ``scenegen experiment NAME`` once per base seed into ``OUT/seed-<N>/`` (the same
+``results.json``, ``table.md`` and run records), with any of:
+
+- ``--astray``: the distractor of ``dps-synthetic`` is present from frame 0, drawn over
+  object 1, so that every tracker learns object 1's model from the distractor, as the DPS
+  paper did (§3.3: "the histogram model was learned from a distracter object"); it still
+  drifts 8 px/frame to the right and vanishes at frame 9. In the preset the model is
+  learned from object 1 itself and the distractor appears at frame 3;
+- ``--lam V`` (repeatable): run at λ = V instead of the experiment's λ (``dps-synthetic``
+  sweeps 20…50; the others use one λ), e.g. a λ at which PS's first-stage uniqueness is
+  as low as the paper's (1.99 of 300 particles at λ = 20, DPS §3.3);
+- ``--param KEY=VALUE`` and ``--method SLUG`` as for ``scenegen experiment``.
+
+``OUT/seed-<N>/variant.json`` records the variant. The variant replaces the preset and
+the experiment in this process only, so the runs use one process (``jobs = 1``); start
+one command per seed to use more cores. The analyses that used it are in
+docs/experiments.md ("Other readings of PS, and the paper's conditions"). Tune only on
+seeds that are not then used to judge.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+from pathlib import Path
+
+from scenegen import presets
+from scenegen.cli.experiment import parse_overrides
+from scenegen.lab.experiments import definitions, run_experiment
+
+DPS_EXPERIMENTS = ("dps-synthetic", "dps-occlusion", "dps-dancers")
+
+
+def astray(cfg):
+    """``dps-synthetic`` with its distractor present, over object 1, from frame 0."""
+    ents = tuple(dataclasses.replace(e, appear=0) if e.role == "distractor" else e
+                 for e in cfg.entities)
+    if ents == cfg.entities:
+        raise SystemExit(f"--astray: preset {cfg.name} has no distractor")
+    return dataclasses.replace(cfg, entities=ents)
+
+
+def with_lam(exp: definitions.Experiment, lams: tuple[float, ...]) -> definitions.Experiment:
+    """The experiment at the λ values ``lams``: its sweep if it sweeps λ, else every
+    method's ``lam`` (one value)."""
+    if exp.sweep and exp.sweep[0][0] == "lam":
+        return dataclasses.replace(exp, sweep=(("lam", lams),))
+    if len(lams) != 1:
+        raise SystemExit(f"{exp.name} does not sweep λ: give one --lam")
+    methods = tuple(dataclasses.replace(m, params=(*[(k, v) for k, v in m.params if k != "lam"],
+                                                   ("lam", lams[0])))
+                    for m in exp.methods)
+    return dataclasses.replace(exp, methods=methods)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("experiment", choices=DPS_EXPERIMENTS)
+    ap.add_argument("--seeds", required=True, help="base seeds, e.g. 1,2,3")
+    ap.add_argument("-o", "--output", required=True, type=Path)
+    ap.add_argument("--astray", action="store_true",
+                    help="dps-synthetic: the distractor over object 1 from frame 0")
+    ap.add_argument("--lam", action="append", type=float, default=None)
+    ap.add_argument("--param", action="append", default=None, metavar="KEY=VALUE")
+    ap.add_argument("--method", action="append", default=None, metavar="SLUG")
+    args = ap.parse_args()
+    exp = definitions.EXPERIMENTS[args.experiment]
+    if args.astray:
+        if args.experiment != "dps-synthetic":
+            raise SystemExit("--astray applies to dps-synthetic only")
+        base = presets._PRESETS["dps-synthetic"]
+        presets._PRESETS["dps-synthetic"] = lambda: astray(base())
+    if args.lam:
+        definitions.EXPERIMENTS[args.experiment] = with_lam(exp, tuple(args.lam))
+    overrides = parse_overrides(args.param)
+    variant = {"experiment": args.experiment, "astray": args.astray, "lam": args.lam,
+               "overrides": overrides, "methods": args.method}
+    for seed in (int(s) for s in args.seeds.split(",")):
+        out = args.output / f"seed-{seed}"
+        results = run_experiment(args.experiment, out, seed=seed, jobs=1, methods=args.method,
+                                 overrides=overrides or None, progress=False, figures=False)
+        (out / "variant.json").write_text(json.dumps({**variant, "seed": seed}, indent=1) + "\n")
+        print(f"== {out}")
+        for c in results["claims"]:
+            print(f"  p = {c['p_value']:.3f}  {c['verdict']:15s} {c['ours']}")
+
+
+if __name__ == "__main__":
+    main()
