@@ -149,13 +149,13 @@ CONFIGS = [
     ("ps", {"ordering": 1}),
     ("ps", {"ordering": 2}),
     ("ps", {"ordering": (1, 0, 2)}),
-    ("ps", {"weighting": "stage"}),
+    ("ps", {"weighting": "placed"}),
     ("ps", {"weighting": "g-only", "ordering": 2}),
     ("dps", {"n_groups": 2}),                      # sizes 1000, 1000 (fast)
     ("dps", {"n_groups": 3}),                      # 667, 667, 666: unequal
     ("dps", {"n_groups": 7, "resampler": "stratified"}),   # 286 x 5, 285 x 2
     ("dps", {"n_groups": 3, "assignment": "interleaved", "resampler": "residual"}),
-    ("dps", {"n_groups": 3, "weighting": "stage"}),
+    ("dps", {"n_groups": 3, "weighting": "placed"}),
     ("dps", {"n_groups": 2, "weighting": "g-only", "resampler": "residual"}),
 ]
 IDS = [f"{name}-{'-'.join(f'{k}={v}' for k, v in p.items()) or 'default'}"
