@@ -82,7 +82,7 @@ MODULES: dict[str, Module] = {
          "PartitionedSampling._groups", "DistributedPartitionedSampling._init",
          "DistributedPartitionedSampling._groups", "DistributedPartitionedSampling._step"),
         ("tests/trackers/test_oracle_particle.py", "tests/trackers/test_equivalences.py",
-         "tests/trackers/test_particle.py"),
+         "tests/trackers/test_particle.py", "tests/trackers/test_ps_weighting.py"),
     ),
     "meanshift": Module(
         "trackers/kernels/meanshift.py",
