@@ -312,9 +312,9 @@ def verdict(p_value: float, interval: tuple[float, float], delta: float, n: int,
     Returns
     -------
     str
-        ``"reproduced"`` (p < alpha and n >= min_n), ``"not reproduced"`` (n >= :data:`MIN_RUNS` and the
-        interval lies below delta, i.e. an effect that large is ruled out, or wholly below
-        0), else ``"inconclusive"`` (too few runs to tell).
+        ``"reproduced"`` (p < alpha and n >= min_n), ``"not reproduced"`` (n >=
+        :data:`MIN_RUNS` and the interval lies below delta, i.e. an effect that large is
+        ruled out, or wholly below 0), else ``"inconclusive"`` (too few runs to tell).
     """
     lo, hi = interval
     if p_value < alpha and n >= min_n:
