@@ -17,13 +17,14 @@ demo: $(STAMP)
 	$(BIN)/scenegen demo -o report
 
 test: $(STAMP)
+	$(BIN)/ruff check scenegen trackers tests tools
 	HYPOTHESIS_PROFILE=$${HYPOTHESIS_PROFILE:-$$( [ -n "$$CI" ] && echo ci || echo dev )} $(BIN)/python -m pytest -q
 
 test-slow: $(STAMP)
 	$(BIN)/python -m pytest -q -m slow
 
 lint: $(STAMP)
-	$(BIN)/ruff check scenegen trackers tests
+	$(BIN)/ruff check scenegen trackers tests tools
 
 bench: $(STAMP)
 	$(BIN)/scenegen bench
