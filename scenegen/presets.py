@@ -300,12 +300,12 @@ def dps_occlusion() -> SceneConfig:
     likelihood, then the other two objects', which do not depend on its state), only at
     another point of the step. So no scene can make the PS ordering or DPS decide the
     walker's fate on our trackers (docs/experiments.md, "DPS Table 3: why the orderings
-    cannot differ"). Variants tried, all methods with the same parameters: tracker
-    dynamics σ = (3, 3, 0.001) (seeds 1–2: DPS 83 %, PS 62–79 %, Non-PS 54 %; seed 3:
-    DPS 25 %, PS 50–75 %, Non-PS 25 %: the lead was noise); λ = 40 (seeds 1–2: DPS 71 %,
-    PS 75–83 %, Non-PS 46 %). Nothing was kept: the scene and the paper's tracker
-    parameters are those of round 2. Replication on base seed 5 (never used for tuning):
-    DPS 72 %, PS 62–68 % (64 % pooled, p = 0.15), Non-PS 64 %.
+    cannot differ with the `placed` weighting"). Variants tried, all methods with the same
+    parameters: tracker dynamics σ = (3, 3, 0.001) (seeds 1–2: DPS 83 %, PS 62–79 %, Non-PS
+    54 %; seed 3: DPS 25 %, PS 50–75 %, Non-PS 25 %: the lead was noise); λ = 40 (seeds 1–2:
+    DPS 71 %, PS 75–83 %, Non-PS 46 %). Nothing was kept: the scene and the paper's tracker
+    parameters are those of round 2. Replication on base seed 5 (never used for tuning): DPS
+    72 %, PS 62–68 % (64 % pooled, p = 0.15), Non-PS 64 %.
 
     Round 4: the cycle argument above holds for the ``placed`` weighting, our reading of
     weighted resampling until then. With the papers' ``stage`` weighting (now the

@@ -15,7 +15,9 @@ For each method of the ``dps-occlusion`` experiment it prints, averaged over fra
 
 The end-of-step uniqueness depends on where the walker sits in the ordering; the first two
 are measured at the walker's own propagation, the same point of the cycle for every
-method (docs/experiments.md, "DPS Table 3: why the orderings cannot differ").
+method (docs/experiments.md, "DPS Table 3: why the orderings cannot differ with the
+`placed` weighting"). Those numbers are of ``--weighting placed``; the default is the
+trackers' own (``stage``, the papers' weighting, since round 4).
 It reads the walker's states before each propagation through the trackers'
 ``propagation_hook`` (tested in ``tests/trackers/test_ps_cycle.py``).
 """
@@ -33,13 +35,17 @@ from scenegen.lab.experiments.definitions import get
 from scenegen.lab.experiments.runner import derive_seed, scene_seed
 
 
-def measure(preset: str, base: int, scene: int, slug: str, run: int) -> np.ndarray:
+def measure(preset: str, base: int, scene: int, slug: str, run: int,
+            weighting: str | None = None) -> np.ndarray:
     """(ancestors, spread, end uniqueness) averaged over all frames, then over hidden ones."""
     exp = get("dps-occlusion")
     method = exp.method(slug)
     seq = scenegen.generate(preset, seed=scene_seed(base, exp.name, preset, scene))
+    params = method.param_dict()
+    if weighting is not None and method.tracker in ("ps", "dps"):
+        params["weighting"] = weighting
     tr = trackers.make(method.tracker, rng=derive_seed(base, "cycle", slug, preset, scene, run),
-                       **method.param_dict())
+                       **params)
     frames = seq.frames
     tr.init(np.asarray(frames[0]), seq.init_boxes(0))
     walker = 0  # the walker is the first target of both presets
@@ -69,12 +75,14 @@ def main() -> None:
     ap.add_argument("--seeds", default="1,2,3", help="base seeds (tuning seeds only)")
     ap.add_argument("--scenes", type=int, default=3)
     ap.add_argument("--runs", type=int, default=1)
+    ap.add_argument("--weighting", default=None,
+                    help="PS/DPS weighting (default: the trackers'; round 3 used placed)")
     args = ap.parse_args()
     bases = [int(b) for b in args.seeds.split(",")]
     numba.set_num_threads(1)
     print("method   ancestors %  spread px  end uniq. %  | hidden: ancestors %  spread px")
     for m in get("dps-occlusion").methods:
-        v = np.mean([measure(args.preset, b, s, m.slug, r) for b in bases
+        v = np.mean([measure(args.preset, b, s, m.slug, r, args.weighting) for b in bases
                      for s in range(args.scenes) for r in range(args.runs)], axis=0)
         print(f"{m.label:9s} {100 * v[0]:8.0f} {v[1]:10.1f} {100 * v[2]:11.0f}  | "
               f"{100 * v[3]:17.0f} {v[4]:10.1f}", flush=True)
