@@ -75,3 +75,42 @@ def test_the_three_weightings_draw_differently():
         sets.append(pf.particles)
     a, b, c = sets
     assert not np.array_equal(a, b) and not np.array_equal(a, c) and not np.array_equal(b, c)
+
+
+@pytest.mark.parametrize("name", ["ps", "dps", "joint-pf"])
+def test_estimate_is_the_weighted_mean_box_of_each_of_many_objects(name):
+    # Six objects (more than the four columns of a box): each estimate is the box of its
+    # object's weighted mean state, with that object's own size.
+    start = np.array([[30.0, 30.0], [80, 40], [130, 50], [60, 120], [120, 130], [170, 170]])
+    z = linear_gaussian.measurements(4, start, 4, SIGMA, R_STD, salt=5)
+    sizes = np.array([[10.0, 12.0], [14, 10], [8, 8], [12, 16], [10, 10], [16, 12]])
+    pf = trackers.make(name, n_particles=120, sigma=(SIGMA, SIGMA, 0.0),
+                       observation=PositionModel(z, np.eye(2) * R_STD**2), rng=2)
+    frames = np.zeros((4, 220, 220, 3), np.uint8)
+    pf.init(frames[0], np.column_stack([z[0] - sizes / 2, sizes]))
+    for t in range(1, 4):
+        est = pf.step(frames[t])
+        w = np.asarray(pf.weights)
+        mean = np.einsum("n,nkc->kc", w, pf.particles)
+        want = np.column_stack([mean[:, :2] - sizes * np.exp(mean[:, 2:3]) / 2,
+                                sizes * np.exp(mean[:, 2:3])])
+        np.testing.assert_allclose(est.boxes, want, atol=1e-9)
+
+
+@pytest.mark.parametrize("name", ["ps", "dps"])
+def test_the_hook_gets_each_moved_objects_own_state(name):
+    # Without noise and at rest, AR2 leaves every state where it is: the hook's "before"
+    # must be the moved object's own state, equal to "after" row for row.
+    z = linear_gaussian.measurements(2, START, T, SIGMA, R_STD, salt=91)
+    pf = trackers.make(name, n_particles=N, sigma=(0.0, 0.0, 0.0),
+                       observation=PositionModel(z, np.eye(2) * R_STD**2), rng=1)
+    frames = np.zeros((3, 220, 220, 3), np.uint8)
+    pf.init(frames[0], np.column_stack([z[0] - 5.0, np.full((K, 2), 10.0)]))
+    calls = []
+    pf.propagation_hook = lambda before, after, objects: calls.append((before, after, objects))
+    pf.step(frames[1])
+    pf.step(frames[2])
+    assert len(calls) == 2 * K
+    for before, after, objects in calls:
+        np.testing.assert_array_equal(before, after)
+        np.testing.assert_array_equal(before[:, :2], START[objects])

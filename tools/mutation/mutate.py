@@ -82,7 +82,8 @@ MODULES: dict[str, Module] = {
          "PartitionedSampling._groups", "DistributedPartitionedSampling._init",
          "DistributedPartitionedSampling._groups", "DistributedPartitionedSampling._step"),
         ("tests/trackers/test_oracle_particle.py", "tests/trackers/test_equivalences.py",
-         "tests/trackers/test_particle.py", "tests/trackers/test_ps_weighting.py"),
+         "tests/trackers/test_particle.py", "tests/trackers/test_ps_weighting.py",
+         "tests/trackers/test_stage_kernels.py"),
     ),
     "meanshift": Module(
         "trackers/kernels/meanshift.py",
