@@ -17,7 +17,9 @@ The end-of-step uniqueness depends on where the walker sits in the ordering; the
 are measured at the walker's own propagation, the same point of the cycle for every
 method (docs/experiments.md, "DPS Table 3: why the orderings cannot differ with the
 `placed` weighting"). Those numbers are of ``--weighting placed``; the default is the
-trackers' own (``stage``, the papers' weighting, since round 4).
+trackers' own (``stage``, the papers' weighting, since round 4), measured in
+"DPS Table 3 with the `stage` weighting" (round 5). ``--param KEY=VALUE`` sets a numeric
+tracker parameter of every method, e.g. ``--param lam=150``.
 It reads the walker's states before each propagation through the trackers'
 ``propagation_hook`` (tested in ``tests/trackers/test_ps_cycle.py``).
 """
@@ -36,7 +38,8 @@ from scenegen.lab.experiments.runner import derive_seed, scene_seed
 
 
 def measure(preset: str, base: int, scene: int, slug: str, run: int,
-            weighting: str | None = None) -> np.ndarray:
+            weighting: str | None = None,
+            extra: dict[str, float] | None = None) -> np.ndarray:
     """(ancestors, spread, end uniqueness) averaged over all frames, then over hidden ones."""
     exp = get("dps-occlusion")
     method = exp.method(slug)
@@ -44,6 +47,7 @@ def measure(preset: str, base: int, scene: int, slug: str, run: int,
     params = method.param_dict()
     if weighting is not None and method.tracker in ("ps", "dps"):
         params["weighting"] = weighting
+    params.update(extra or {})
     tr = trackers.make(method.tracker, rng=derive_seed(base, "cycle", slug, preset, scene, run),
                        **params)
     frames = seq.frames
@@ -77,12 +81,16 @@ def main() -> None:
     ap.add_argument("--runs", type=int, default=1)
     ap.add_argument("--weighting", default=None,
                     help="PS/DPS weighting (default: the trackers'; round 3 used placed)")
+    ap.add_argument("--param", action="append", default=[], metavar="KEY=VALUE",
+                    help="a numeric tracker parameter for every method, e.g. lam=150")
     args = ap.parse_args()
+    extra = {k: float(v) for k, v in (p.split("=", 1) for p in args.param)}
     bases = [int(b) for b in args.seeds.split(",")]
     numba.set_num_threads(1)
     print("method   ancestors %  spread px  end uniq. %  | hidden: ancestors %  spread px")
     for m in get("dps-occlusion").methods:
-        v = np.mean([measure(args.preset, b, s, m.slug, r, args.weighting) for b in bases
+        v = np.mean([measure(args.preset, b, s, m.slug, r, args.weighting,
+                                 extra) for b in bases
                      for s in range(args.scenes) for r in range(args.runs)], axis=0)
         print(f"{m.label:9s} {100 * v[0]:8.0f} {v[1]:10.1f} {100 * v[2]:11.0f}  | "
               f"{100 * v[3]:17.0f} {v[4]:10.1f}", flush=True)
