@@ -1,6 +1,7 @@
 """The statistics the experiments judge the papers' claims with (no scipy needed).
 
-Intervals: :func:`wilson` for rates, :func:`newcombe_diff` for the difference of two rates,
+Intervals: :func:`wilson` for rates, :func:`newcombe_diff` for the difference of two rates
+on independent samples and :func:`newcombe_paired_diff` on paired cases,
 :func:`bootstrap_mean` and :func:`bootstrap_paired_diff` (percentile bootstrap, seeded) for
 means, and :func:`bootstrap_clustered_diff` for the difference of two rates over paired
 scenes (runs on one scene are not independent: the scene is resampled, not the run).
@@ -44,6 +45,7 @@ __all__ = [
     "cochran_q",
     "mcnemar_exact",
     "newcombe_diff",
+    "newcombe_paired_diff",
     "norm_ppf",
     "norm_sf",
     "two_proportion_z",
@@ -126,6 +128,41 @@ def newcombe_diff(k1: int, n1: int, k2: int, n2: int,
     d = p1 - p2
     return (d - math.sqrt((p1 - l1) ** 2 + (u2 - p2) ** 2),
             d + math.sqrt((u1 - p1) ** 2 + (p2 - l2) ** 2))
+
+
+def newcombe_paired_diff(n_ss: int, n_sf: int, n_fs: int, n_ff: int,
+                         level: float = LEVEL) -> tuple[float, float]:
+    """Newcombe's square-and-add interval of p_A − p_B over paired cases.
+
+    Newcombe (1998), "Improved confidence intervals for the difference between binomial
+    proportions based on paired data", method 10: the two Wilson intervals of
+    :func:`newcombe_diff`, combined with the correlation φ of the paired outcomes, so
+    that cases which succeed or fail for both methods narrow the interval as they do the
+    McNemar test. ``n_ss``: both succeed; ``n_sf``: A succeeds and B fails; ``n_fs``: the
+    reverse; ``n_ff``: both fail. φ is (n_ss n_ff − n_sf n_fs − n/2) / √(row and column
+    products) when the cross-product exceeds n/2, 0 when it lies in [0, n/2], and the
+    plain correlation below 0; φ = 0 (the independent-sample interval) when a margin is
+    empty. Returns (nan, nan) without cases.
+    """
+    n = n_ss + n_sf + n_fs + n_ff
+    if n <= 0:
+        return (float("nan"), float("nan"))
+    ka, kb = n_ss + n_sf, n_ss + n_fs
+    p1, p2 = ka / n, kb / n
+    l1, u1 = wilson(ka, n, level)
+    l2, u2 = wilson(kb, n, level)
+    margins = ka * (n - ka) * kb * (n - kb)
+    phi = 0.0
+    if margins > 0:
+        cross = n_ss * n_ff - n_sf * n_fs
+        if cross > n / 2:
+            phi = (cross - n / 2) / math.sqrt(margins)
+        elif cross < 0:
+            phi = cross / math.sqrt(margins)
+    d = p1 - p2
+    dl1, du1, dl2, du2 = p1 - l1, u1 - p1, p2 - l2, u2 - p2
+    return (d - math.sqrt(max(0.0, dl1 ** 2 + du2 ** 2 - 2 * phi * dl1 * du2)),
+            d + math.sqrt(max(0.0, dl2 ** 2 + du1 ** 2 - 2 * phi * dl2 * du1)))
 
 
 def two_proportion_z(k1: int, n1: int, k2: int, n2: int) -> Test:

@@ -179,16 +179,21 @@ def _claim(out: list[dict[str, Any]], claim: str, test: stats.Test, effect: floa
     })
 
 
+def _paired_table(fa: list[bool], fb: list[bool]) -> tuple[int, int, int, int]:
+    """The 2 x 2 table of paired outcomes: (both succeed, only a, only b, both fail)."""
+    n_ss = sum(x and y for x, y in zip(fa, fb, strict=True))
+    n_sf = sum(x and not y for x, y in zip(fa, fb, strict=True))
+    n_fs = sum(y and not x for x, y in zip(fa, fb, strict=True))
+    return n_ss, n_sf, n_fs, len(fa) - n_ss - n_sf - n_fs
+
+
 def _paired_rates(a: Records, b: Records, ok: Any) -> tuple[int, int, int, int, int]:
     """Paired cases of methods a and b: (k_a, k_b, n, n_sf, n_fs) of success ``ok(r)``."""
     ra = {_case(r): bool(ok(r)) for r in a}
     rb = {_case(r): bool(ok(r)) for r in b}
     cases = sorted(set(ra) & set(rb))
-    fa = [ra[c] for c in cases]
-    fb = [rb[c] for c in cases]
-    n_sf = sum(x and not y for x, y in zip(fa, fb, strict=True))
-    n_fs = sum(y and not x for x, y in zip(fa, fb, strict=True))
-    return sum(fa), sum(fb), len(cases), n_sf, n_fs
+    n_ss, n_sf, n_fs, _ = _paired_table([ra[c] for c in cases], [rb[c] for c in cases])
+    return n_ss + n_sf, n_ss + n_fs, len(cases), n_sf, n_fs
 
 
 def _mcnemar_claim(out: list[dict[str, Any]], claim: str, a: Records, b: Records, ok: Any,
@@ -196,7 +201,7 @@ def _mcnemar_claim(out: list[dict[str, Any]], claim: str, a: Records, b: Records
     ka, kb, n, n_sf, n_fs = _paired_rates(a, b, ok)
     if n == 0:
         return
-    lo, hi = stats.newcombe_diff(ka, n, kb, n)
+    lo, hi = stats.newcombe_paired_diff(ka - n_sf, n_sf, n_fs, n - ka - n_fs)
     _claim(out, claim, stats.mcnemar_exact(n_sf, n_fs), 100.0 * (ka - kb) / n,
            (100.0 * lo, 100.0 * hi), delta,
            f"{label_a} {100 * ka / n:.0f}% vs {label_b} {100 * kb / n:.0f}% of {n} paired "
@@ -238,7 +243,7 @@ def _orderings_claim(out: list[dict[str, Any]], claim: str, recs: dict[str, Reco
     Cochran's Q over the cases (preset, scene, run) that every ordering ran: each case is
     a block, so what the scene decides for every ordering alike is not counted as a
     difference. The effect is the best ordering's rate minus the worst's (``rates``:
-    label -> rate with k, n, pct), with Newcombe's interval.
+    label -> rate with k, n, pct), with Newcombe's paired interval over the cases both ran.
     """
     flags = {m: {_case(r): bool(ok(r)) for r in rs} for m, rs in recs.items()}
     cases = sorted(set.intersection(*(set(f) for f in flags.values())))
@@ -248,7 +253,8 @@ def _orderings_claim(out: list[dict[str, Any]], claim: str, recs: dict[str, Reco
     best = max(recs, key=lambda m: (rates[m]["pct"], m))
     worst = min(recs, key=lambda m: (rates[m]["pct"], m))
     b, w = rates[best], rates[worst]
-    lo, hi = stats.newcombe_diff(b["k"], b["n"], w["k"], w["n"])
+    lo, hi = stats.newcombe_paired_diff(*_paired_table([flags[best][c] for c in cases],
+                                                       [flags[worst][c] for c in cases]))
     _claim(out, claim, test, b["pct"] - w["pct"], (100 * lo, 100 * hi), delta,
            f"best {best} {b['pct']:.0f}%, worst {worst} {w['pct']:.0f}% of {b['n']} runs; "
            f"Q = {test.statistic:.1f} over {len(cases)} paired cases",

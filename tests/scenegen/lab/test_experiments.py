@@ -440,8 +440,31 @@ def test_dps_limitation_pools_the_orderings_the_paper_puts_above_dps():
                               PAPER["dps-occlusion"]["dps-occlusion"], 0)
     assert claims and not [c for c in claims if "the paper finds above DPS" in c["claim"]]
     order = [c for c in claims if "the ordering matters" in c["claim"]]
-    # Every ordering succeeds on the same runs: no discordant case, Q = 0.
+    # Every ordering succeeds on the same runs: no discordant case, Q = 0, and the paired
+    # interval of best − worst is ±4 points (unpaired it would be ±19).
     assert order[0]["test"].startswith("Cochran's Q") and order[0]["p_value"] == 1.0
+    assert order[0]["interval"] == pytest.approx([-4.04, 4.04], abs=0.01)
+
+
+def test_mcnemar_claims_carry_the_paired_interval():
+    """Paired outcomes (A 40 of 50, B 38 of 50, the two discordant cases both A's): the
+    interval is Newcombe's paired one (−3.3 to +11.8 points), which rules out a 20-point
+    lead; the independent-sample interval (−12 to +20) could not."""
+    from scenegen.lab.experiments import summary
+
+    def runs(ok):
+        return [{"key": {"preset": "p", "scene": i, "run": 0}, "targets": [{"state": [o]}]}
+                for i, o in enumerate(ok)]
+
+    a = runs([True] * 40 + [False] * 10)
+    b = runs([True] * 38 + [False] * 12)
+    out: list = []
+    summary._mcnemar_claim(out, "A above B", a, b, lambda r: r["targets"][0]["state"][0],
+                           20.0, "A", "B", delta_source="stated")
+    (c,) = out
+    assert c["interval"] == pytest.approx([-3.34, 11.83], abs=0.01)
+    assert c["p_value"] == pytest.approx(0.25) and c["verdict"] == "not reproduced"
+    assert "discordant 2/0" in c["ours"]
 
 
 def test_clustered_claims_count_scenes_not_runs():

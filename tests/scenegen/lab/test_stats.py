@@ -43,6 +43,27 @@ def test_newcombe_difference_interval():
     assert lo == pytest.approx(0.0524, abs=5e-4) and hi == pytest.approx(0.3339, abs=5e-4)
 
 
+def test_newcombe_paired_interval():
+    # Fagerland, Lydersen & Laake (2017), ch. 8, Cavo et al. 2012 (paired 2 x 2 [[59, 6],
+    # [16, 80]]): estimate -0.0621, 95 % CI -0.1186 to -0.0046.
+    lo, hi = stats.newcombe_paired_diff(59, 6, 16, 80)
+    assert lo == pytest.approx(-0.1186, abs=5e-5) and hi == pytest.approx(-0.0046, abs=5e-5)
+    # The same margins as independent samples give a wider interval that covers 0.
+    ulo, uhi = stats.newcombe_diff(65, 161, 75, 161)
+    assert ulo < lo and uhi > 0 > hi
+    # No association beyond chance (cross-product within [0, n/2]), or an empty margin:
+    # the independent-sample interval.
+    assert stats.newcombe_paired_diff(5, 5, 5, 5) == \
+        pytest.approx(stats.newcombe_diff(10, 20, 10, 20))
+    assert stats.newcombe_paired_diff(38, 2, 0, 0) == \
+        pytest.approx(stats.newcombe_diff(40, 40, 38, 40))
+    # Negatively associated outcomes widen it.
+    nlo, nhi = stats.newcombe_paired_diff(1, 9, 9, 1)
+    wlo, whi = stats.newcombe_diff(10, 20, 10, 20)
+    assert nlo < wlo and nhi > whi
+    assert all(math.isnan(x) for x in stats.newcombe_paired_diff(0, 0, 0, 0))
+
+
 def test_two_proportion_z_by_hand():
     t = stats.two_proportion_z(30, 50, 20, 50)  # pooled p 0.5, se 0.1, z 2
     assert t.statistic == pytest.approx(2.0)
