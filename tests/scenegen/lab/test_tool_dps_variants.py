@@ -3,7 +3,6 @@ experiments on (docs/experiments.md, "Other readings of PS")."""
 
 from __future__ import annotations
 
-import importlib.util
 import subprocess
 import sys
 from pathlib import Path
@@ -17,13 +16,6 @@ from scenegen.lab.experiments.definitions import EXPERIMENTS
 
 TOOL = Path(__file__).resolve().parents[3] / "tools" / "dps" / "variants.py"
 
-
-@pytest.fixture(scope="module")
-def tool():
-    spec = importlib.util.spec_from_file_location("dps_variants", TOOL)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
 
 
 def test_astray_draws_the_distractor_over_object_1_from_frame_0(tool):

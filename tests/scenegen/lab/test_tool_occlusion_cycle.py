@@ -3,23 +3,13 @@ end of the step (docs/experiments.md, "DPS Table 3 with the `stage` weighting").
 
 from __future__ import annotations
 
-import importlib.util
 import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
-import pytest
 
 TOOL = Path(__file__).resolve().parents[3] / "tools" / "occlusion" / "cycle.py"
-
-
-@pytest.fixture(scope="module")
-def tool():
-    spec = importlib.util.spec_from_file_location("occlusion_cycle", TOOL)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
 
 
 def test_the_last_placed_object_ends_the_step_unique_but_moved_from_few_ancestors(tool):
