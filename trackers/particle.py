@@ -68,6 +68,7 @@ from trackers.kernels.sampling import SYSTEMATIC, count_distinct
 from trackers.kernels.stages import (
     effective_uv,
     gather_pair,
+    group_weights,
     normalise_rows,
     propagate_objects,
     reassemble,
@@ -101,7 +102,7 @@ __all__ = [
 ]
 
 #: Rules that assign particles to the DPS mixture components (``assignment``).
-ASSIGNMENTS: tuple[str, ...] = ("random", "interleaved")
+ASSIGNMENTS: tuple[str, ...] = ("random", "interleaved", "persistent")
 
 #: Weighting functions of PS's weighted resampling stages (``weighting``).
 WEIGHTINGS: tuple[str, ...] = ("stage", "placed", "g-only")
@@ -407,11 +408,19 @@ class _Partitioned(_ParticleTracker):
         reordered so that the groups are contiguous, the group sizes (C,) and each
         group's ordering (C, M)."""
 
+    def _ancestors(self) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64],
+                                  NDArray[np.float64] | None]:
+        """The step's ancestors (N,), group sizes (C,), orderings (C, M) and log π_c,t−1
+        (C,; None: groups drawn afresh, π_c,t−1 = N_c / N): the whole set resampled by
+        its weights, then split by ``_groups``."""
+        idx = resample(self.weights, method=self.params.resampler, rng=self.rng)
+        return (*self._groups(idx), None)
+
     def _partitioned_step(self, frame: NDArray[np.uint8]) -> tuple[Estimate, NDArray]:
         obs: FrameLikelihood = self.model.observe(frame)
         n, m = self.params.n_particles, self.n_targets
         method = self.params.resampler
-        idx, sizes, orderings = self._groups(resample(self.weights, method=method, rng=self.rng))
+        idx, sizes, orderings, log_prior = self._ancestors()
         x, prev = gather_pair(self.particles, self._prev, idx)
         group = np.repeat(np.arange(sizes.size), sizes)
         # objects[j, r]: the object particle r moves at stage j (its group's ordering).
@@ -476,7 +485,8 @@ class _Partitioned(_ParticleTracker):
         # The set {x, π'} still represents the predicted joint state (weighted resampling
         # preserves it), so π' Π_i p(Z | X_i) are the unnormalised posterior weights w̃.
         logw = logpi + ll.sum(axis=1)
-        weights, mixture = self._reassemble(logw, logpi, sizes)
+        weights, mixture, self._log_mixture = self._reassemble(logw, logpi, sizes, log_prior)
+        self._logw = logw
         self.particles = x
         self._prev = prev
         self.weights = weights
@@ -485,22 +495,26 @@ class _Partitioned(_ParticleTracker):
 
     @staticmethod
     def _reassemble(logw: NDArray[np.float64], logpi: NDArray[np.float64],
-                    sizes: NDArray[np.int64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+                    sizes: NDArray[np.int64], log_prior: NDArray[np.float64] | None = None
+                    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
         """Mixture reassembly (DPS §4, after Vermaak, Doucet & Pérez 2003).
 
         π_c,t ∝ π_c,t−1 Σ_{n∈c} w̃_n, and particle n of group c gets π_c,t w̃_n / Σ_c w̃,
         with w̃_n = π'_n Π_i p(Z | X_i) (log ``logw``) and π' the group's proposal weights
         (log ``logpi``) normalised in the group, so that Σ_c w̃ estimates the group's
-        evidence. The groups are drawn afresh from an equally weighted (resampled) set, so
-        a group of N_c particles starts with π_c,t−1 = N_c / N. With one group this is
-        plain normalisation. Returns the weights (N,) and the mixture weights (C,).
+        evidence. Groups drawn afresh from an equally weighted (resampled) set start with
+        π_c,t−1 = N_c / N (``log_prior`` None); groups that keep their particles pass the
+        previous step's log π_c (``log_prior`` (C,)). With one group this is plain
+        normalisation. Returns the weights (N,), the mixture weights (C,) and their logs.
         """
         if sizes.size == 1:
-            return normalised_weights(logw), np.ones(1)
+            return normalised_weights(logw), np.ones(1), np.zeros(1)
         # log_total = LSE_c(logw), log_evidence = log_total − LSE_c(logpi), mixture =
-        # normalised(log(N_c / N) + log_evidence), weights = normalised(logw + log
+        # normalised(log π_c,t−1 + log_evidence), weights = normalised(logw + log
         # mixture_c − log_total_c), in compiled glue between numpy's exp and log.
-        return reassemble(logw, logpi, sizes, np.log(sizes / sizes.sum()))
+        if log_prior is None:
+            log_prior = np.log(sizes / sizes.sum())
+        return reassemble(logw, logpi, sizes, log_prior, with_log=True)
 
 
 class PartitionedSampling(_Partitioned):
@@ -552,7 +566,13 @@ class DistributedPartitionedSampling(_Partitioned):
     partition each step; "interleaved" sends particle n of the resampled set to
     component n mod C: systematic resampling leaves copies of one ancestor next to each
     other, so this spreads them over the components (stratified assignment) and uses no
-    randomness.
+    randomness. "persistent" keeps the components: each is resampled within itself by
+    its own weights, and its mixture weight is carried from step to step (π_c,t ∝
+    π_c,t−1 Σ_{n∈c} w̃_n with the previous π_c,t−1, the general form of the paper's
+    Eq. 3, as in Vermaak, Doucet & Pérez's mixture tracking, without their
+    re-clustering). DPS is then a mixture of C PS filters, one per ordering, weighted by
+    their evidence. The components start as contiguous blocks of the initial set (all
+    its particles are equal).
     """
 
     name = "dps"
@@ -569,7 +589,21 @@ class DistributedPartitionedSampling(_Partitioned):
         self._orders = np.stack([circular_shift(k, i % k) for i in range(c)])
         if self.params.assignment == "interleaved":
             self._interleave = np.concatenate([np.arange(i, n, c) for i in range(c)])
+        self._logw: NDArray[np.float64] | None = None
         super()._init(frame, boxes)
+
+    def _ancestors(self):
+        if self.params.assignment != "persistent" or self._sizes_c.size == 1:
+            return super()._ancestors()
+        sizes = self._sizes_c
+        if self._logw is None:  # first step: every particle is the initial state
+            idx = np.arange(self.params.n_particles)
+            log_prior = np.log(sizes / sizes.sum())
+        else:
+            idx = resample_groups(group_weights(self._logw, sizes), sizes,
+                                  method=self.params.resampler, rng=self.rng)
+            log_prior = self._log_mixture
+        return idx, sizes, self._orders, log_prior
 
     def _groups(self, idx):
         if self._sizes_c.size > 1:

@@ -155,6 +155,7 @@ CONFIGS = [
     ("dps", {"n_groups": 3}),                      # 667, 667, 666: unequal
     ("dps", {"n_groups": 7, "resampler": "stratified"}),   # 286 x 5, 285 x 2
     ("dps", {"n_groups": 3, "assignment": "interleaved", "resampler": "residual"}),
+    ("dps", {"n_groups": 3, "assignment": "persistent"}),  # a mixture of three PS filters
     ("dps", {"n_groups": 3, "weighting": "placed"}),
     ("dps", {"n_groups": 2, "weighting": "g-only", "resampler": "residual"}),
 ]

@@ -166,7 +166,8 @@ def test_bad_boxes_and_frames_raise(name):
     ("particle", {}, "unknown tracker 'particle'; valid trackers: condensation"),
     ("ps", {"orderings": 1}, "unknown parameter 'orderings' for tracker 'ps'; valid: .*ordering"),
     ("dps", {"n_groups": 0}, "n_groups"),
-    ("dps", {"assignment": "greedy"}, "unknown assignment 'greedy'; valid: random, interleaved"),
+    ("dps", {"assignment": "greedy"},
+     "unknown assignment 'greedy'; valid: random, interleaved, persistent"),
     ("ps", {"weighting": "joint"}, "unknown weighting 'joint'; valid: stage, placed, g-only"),
     ("joint-pf", {"weighting": "stage"}, "unknown parameter 'weighting' for tracker 'joint-pf'"),
     ("joint-pf", {"n_particles": 0}, "n_particles"),
@@ -205,8 +206,8 @@ def test_mixture_reassembly_weights_groups_by_size_and_evidence():
     sizes = np.array([3, 2])
     logpi = np.log(np.array([1.0, 1.0, 2.0, 5.0, 5.0]))  # unnormalised π' per group
     lik = np.array([0.5, 1.0, 2.0, 3.0, 1.0])
-    weights, mixture = DistributedPartitionedSampling._reassemble(logpi + np.log(lik), logpi,
-                                                                   sizes)
+    weights, mixture, log_mixture = DistributedPartitionedSampling._reassemble(
+        logpi + np.log(lik), logpi, sizes)
     pi = np.exp(logpi)
     ev = np.array([np.sum(pi[:3] * lik[:3]) / pi[:3].sum(),
                    np.sum(pi[3:] * lik[3:]) / pi[3:].sum()])
@@ -216,3 +217,41 @@ def test_mixture_reassembly_weights_groups_by_size_and_evidence():
     expected = np.concatenate([expected_mix[0] * w[:3] / w[:3].sum(),
                                expected_mix[1] * w[3:] / w[3:].sum()])
     np.testing.assert_allclose(weights, expected)
+    np.testing.assert_allclose(np.exp(log_mixture), mixture)
+    # Components that keep their particles carry their mixture weight: π_c,t ∝ π_c,t−1 ×
+    # evidence_c, here with π_c,t−1 = (0.9, 0.1) instead of the sizes' (0.6, 0.4); a
+    # component whose prior weight underflows stays finite in log and weighs nothing.
+    prior = np.log([0.9, 0.1])
+    weights, mixture, log_mixture = DistributedPartitionedSampling._reassemble(
+        logpi + np.log(lik), logpi, sizes, prior)
+    np.testing.assert_allclose(mixture, [0.9, 0.1] * ev / np.sum([0.9, 0.1] * ev))
+    _, mixture, log_mixture = DistributedPartitionedSampling._reassemble(
+        logpi + np.log(lik), logpi, sizes, np.array([0.0, -2000.0]))
+    assert mixture[1] == 0.0 and np.isfinite(log_mixture).all()
+    assert log_mixture[1] == pytest.approx(-2000.0 + np.log(ev[1] / ev[0]))
+
+
+@pytest.mark.parametrize("assignment, kept", [("persistent", True), ("random", False)])
+def test_persistent_components_keep_their_particles(assignment, kept):
+    """With ``assignment="persistent"`` every particle of component c moves from an
+    ancestor of component c at the end of the previous step; with "random" they mix."""
+    frames, boxes = _scene(3)
+    tr = DistributedPartitionedSampling(assignment=assignment, n_particles=60, rng=5)
+    moved: list = []
+    tr.propagation_hook = lambda before, after, objects: moved.append((before, objects))
+    tr.init(frames[0], boxes[0])
+    sizes = tr._sizes_c
+    group = np.repeat(np.arange(sizes.size), sizes)
+    inside = []
+    for t, frame in enumerate(frames[1:]):
+        old = tr.particles.copy()
+        moved.clear()
+        est = tr.step(frame)
+        np.testing.assert_allclose(est.extras["mixture_weights"].sum(), 1.0)
+        if t == 0:
+            continue
+        before, objects = moved[0]  # stage 0: ancestors as they were at the end of t − 1
+        for r in range(before.shape[0]):
+            own = old[group == group[r], objects[r]]
+            inside.append(bool((own == before[r]).all(axis=1).any()))
+    assert all(inside) if kept else not all(inside)

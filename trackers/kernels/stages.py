@@ -42,6 +42,7 @@ from trackers.kernels.sampling import _inverse_cdf_groups
 __all__ = [
     "effective_uv",
     "gather_pair",
+    "group_weights",
     "normalise_groups",
     "normalise_groups_checked",
     "normalise_rows",
@@ -486,6 +487,18 @@ def _group_max_shift(x, sizes):
     return out, top
 
 
+def group_weights(logw: NDArray[np.float64], sizes: NDArray[np.int64]) -> NDArray[np.float64]:
+    """exp(log w − its group's maximum) (N,): weights that never sum to 0 in a group.
+
+    ``logw`` (N,) holds contiguous groups of lengths ``sizes`` (C,); the largest weight
+    of every group is 1, so a group far below the others (log π_c → −∞) can still be
+    resampled within itself.
+    """
+    shifted, _ = _group_max_shift(np.ascontiguousarray(logw, dtype=np.float64),
+                                  np.ascontiguousarray(sizes, dtype=np.int64))
+    return np.exp(shifted)
+
+
 @njit(cache=True)
 def _reassemble_shift(logw, logpi, sizes):
     n = logw.shape[0]
@@ -539,8 +552,8 @@ def _final_log_weights(logw, log_mixture, log_total, sizes):
 
 
 def reassemble(logw: NDArray[np.float64], logpi: NDArray[np.float64],
-               sizes: NDArray[np.int64], log_prior: NDArray[np.float64] | None = None
-               ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+               sizes: NDArray[np.int64], log_prior: NDArray[np.float64] | None = None,
+               *, with_log: bool = False) -> tuple[NDArray[np.float64], ...]:
     """The DPS mixture reassembly (``_Partitioned._reassemble``) with compiled glue.
 
     Parameters
@@ -550,7 +563,11 @@ def reassemble(logw: NDArray[np.float64], logpi: NDArray[np.float64],
     sizes : ndarray of shape (C,), int64, C >= 2
         Group lengths.
     log_prior : ndarray of shape (C,), optional
-        log(N_c / N), ``np.log(sizes / sizes.sum())`` (computed here if None).
+        log π_c,t−1: log(N_c / N), ``np.log(sizes / sizes.sum())``, for groups drawn
+        afresh (computed here if None), or the previous step's log mixture weights for
+        groups that keep their particles.
+    with_log : bool, optional
+        Also return log π_c,t (which does not underflow where π_c,t does).
 
     Returns
     -------
@@ -558,6 +575,8 @@ def reassemble(logw: NDArray[np.float64], logpi: NDArray[np.float64],
         The posterior weights, summing to 1.
     mixture : ndarray of shape (C,)
         The mixture weights π_c,t.
+    log_mixture : ndarray of shape (C,)
+        log π_c,t, normalised; only with ``with_log``.
 
     Notes
     -----
@@ -574,8 +593,13 @@ def reassemble(logw: NDArray[np.float64], logpi: NDArray[np.float64],
     log_evidence = log_total - (top_p + logs[1])
     if log_prior is None:
         log_prior = np.log(sizes / sizes.sum())
-    mixture = _divide_by_sum(np.exp(_max_shift(log_prior + log_evidence)))
-    final = np.exp(_final_log_weights(logw, np.log(mixture), log_total, sizes))
+    top = _max_shift(log_prior + log_evidence)
+    mixture = _divide_by_sum(np.exp(top))
+    with np.errstate(divide="ignore"):  # a component far below the others: π_c = 0
+        log_mixture = np.log(mixture)
+    final = np.exp(_final_log_weights(logw, log_mixture, log_total, sizes))
+    if with_log:
+        return _divide_by_sum(final), mixture, top - np.log(np.exp(top).sum())
     return _divide_by_sum(final), mixture
 
 
