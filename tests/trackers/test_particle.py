@@ -229,6 +229,11 @@ def test_mixture_reassembly_weights_groups_by_size_and_evidence():
         logpi + np.log(lik), logpi, sizes, np.array([0.0, -2000.0]))
     assert mixture[1] == 0.0 and np.isfinite(log_mixture).all()
     assert log_mixture[1] == pytest.approx(-2000.0 + np.log(ev[1] / ev[0]))
+    # One group: plain normalisation, mixture (1,) and log mixture (0,).
+    weights, mixture, log_mixture = DistributedPartitionedSampling._reassemble(
+        np.log(lik), np.zeros(5), np.array([5]))
+    np.testing.assert_allclose(weights, lik / lik.sum())
+    assert mixture.tolist() == [1.0] and log_mixture.tolist() == [0.0]
 
 
 @pytest.mark.parametrize("assignment, kept", [("persistent", True), ("random", False)])

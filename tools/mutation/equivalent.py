@@ -94,6 +94,12 @@ EQUIVALENT["particle"] += [  # noqa: F821
      "np.exp(logpi - logpi.max()), np.exp(log_g + log_g.max()), sizes,",
      "a constant factor of g cancels in weighted resampling; the shift only keeps exp() "
      "in range (log_g is at most 0 after the shift, at least a few hundred below)"),
+    ("def _estimate(self, weights: NDArray[np.float64], extras: dict | None = None",
+     "def _estimate(self, weights: NDArray[np.float64], extras: dict & None = None",
+     "an annotation: never evaluated (from __future__ import annotations)"),
+    ("log_prior = np.log(sizes / sizes.sum())", "log_prior = np.log(sizes * sizes.sum())",
+     "every component's log prior moves by the same 2 log N, and the mixture weights are "
+     "normalised over the components (persistent components carry the normalised ones)"),
 ]
 EQUIVALENT["annealed"] = [  # noqa: F821
     ("coarse = np.broadcast_to(np.logspace(-8.0, 0.0, 65), (log_w.shape[0], 65))",
