@@ -514,7 +514,7 @@ class _Partitioned(_ParticleTracker):
         # mixture_c − log_total_c), in compiled glue between numpy's exp and log.
         if log_prior is None:
             log_prior = np.log(sizes / sizes.sum())
-        return reassemble(logw, logpi, sizes, log_prior, with_log=True)
+        return reassemble(logw, logpi, sizes, log_prior)
 
 
 class PartitionedSampling(_Partitioned):

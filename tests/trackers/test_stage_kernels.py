@@ -175,8 +175,9 @@ def test_reassemble_is_the_numpy_mixture_reassembly(sizes):
     logpi = rng.normal(0, 2, n)
     logw = logpi + rng.normal(-30, 10, n)
     want_w, want_m = _reassemble_numpy(logw, logpi, sizes)
-    got_w, got_m = reassemble(logw, logpi, sizes)
+    got_w, got_m, got_log = reassemble(logw, logpi, sizes, np.log(sizes / sizes.sum()))
     assert np.array_equal(got_w, want_w) and np.array_equal(got_m, want_m)
+    np.testing.assert_allclose(np.exp(got_log), want_m, rtol=1e-12)
 
 
 def test_weighted_mean_and_diagnostics_are_the_numpy_ones():

@@ -21,10 +21,6 @@ EQUIVALENT["particle"] = [  # noqa: F821
      "np.exp(logpi + logpi.max()), np.exp(log_g - log_g.max()), sizes,",
      "a constant factor of the weights cancels in weighted resampling; the shift only "
      "keeps exp() in range, and logpi = log of weights normalised per group is >= -log N"),
-    ("return reassemble(logw, logpi, sizes, np.log(sizes / sizes.sum()))",
-     "return reassemble(logw, logpi, sizes, np.log(sizes * sizes.sum()))",
-     "every component's log prior moves by the same 2 log N, and the mixture weights are "
-     "normalised over the components"),
     ("self._sizes_c = np.array([n // c + (i < n % c) for i in range(c)], dtype=np.int64)",
      "self._sizes_c = np.array([n / c + (i < n % c) for i in range(c)], dtype=np.int64)",
      "the int64 cast truncates the positive n / c + 0 or 1 to n // c + 0 or 1"),

@@ -552,8 +552,8 @@ def _final_log_weights(logw, log_mixture, log_total, sizes):
 
 
 def reassemble(logw: NDArray[np.float64], logpi: NDArray[np.float64],
-               sizes: NDArray[np.int64], log_prior: NDArray[np.float64] | None = None,
-               *, with_log: bool = False) -> tuple[NDArray[np.float64], ...]:
+               sizes: NDArray[np.int64], log_prior: NDArray[np.float64]
+               ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """The DPS mixture reassembly (``_Partitioned._reassemble``) with compiled glue.
 
     Parameters
@@ -562,12 +562,10 @@ def reassemble(logw: NDArray[np.float64], logpi: NDArray[np.float64],
         log w̃ and log π' of every particle.
     sizes : ndarray of shape (C,), int64, C >= 2
         Group lengths.
-    log_prior : ndarray of shape (C,), optional
+    log_prior : ndarray of shape (C,)
         log π_c,t−1: log(N_c / N), ``np.log(sizes / sizes.sum())``, for groups drawn
-        afresh (computed here if None), or the previous step's log mixture weights for
-        groups that keep their particles.
-    with_log : bool, optional
-        Also return log π_c,t (which does not underflow where π_c,t does).
+        afresh, or the previous step's log mixture weights for groups that keep their
+        particles.
 
     Returns
     -------
@@ -576,7 +574,7 @@ def reassemble(logw: NDArray[np.float64], logpi: NDArray[np.float64],
     mixture : ndarray of shape (C,)
         The mixture weights π_c,t.
     log_mixture : ndarray of shape (C,)
-        log π_c,t, normalised; only with ``with_log``.
+        log π_c,t, normalised (finite where π_c,t underflows to 0).
 
     Notes
     -----
@@ -591,16 +589,13 @@ def reassemble(logw: NDArray[np.float64], logpi: NDArray[np.float64],
     logs = np.log(_reassemble_sums(np.exp(shifted), sizes))
     log_total = top_w + logs[0]
     log_evidence = log_total - (top_p + logs[1])
-    if log_prior is None:
-        log_prior = np.log(sizes / sizes.sum())
     top = _max_shift(log_prior + log_evidence)
-    mixture = _divide_by_sum(np.exp(top))
+    e = np.exp(top)
+    mixture = _divide_by_sum(e)
     with np.errstate(divide="ignore"):  # a component far below the others: π_c = 0
         log_mixture = np.log(mixture)
     final = np.exp(_final_log_weights(logw, log_mixture, log_total, sizes))
-    if with_log:
-        return _divide_by_sum(final), mixture, top - np.log(np.exp(top).sum())
-    return _divide_by_sum(final), mixture
+    return _divide_by_sum(final), mixture, top - np.log(e.sum())
 
 
 @njit(cache=True)
