@@ -326,6 +326,12 @@ def dps_occlusion() -> SceneConfig:
     3.6–4.8 px, no ordering pattern; DPS 38–58 % against PS 33–52 %). Docs:
     "DPS Table 3 with the `stage` weighting".
 
+    Round 6, seven tracked objects (``tools/dps/variants.py --crowd``: four stationary
+    objects of ``dps-synthetic`` added near the corners, N = 300; tuning seeds 1–3, 18
+    runs per method): the walker sampled first ends the step with 11.5 % distinct states,
+    but every method loses it in most runs (DPS 2 / 18, PS pooled 21 / 126, Non-PS 2 / 18),
+    the final weights keeping six likelihoods. Not adopted.
+
     Differs from the paper: RealSeq1 is real video of people; ours are banded ellipses
     (hair/face/shirt/trousers), the occluders are a little larger than the walker so that
     occlusion is total for several frames each time, and the walk is nearly straight.

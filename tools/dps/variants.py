@@ -6,6 +6,7 @@ Usage::
     python tools/dps/variants.py dps-synthetic --seeds 1,2,3 -o /tmp/v --lam 150
     python tools/dps/variants.py dps-occlusion --seeds 7 -o /tmp/v --lam 150 \\
         --method ps-123 --method ps-231 --method ps-312 --method dps --param weighting=stage
+    python tools/dps/variants.py dps-occlusion --seeds 1,2,3 --crowd --scenes 3 --runs 2 -o /tmp/v
 
 It runs ``scenegen experiment NAME`` once per base seed into ``OUT/seed-<N>/`` (the same
 ``results.json``, ``table.md`` and run records), with any of:
@@ -18,7 +19,13 @@ It runs ``scenegen experiment NAME`` once per base seed into ``OUT/seed-<N>/`` (
 - ``--lam V`` (repeatable): run at λ = V instead of the experiment's λ (``dps-synthetic``
   sweeps 20…50; the others use one λ), e.g. a λ at which PS's first-stage uniqueness is
   as low as the paper's (1.99 of 300 particles at λ = 20, DPS §3.3);
-- ``--param KEY=VALUE`` and ``--method SLUG`` as for ``scenegen experiment``.
+- ``--crowd``: the occlusion scenes with four more tracked objects (looks 2–5 of
+  ``dps-synthetic``, 30x30, standing near the frame's corners, away from the walker's
+  path), so that seven objects are tracked as on ``dps-synthetic``, with its N = 300
+  and its seven circular-shift PS orderings; the paper expects impoverishment to "only
+  become more pronounced as ... more objects are added" (DPS §3.3);
+- ``--param KEY=VALUE``, ``--method SLUG``, ``--scenes S`` and ``--runs R`` as for
+  ``scenegen experiment``.
 
 ``OUT/seed-<N>/variant.json`` records the variant. The variant replaces the preset and
 the experiment in this process only, so the runs use one process (``jobs = 1``); start
@@ -36,6 +43,7 @@ from pathlib import Path
 
 from scenegen import presets
 from scenegen.cli.experiment import parse_overrides
+from scenegen.config import Appearance, EntitySpec
 from scenegen.lab.experiments import definitions, run_experiment
 
 DPS_EXPERIMENTS = ("dps-synthetic", "dps-occlusion", "dps-dancers")
@@ -48,6 +56,34 @@ def astray(cfg):
     if ents == cfg.entities:
         raise SystemExit(f"--astray: preset {cfg.name} has no distractor")
     return dataclasses.replace(cfg, entities=ents)
+
+
+CROWD_POSITIONS = ((70.0, 55.0), (290.0, 55.0), (70.0, 240.0), (290.0, 240.0))
+"""Where ``--crowd`` stands its four extra objects (centres, px)."""
+
+
+def crowd(cfg):
+    """``cfg`` with four more tracked, stationary objects: looks 2–5 of ``dps-synthetic``
+    at :data:`CROWD_POSITIONS`, behind everything else (they overlap nothing)."""
+    top = max(d for e in cfg.entities for _, d in e.depth)
+    extra = tuple(
+        EntitySpec(name=f"extra{i + 1}", role="target",
+                   appearance=Appearance(shape=shape, size=(30, 30), pattern=pattern,
+                                         colors=colors),
+                   position=pos, depth=((0, top + 1 + i),))
+        for i, ((shape, pattern, colors), pos) in enumerate(
+            zip(presets._DPS_LOOKS[1:5], CROWD_POSITIONS, strict=True)))
+    return dataclasses.replace(cfg, entities=(*cfg.entities, *extra))
+
+
+def crowd_experiment(exp: definitions.Experiment, m: int) -> definitions.Experiment:
+    """``exp`` with ``m`` tracked objects: Non-PS, the ``m`` circular-shift PS orderings
+    and DPS, at N = 300 and the experiment's λ."""
+    params = tuple((k, 300 if k == "n_particles" else v) for k, v in exp.methods[0].params)
+    return dataclasses.replace(exp, methods=(
+        definitions.Method("Non-PS", "nonps", "joint-pf", params),
+        *definitions._ps_methods(m, params),
+        definitions.Method("DPS", "dps", "dps", params)))
 
 
 def with_lam(exp: definitions.Experiment, lams: tuple[float, ...]) -> definitions.Experiment:
@@ -70,7 +106,11 @@ def main() -> None:
     ap.add_argument("-o", "--output", required=True, type=Path)
     ap.add_argument("--astray", action="store_true",
                     help="dps-synthetic: the distractor over object 1 from frame 0")
+    ap.add_argument("--crowd", action="store_true",
+                    help="dps-occlusion: four more tracked objects (seven in all), N = 300")
     ap.add_argument("--lam", action="append", type=float, default=None)
+    ap.add_argument("--scenes", type=int, default=None)
+    ap.add_argument("--runs", type=int, default=None)
     ap.add_argument("--param", action="append", default=None, metavar="KEY=VALUE")
     ap.add_argument("--method", action="append", default=None, metavar="SLUG")
     args = ap.parse_args()
@@ -80,14 +120,24 @@ def main() -> None:
             raise SystemExit("--astray applies to dps-synthetic only")
         base = presets._PRESETS["dps-synthetic"]
         presets._PRESETS["dps-synthetic"] = lambda: astray(base())
+    if args.crowd:
+        if args.experiment != "dps-occlusion":
+            raise SystemExit("--crowd applies to dps-occlusion only")
+        for name in exp.presets:
+            base_occ = presets._PRESETS[name]
+            presets._PRESETS[name] = lambda b=base_occ: crowd(b())
+        m = len(presets.get(exp.presets[0]).entities)
+        exp = definitions.EXPERIMENTS[args.experiment] = crowd_experiment(exp, m)
     if args.lam:
         definitions.EXPERIMENTS[args.experiment] = with_lam(exp, tuple(args.lam))
     overrides = parse_overrides(args.param)
-    variant = {"experiment": args.experiment, "astray": args.astray, "lam": args.lam,
-               "overrides": overrides, "methods": args.method}
+    variant = {"experiment": args.experiment, "astray": args.astray, "crowd": args.crowd,
+               "lam": args.lam, "overrides": overrides, "methods": args.method,
+               "scenes": args.scenes, "runs": args.runs}
     for seed in (int(s) for s in args.seeds.split(",")):
         out = args.output / f"seed-{seed}"
         results = run_experiment(args.experiment, out, seed=seed, jobs=1, methods=args.method,
+                                 scenes=args.scenes, runs=args.runs,
                                  overrides=overrides or None, progress=False, figures=False)
         (out / "variant.json").write_text(json.dumps({**variant, "seed": seed}, indent=1) + "\n")
         print(f"== {out}")

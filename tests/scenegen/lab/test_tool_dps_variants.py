@@ -47,9 +47,45 @@ def test_lam_replaces_the_sweep_or_every_methods_lam(tool):
         tool.with_lam(EXPERIMENTS["dps-occlusion"], (20.0, 40.0))
 
 
-def test_astray_is_refused_outside_dps_synthetic(tmp_path):
-    out = subprocess.run([sys.executable, str(TOOL), "dps-occlusion", "--seeds", "1",
-                          "--astray", "-o", str(tmp_path)], capture_output=True, text=True,
-                         timeout=120)
-    assert out.returncode != 0 and "dps-synthetic only" in out.stderr
+@pytest.mark.parametrize(("experiment", "flag", "message"), [
+    ("dps-occlusion", "--astray", "dps-synthetic only"),
+    ("dps-synthetic", "--crowd", "dps-occlusion only"),
+])
+def test_a_variant_is_refused_on_another_experiment(tmp_path, experiment, flag, message):
+    out = subprocess.run([sys.executable, str(TOOL), experiment, "--seeds", "1", flag,
+                          "-o", str(tmp_path)], capture_output=True, text=True, timeout=120)
+    assert out.returncode != 0 and message in out.stderr
     assert not any(tmp_path.iterdir())
+
+
+def _overlap(a, b) -> bool:
+    return a[0] < b[0] + b[2] and b[0] < a[0] + a[2] and a[1] < b[1] + b[3] and b[1] < a[1] + a[3]
+
+
+@pytest.mark.parametrize("name", ["dps-occlusion", "dps-occlusion-2"])
+def test_crowd_adds_four_tracked_objects_away_from_the_walkers_path(tool, name):
+    base = presets.get(name)
+    cfg = tool.crowd(base)
+    assert cfg.entities[:len(base.entities)] == base.entities
+    extra = cfg.entities[len(base.entities):]
+    assert [e.name for e in extra] == ["extra1", "extra2", "extra3", "extra4"]
+    assert all(e.role == "target" and e.motion is None for e in extra)
+    assert [e.appearance.pattern for e in extra] == [p for _, p, _ in presets._DPS_LOOKS[1:5]]
+    seq = scenegen.generate(cfg, seed=2)
+    box = np.asarray(seq.gt.box)
+    assert box.shape[1] == len(base.entities) + 4
+    n0 = len(base.entities)
+    # Over the whole sequence no extra object's box touches the walker's or a person's.
+    for t in range(seq.n_frames):
+        for i in range(n0, n0 + 4):
+            assert not any(_overlap(box[t, i], box[t, j]) for j in range(n0)), (t, i)
+
+
+def test_crowd_experiment_tracks_seven_objects_with_every_ordering(tool):
+    exp = tool.crowd_experiment(EXPERIMENTS["dps-occlusion"], 7)
+    slugs = [m.slug for m in exp.methods]
+    assert slugs[0] == "nonps" and slugs[-1] == "dps"
+    assert slugs[1:-1] == ["ps-1234567", "ps-2345671", "ps-3456712", "ps-4567123",
+                           "ps-5671234", "ps-6712345", "ps-7123456"]
+    assert all(m.param_dict()["n_particles"] == 300 for m in exp.methods)
+    assert all(m.param_dict()["lam"] == 20.0 for m in exp.methods)
