@@ -18,13 +18,16 @@ tied to exactly those records.
   record reads, matches its digest, its listed digest and its file name, and has the
   record's fields; ``results.json`` equals the summary recomputed from those records (so
   an edit whose digest was recomputed is still found); ``table.md`` is the table of
-  ``results.json``. With ``deep``, every run is also computed again and compared.
+  ``results.json``. With ``deep``, every run is also computed again and compared. When
+  only the summary or the table differs, the line names :func:`rerun_command`, which
+  recomputes both from the intact runs.
 """
 
 from __future__ import annotations
 
 import functools
 import json
+import shlex
 import sys
 from dataclasses import MISSING, fields
 from pathlib import Path
@@ -43,6 +46,7 @@ __all__ = [
     "read_results",
     "record_problems",
     "report_entry",
+    "rerun_command",
     "warn",
     "write_record",
     "write_results",
@@ -251,6 +255,55 @@ def _more(problems: list[str]) -> list[str]:
     return [*problems[:_MAX_LISTED], f"... and {len(problems) - _MAX_LISTED} more problems"]
 
 
+def rerun_command(exp: Any, keys: list[dict[str, Any]], folder: str | Path) -> str:
+    """The ``scenegen experiment`` command that plans exactly the runs of ``keys``.
+
+    Run into ``folder``, it resumes: the intact runs are kept and ``results.json`` and
+    ``table.md`` are computed again from them (what a summary written by another version
+    of scenegen needs).
+
+    Parameters
+    ----------
+    exp : Experiment
+        The experiment the runs belong to.
+    keys : list of dict
+        The ``key`` of each run record (S, R, base seed, quick flag, methods, swept values
+        and overrides are read from them).
+    folder : str or Path
+        The experiment folder.
+
+    Returns
+    -------
+    str
+        A shell command line, e.g. ``scenegen experiment shm-depth --runs 1 -o out/shm``.
+    """
+    runs = max(k["run"] for k in keys) + 1
+    scenes = max(k["scene"] for k in keys) + 1
+    seed, quick = int(keys[0]["seed"]), bool(keys[0]["quick"])
+    args = ["scenegen", "experiment", exp.name]
+    if scenes != exp.scenes:
+        args += ["--scenes", str(scenes)]
+    if runs != exp.runs:
+        args += ["--runs", str(runs)]
+    if seed:
+        args += ["--seed", str(seed)]
+    if quick:
+        args.append("--quick")
+    chosen = {k["method"] for k in keys}
+    if chosen != {m.slug for m in exp.methods}:
+        for m in exp.methods:
+            if m.slug in chosen:
+                args += ["--method", m.slug]
+    values = sorted({float(k["value"]) for k in keys if k["param"]})
+    if values and values != sorted(float(v) for _, v in exp.sweep_values(quick)):
+        for v in values:
+            args += ["--value", f"{v:g}"]
+    for name, value in sorted(map(tuple, keys[0].get("overrides") or ())):
+        text = value if isinstance(value, str) else json.dumps(value)
+        args += ["--param", f"{name}={text}"]
+    return shlex.join([*args, "-o", str(folder)])
+
+
 def check_experiment(folder: str | Path, *, deep: bool = False) -> list[str]:
     """Check an experiment folder; one line per problem, empty when it is sound.
 
@@ -306,11 +359,15 @@ def check_experiment(folder: str | Path, *, deep: bool = False) -> list[str]:
     except Exception as err:  # noqa: BLE001 - sound digests, yet contents no summary expects
         return [f"{res_path}: its runs cannot be summarised ({type(err).__name__}: "
                 f"{str(err)[:80]})"]  # fmt: skip
+    # The runs are intact (digests above), so a summary or table that differs was edited,
+    # or written by a scenegen that summarises differently; the hint says how to redo it.
+    command = rerun_command(exp, [r["key"] for r in records], root)
+    redo = f"or written by another version of scenegen: `{command}` recomputes it from the runs"
     if fresh != results:
         keys = sorted(k for k in set(fresh) | set(results) if fresh.get(k) != results.get(k))
         verb = "differs" if len(keys) == 1 else "differ"
         problems.append(f"{res_path}: {', '.join(keys)} {verb} from the summary of its runs "
-                        "(edited)")  # fmt: skip
+                        f"(edited, {redo})")  # fmt: skip
     table = root / "table.md"
     try:
         text = table.read_text(encoding="utf-8")
@@ -320,7 +377,8 @@ def check_experiment(folder: str | Path, *, deep: bool = False) -> list[str]:
         problems.append(f"{table}: unreadable ({type(err).__name__})")
     else:
         if text != render_table(exp, fresh, WHY.get(exp.name, "")):
-            problems.append(f"{table}: is not the table of {res_path.name} (damaged or edited)")
+            problems.append(f"{table}: is not the table of {res_path.name} (damaged, edited, "
+                            f"{redo})")  # fmt: skip
     if deep and not problems:
         for (name, _), rec in zip(entries, records, strict=True):
             again = json.loads(json.dumps(run_task(Task(**rec["key"])), sort_keys=True))

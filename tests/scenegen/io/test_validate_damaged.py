@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import os
+import shlex
 import shutil
 
 import h5py
@@ -609,11 +610,36 @@ def test_damaged_or_edited_experiment_files_are_one_line_each(exp_copy, capsys):
     ]
 
 
+def _redo(folder) -> str:
+    # EXP_ARGS, less the defaults of shm-depth (R = 1) and --jobs.
+    return ("or written by another version of scenegen: `scenegen experiment shm-depth "
+            f"--scenes 1 --quick --method kalman -o {folder}` recomputes it from the runs")
+
+
+def test_the_command_the_check_names_recomputes_the_summary_and_table(exp_copy, capsys):
+    # A summary and a table that the current code does not produce (as one written by
+    # another version): the named command, run into the folder, makes it valid again and
+    # computes no run again.
+    _reseal(exp_copy / "results.json", lambda d: d["summary"].__setitem__("extra", 1))
+    table = exp_copy / "table.md"
+    table.write_text(table.read_text() + "\nwritten by another version\n")
+    runs = {p.name: p.read_bytes() for p in (exp_copy / "runs").iterdir()}
+    code, err, _ = _validate(exp_copy, capsys)
+    assert code == 1 and len(err) == 2
+    command = err[0].split("`")[1]
+    assert command.startswith("scenegen experiment ") and err[1].split("`")[1] == command
+    assert main(shlex.split(command)[1:]) == 0
+    capsys.readouterr()
+    assert {p.name: p.read_bytes() for p in (exp_copy / "runs").iterdir()} == runs
+    assert _validate(exp_copy, capsys)[:2] == (0, [])
+
+
 def test_an_edited_results_json_is_found_even_resealed(exp_copy, capsys):
     res = exp_copy / "results.json"
     _reseal(res, lambda d: d["summary"].__setitem__("extra", 1))
     code, err, _ = _validate(exp_copy, capsys)
-    assert code == 1 and err == [f"{res}: summary differs from the summary of its runs (edited)"]
+    assert code == 1 and err == [f"{res}: summary differs from the summary of its runs "
+                                 f"(edited, {_redo(exp_copy)})"]
     _reseal(res, lambda d: d.__setitem__("runs", "1"))
     code, err, _ = _validate(exp_copy, capsys)
     assert err == [f"{res}: not an experiment's results (runs is missing or not a int)"]
@@ -623,7 +649,8 @@ def test_a_damaged_table_md_is_named(exp_copy, capsys):
     table = exp_copy / "table.md"
     table.write_text(table.read_text().replace("reproduced", "rEproduced", 1))
     code, err, _ = _validate(exp_copy, capsys)
-    assert code == 1 and err == [f"{table}: is not the table of results.json (damaged or edited)"]
+    assert code == 1 and err == [f"{table}: is not the table of results.json (damaged, edited, "
+                                 f"{_redo(exp_copy)})"]
     table.unlink()
     assert _validate(exp_copy, capsys)[1] == [f"{table}: missing"]
 

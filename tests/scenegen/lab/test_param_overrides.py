@@ -128,3 +128,34 @@ def test_compare_root_summarises_both_sides_and_adds_shared_runs(tmp_path, monke
     out = tmp_path / "t.md"
     assert kq.main([str(tmp_path), "-o", str(out)]) == 0
     assert "M/success" in out.read_text()
+
+
+@pytest.mark.parametrize(("name", "plan", "options"), [
+    ("shm-depth", {}, ""),
+    ("dps-synthetic", {"quick": True}, "--quick"),
+    ("dps-synthetic", {"runs": 2, "scenes": 3, "seed": 4, "methods": ["ps-1234567", "dps"],
+                       "values": [30.0, 50.0], "overrides": {"weighting": "placed",
+                                                             "sigma": [1.0, 1.0, 0.01]}},
+     "--scenes 3 --runs 2 --seed 4 --method ps-1234567 --method dps --value 30 --value 50 "
+     "--param 'sigma=[1.0, 1.0, 0.01]' --param weighting=placed"),
+    ("kams-accuracy", {"scenes": 1, "quick": True, "methods": ["kams"],
+                       "overrides": {"kernel": "epanechnikov", "n_layers": 4}},
+     "--scenes 1 --quick --method kams --param kernel=epanechnikov --param n_layers=4"),
+])
+def test_rerun_command_plans_exactly_the_runs_it_was_made_from(name, plan, options):
+    import dataclasses
+    import shlex
+
+    from scenegen.cli import _parser
+    from scenegen.lab.experiments.outputs import rerun_command
+
+    exp = get(name)
+    kw = {"runs": exp.runs, "seed": 0, "quick": False, **plan}
+    tasks = plan_tasks(exp, **kw)
+    command = rerun_command(exp, [dataclasses.asdict(t) for t in tasks], "out/x")
+    assert command == " ".join(filter(None, ["scenegen experiment", name, options, "-o out/x"]))
+    args = _parser().parse_args(shlex.split(command)[1:])
+    again = plan_tasks(get(args.name), runs=args.runs or exp.runs, scenes=args.scenes,
+                       seed=args.seed, quick=args.quick, methods=args.method,
+                       values=args.value, overrides=parse_overrides(args.param))
+    assert again == tasks
