@@ -37,7 +37,7 @@ from typing import Any
 
 from scenegen.errors import ConfigError
 from scenegen.lab.experiments.definitions import EXPERIMENTS, PAPER, Experiment, Method, get, names
-from scenegen.lab.experiments.outputs import RECORDS, listing, write_results
+from scenegen.lab.experiments.outputs import RECORDS, listing, sweep_of, write_results
 from scenegen.lab.experiments.runner import (
     Task,
     derive_seed,
@@ -93,9 +93,7 @@ def results_document(exp: Experiment, records: list[dict[str, Any]]) -> dict[str
     file with its digest), so ``scenegen validate DIR`` can compute it again.
     """
     keys = [r["key"] for r in records]
-    r = max(k["run"] for k in keys) + 1
-    s = max(k["scene"] for k in keys) + 1
-    seed, quick = int(keys[0]["seed"]), bool(keys[0]["quick"])
+    r, s, seed, quick = sweep_of(keys)
     chosen = {k["method"] for k in keys}
     results: dict[str, Any] = {
         "experiment": exp.name,

@@ -47,6 +47,7 @@ __all__ = [
     "record_problems",
     "report_entry",
     "rerun_command",
+    "sweep_of",
     "warn",
     "write_record",
     "write_results",
@@ -255,6 +256,13 @@ def _more(problems: list[str]) -> list[str]:
     return [*problems[:_MAX_LISTED], f"... and {len(problems) - _MAX_LISTED} more problems"]
 
 
+def sweep_of(keys: list[dict[str, Any]]) -> tuple[int, int, int, bool]:
+    """R, S, the base seed and the quick flag of a sweep, from its runs' ``key``s."""
+    runs = max(k["run"] for k in keys) + 1
+    scenes = max(k["scene"] for k in keys) + 1
+    return runs, scenes, int(keys[0]["seed"]), bool(keys[0]["quick"])
+
+
 def rerun_command(exp: Any, keys: list[dict[str, Any]], folder: str | Path) -> str:
     """The ``scenegen experiment`` command that plans exactly the runs of ``keys``.
 
@@ -277,9 +285,7 @@ def rerun_command(exp: Any, keys: list[dict[str, Any]], folder: str | Path) -> s
     str
         A shell command line, e.g. ``scenegen experiment shm-depth --runs 1 -o out/shm``.
     """
-    runs = max(k["run"] for k in keys) + 1
-    scenes = max(k["scene"] for k in keys) + 1
-    seed, quick = int(keys[0]["seed"]), bool(keys[0]["quick"])
+    runs, scenes, seed, quick = sweep_of(keys)
     args = ["scenegen", "experiment", exp.name]
     if scenes != exp.scenes:
         args += ["--scenes", str(scenes)]
@@ -361,13 +367,15 @@ def check_experiment(folder: str | Path, *, deep: bool = False) -> list[str]:
                 f"{str(err)[:80]})"]  # fmt: skip
     # The runs are intact (digests above), so a summary or table that differs was edited,
     # or written by a scenegen that summarises differently; the hint says how to redo it.
-    command = rerun_command(exp, [r["key"] for r in records], root)
-    redo = f"or written by another version of scenegen: `{command}` recomputes it from the runs"
+    def redo() -> str:
+        command = rerun_command(exp, [r["key"] for r in records], root)
+        return f"or written by another version of scenegen: `{command}` recomputes it from the runs"
+
     if fresh != results:
         keys = sorted(k for k in set(fresh) | set(results) if fresh.get(k) != results.get(k))
         verb = "differs" if len(keys) == 1 else "differ"
         problems.append(f"{res_path}: {', '.join(keys)} {verb} from the summary of its runs "
-                        f"(edited, {redo})")  # fmt: skip
+                        f"(edited, {redo()})")  # fmt: skip
     table = root / "table.md"
     try:
         text = table.read_text(encoding="utf-8")
@@ -378,7 +386,7 @@ def check_experiment(folder: str | Path, *, deep: bool = False) -> list[str]:
     else:
         if text != render_table(exp, fresh, WHY.get(exp.name, "")):
             problems.append(f"{table}: is not the table of {res_path.name} (damaged, edited, "
-                            f"{redo})")  # fmt: skip
+                            f"{redo()})")  # fmt: skip
     if deep and not problems:
         for (name, _), rec in zip(entries, records, strict=True):
             again = json.loads(json.dumps(run_task(Task(**rec["key"])), sort_keys=True))
