@@ -97,6 +97,7 @@ __all__ = [
     "ParticleParams",
     "PartitionedParams",
     "PartitionedSampling",
+    "RESAMPLE_SCOPES",
     "WEIGHTINGS",
     "circular_shift",
 ]
@@ -106,6 +107,10 @@ ASSIGNMENTS: tuple[str, ...] = ("random", "interleaved", "persistent")
 
 #: Weighting functions of PS's weighted resampling stages (``weighting``).
 WEIGHTINGS: tuple[str, ...] = ("stage", "placed", "g-only")
+
+#: What a PS stage's weighted resampling copies from the drawn ancestors
+#: (``resample_scope``).
+RESAMPLE_SCOPES: tuple[str, ...] = ("joint", "placed")
 
 
 def circular_shift(n_objects: int, k: int) -> NDArray[np.int64]:
@@ -195,13 +200,24 @@ class PartitionedParams(ParticleParams):
         first object is selected at every stage, then penalised by the final weights).
         All three keep the set a correct weighted sample of the same posterior
         (docs/algorithms.md §2.5).
+    resample_scope : {"joint", "placed"}, optional
+        **(open)** What a stage's weighted resampling copies from the drawn ancestor.
+        "joint" (default): the whole joint state, so the objects not yet placed in the
+        step are thinned by the placed objects' selections. "placed": only the
+        sub-states of the objects placed so far in the particle's ordering (o_1 … o_j at
+        stage j, "weighted resampling in each partition", DPS §3); the others keep
+        their own. Valid because the objects are independent a priori and in the
+        likelihood, and every step starts from an equally weighted set; then the object
+        sampled last is resampled once per step and the first M times.
     """
 
     weighting: str = "stage"
+    resample_scope: str = "joint"
 
     def __post_init__(self) -> None:
         super().__post_init__()
         check_choice(self, "weighting", WEIGHTINGS, what="weighting")
+        check_choice(self, "resample_scope", RESAMPLE_SCOPES)
 
 
 @dataclass(frozen=True)
@@ -434,6 +450,10 @@ class _Partitioned(_ParticleTracker):
         rows = np.arange(n)
         stage_only = self.params.weighting == "stage"
         g_only = self.params.weighting == "g-only"
+        # resample_scope "placed": placed[r, o] marks the objects row r has placed so far;
+        # only those come from the drawn ancestor (None: all of them).
+        placed = (np.zeros((n, m), dtype=np.bool_)
+                  if self.params.resample_scope == "placed" else None)
         # Stage 0's AR2 (the (N, 3) normals of ``AR2.propagate``); every later stage's
         # comes with the previous stage's weighted resampling, in one kernel call.
         new = propagate_objects(x, prev, objects[0], self.rng.standard_normal((n, 3)),
@@ -448,6 +468,8 @@ class _Partitioned(_ParticleTracker):
             if j == m - 1:
                 ll[np.arange(n), obj] = stage
                 break
+            if placed is not None:
+                placed[rows, obj] = True
             # Weighted resampling (DPS §3) inside each group: ancestors ∝ π g_j, weights
             # π / ρ. "stage": g_j = p(Z | X_{o_j}); "placed": g_j = Π_{i<=j} p(Z | X_{o_i}),
             # the objects placed so far (with π ∝ 1 / g_{j-1}, ancestors ∝ p(Z | X_{o_j}));
@@ -468,12 +490,18 @@ class _Partitioned(_ParticleTracker):
                 noise = self.rng.standard_normal((n, 3))
                 out = resample_propagate(pi_g[0], pi_g[1], sizes, uniforms, mode, x, prev,
                                          ll, log_g, objects[j + 1], noise, self._mean,
-                                         dyn._sigma, dyn.a1, dyn.a2)
+                                         dyn._sigma, dyn.a1, dyn.a2, placed)
             if out is None:
                 # Residual resampling, or weights the checked path rejects (it raises).
                 k, w = weighted_resample_groups(pi_g[0], pi_g[1], sizes, method=method,
                                                 rng=self.rng)
-                x, prev, ll, log_g = x[k], prev[k], ll[k], log_g[k]
+                if placed is None:
+                    x, prev, ll = x[k], prev[k], ll[k]
+                else:
+                    x = np.where(placed[:, :, None], x[k], x)
+                    prev = np.where(placed[:, :, None], prev[k], prev)
+                    ll = np.where(placed, ll[k], ll)
+                log_g = log_g[k]
                 noise = self.rng.standard_normal((n, 3))
                 new = propagate_objects(x, prev, objects[j + 1], noise, self._mean,
                                         dyn._sigma, dyn.a1, dyn.a2)

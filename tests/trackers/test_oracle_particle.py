@@ -151,6 +151,8 @@ CONFIGS = [
     ("ps", {"ordering": (1, 0, 2)}),
     ("ps", {"weighting": "placed"}),
     ("ps", {"weighting": "g-only", "ordering": 2}),
+    ("ps", {"resample_scope": "placed"}),
+    ("ps", {"resample_scope": "placed", "weighting": "placed", "ordering": 2}),
     ("dps", {"n_groups": 2}),                      # sizes 1000, 1000 (fast)
     ("dps", {"n_groups": 3}),                      # 667, 667, 666: unequal
     ("dps", {"n_groups": 7, "resampler": "stratified"}),   # 286 x 5, 285 x 2
@@ -158,6 +160,8 @@ CONFIGS = [
     ("dps", {"n_groups": 3, "assignment": "persistent"}),  # a mixture of three PS filters
     ("dps", {"n_groups": 3, "weighting": "placed"}),
     ("dps", {"n_groups": 2, "weighting": "g-only", "resampler": "residual"}),
+    ("dps", {"n_groups": 3, "resample_scope": "placed"}),
+    ("dps", {"n_groups": 3, "resample_scope": "placed", "resampler": "residual"}),
 ]
 IDS = [f"{name}-{'-'.join(f'{k}={v}' for k, v in p.items()) or 'default'}"
        for name, p in CONFIGS]

@@ -169,6 +169,7 @@ def test_bad_boxes_and_frames_raise(name):
     ("dps", {"assignment": "greedy"},
      "unknown assignment 'greedy'; valid: random, interleaved, persistent"),
     ("ps", {"weighting": "joint"}, "unknown weighting 'joint'; valid: stage, placed, g-only"),
+    ("dps", {"resample_scope": "all"}, "unknown resample_scope 'all'; valid: joint, placed"),
     ("joint-pf", {"weighting": "stage"}, "unknown parameter 'weighting' for tracker 'joint-pf'"),
     ("joint-pf", {"n_particles": 0}, "n_particles"),
     ("condensation", {"resampler": "best"}, "unknown resampler 'best'"),

@@ -133,6 +133,45 @@ def test_weighted_resample_gather_is_weighted_resample_groups(method, sizes):
     assert np.array_equal(fused[1], gx2) and np.array_equal(fused[2], gp2)
 
 
+@pytest.mark.parametrize("fused", [False, True])
+def test_the_placed_scope_gathers_only_the_placed_objects(fused):
+    # resample_scope "placed": a row's placed objects (x, prev, ll) come from its
+    # ancestor, the others stay the row's own; log_g always comes from the ancestor.
+    rng = np.random.default_rng(5)
+    sizes = np.array([40, 40, 20], dtype=np.int64)
+    n = int(sizes.sum())
+    x, prev, _ = _set(rng, n)
+    ll = rng.normal(size=(n, 4))
+    log_g = rng.normal(size=n)
+    placed = rng.random((n, 4)) < 0.5
+    pi_g = np.exp(np.stack([rng.normal(size=n), rng.normal(0, 3, n)]))
+    uniforms = np.random.default_rng(7).random(sizes.size)
+    k, w = weighted_resample_groups(pi_g[0], pi_g[1], sizes, method="systematic",
+                                    rng=np.random.default_rng(7))
+    want_x = np.where(placed[:, :, None], x[k], x)
+    want_p = np.where(placed[:, :, None], prev[k], prev)
+    if fused:
+        obj = rng.integers(0, 4, n).astype(np.int64)
+        noise = rng.standard_normal((n, 3))
+        mean, sig = np.zeros((4, 3)), np.array([2.0, 2.0, 0.001])
+        out = resample_propagate(pi_g[0], pi_g[1], sizes, uniforms, SYSTEMATIC, x, prev, ll,
+                                 log_g, obj, noise, mean, sig, 2.0, -1.0, placed)
+        new = propagate_objects(want_x, want_p, obj, noise, mean, sig, 2.0, -1.0)
+        assert out is not None and np.array_equal(out[5], new)
+        got_w, gx, gp, gll, gg = out[:5]
+    else:
+        out = weighted_resample_gather(pi_g[0], pi_g[1], sizes, uniforms, SYSTEMATIC, x, prev,
+                                       ll, log_g, placed)
+        assert out is not None
+        got_w, got_k, gx, gp, gll, gg = out
+        assert np.array_equal(got_k, k)
+    assert np.array_equal(got_w, w)
+    for a, b in ((gx, want_x), (gp, want_p), (gll, np.where(placed, ll[k], ll)),
+                 (gg, log_g[k])):
+        assert np.array_equal(a, b)
+    assert not np.array_equal(gx, x[k])  # the scope changed something
+
+
 def test_invalid_weights_leave_the_kernels_for_the_checked_path():
     a = np.array([1.0, np.nan, 1.0])
     out = weighted_resample_gather(a, np.ones(3), np.array([3]), np.array([0.5]), SYSTEMATIC,

@@ -18,8 +18,9 @@ are measured at the walker's own propagation, the same point of the cycle for ev
 method (docs/experiments.md, "DPS Table 3: why the orderings cannot differ with the
 `placed` weighting"). Those numbers are of ``--weighting placed``; the default is the
 trackers' own (``stage``, the papers' weighting, since round 4), measured in
-"DPS Table 3 with the `stage` weighting" (round 5). ``--param KEY=VALUE`` sets a numeric
-tracker parameter of every method, e.g. ``--param lam=150``.
+"DPS Table 3 with the `stage` weighting" (round 5). ``--param KEY=VALUE`` sets a tracker
+parameter of every method that has it, as ``scenegen experiment --param`` reads it, e.g.
+``--param lam=150`` or ``--param resample_scope=placed`` (PS and DPS only).
 It reads the walker's states before each propagation through the trackers'
 ``propagation_hook`` (tested in ``tests/trackers/test_ps_cycle.py``).
 """
@@ -27,19 +28,22 @@ It reads the walker's states before each propagation through the trackers'
 from __future__ import annotations
 
 import argparse
+import dataclasses
 
 import numba
 import numpy as np
 
 import scenegen
 import trackers
+from scenegen.cli.experiment import parse_overrides
 from scenegen.lab.experiments.definitions import get
 from scenegen.lab.experiments.runner import derive_seed, scene_seed
+from trackers.particle import ParticleParams
 
 
 def measure(preset: str, base: int, scene: int, slug: str, run: int,
             weighting: str | None = None,
-            extra: dict[str, float] | None = None) -> np.ndarray:
+            extra: dict[str, object] | None = None) -> np.ndarray:
     """(ancestors, spread, end uniqueness) averaged over all frames, then over hidden ones."""
     exp = get("dps-occlusion")
     method = exp.method(slug)
@@ -47,7 +51,10 @@ def measure(preset: str, base: int, scene: int, slug: str, run: int,
     params = method.param_dict()
     if weighting is not None and method.tracker in ("ps", "dps"):
         params["weighting"] = weighting
-    params.update(extra or {})
+    # Parameters of PS and DPS alone (weighting, resample_scope, …) skip the other filters.
+    shared = {f.name for f in dataclasses.fields(ParticleParams)}
+    params.update({k: v for k, v in (extra or {}).items()
+                   if method.tracker in ("ps", "dps") or k in shared})
     tr = trackers.make(method.tracker, rng=derive_seed(base, "cycle", slug, preset, scene, run),
                        **params)
     frames = seq.frames
@@ -82,9 +89,9 @@ def main() -> None:
     ap.add_argument("--weighting", default=None,
                     help="PS/DPS weighting (default: the trackers'; round 3 used placed)")
     ap.add_argument("--param", action="append", default=[], metavar="KEY=VALUE",
-                    help="a numeric tracker parameter for every method, e.g. lam=150")
+                    help="a tracker parameter for every method that has it, e.g. lam=150")
     args = ap.parse_args()
-    extra = {k: float(v) for k, v in (p.split("=", 1) for p in args.param)}
+    extra = parse_overrides(args.param)
     bases = [int(b) for b in args.seeds.split(",")]
     numba.set_num_threads(1)
     print("method   ancestors %  spread px  end uniq. %  | hidden: ancestors %  spread px")

@@ -11,7 +11,8 @@ few compiled calls over all particles at once (docs/algorithms.md, implementatio
 - ``stage_log_weights``: record a stage's log-likelihoods and return the shifted
   log-weights whose exponentials the weighted resampling needs;
 - ``weighted_resample_gather``: weighted resampling of every group and the gather of the
-  particle arrays by the drawn ancestors;
+  particle arrays by the drawn ancestors (every object's sub-state, or only the placed
+  objects', ``resample_scope``);
 - ``normalise_groups``: weights normalised per group (the plain resamplers' first step);
 - ``weighted_mean_states``: the weighted mean state per object, and the unweighted
   variance of the set (the diagnostics), for the estimate.
@@ -361,7 +362,26 @@ def gather_pair(x: NDArray[np.float64], prev: NDArray[np.float64], idx: NDArray[
 
 
 @njit(cache=True)
-def _weighted_resample_gather(a, b, sizes, uniforms, mode, x, prev, ll, log_g):
+def _gather_placed(x, prev, ll, idx, placed):
+    """x, prev, ll of every row with the placed objects' columns from the row's ancestor
+    and the others from the row itself (``resample_scope="placed"``)."""
+    n, m, d = x.shape
+    x2 = np.empty((n, m, d))
+    p2 = np.empty((n, m, d))
+    ll2 = np.empty((n, m))
+    for i in range(n):
+        for o in range(m):
+            src = idx[i] if placed[i, o] else i
+            for c in range(d):
+                x2[i, o, c] = x[src, o, c]
+                p2[i, o, c] = prev[src, o, c]
+            ll2[i, o] = ll[src, o]
+    return x2, p2, ll2
+
+
+@njit(cache=True)
+def _weighted_resample_gather(a, b, sizes, uniforms, mode, x, prev, ll, log_g, scoped,
+                              placed):
     n = a.shape[0]
     if not (_valid(a) and _valid(b)):
         return np.empty(0), np.empty(0, dtype=np.int64), x, prev, ll, log_g
@@ -374,16 +394,29 @@ def _weighted_resample_gather(a, b, sizes, uniforms, mode, x, prev, ll, log_g):
     for i in range(n):
         new[i] = 1.0 / b[idx[i]]
     w, _ = _normalise_groups(new, sizes)
+    g2 = np.empty_like(log_g)
+    for i in range(n):
+        g2[i] = log_g[idx[i]]
+    if scoped:
+        x2, prev2, ll2 = _gather_placed(x, prev, ll, idx, placed)
+        return w, idx, x2, prev2, ll2, g2
     x2, prev2 = _gather_pair(x, prev, idx)
     m = ll.shape[1]
     ll2 = np.empty_like(ll)
-    g2 = np.empty_like(log_g)
     for i in range(n):
         k = idx[i]
         for o in range(m):
             ll2[i, o] = ll[k, o]
-        g2[i] = log_g[k]
     return w, idx, x2, prev2, ll2, g2
+
+
+_JOINT = np.empty((0, 0), dtype=np.bool_)
+
+
+def _scope(placed: NDArray[np.bool_] | None) -> tuple[bool, NDArray[np.bool_]]:
+    if placed is None:
+        return False, _JOINT
+    return True, np.ascontiguousarray(placed, dtype=np.bool_)
 
 
 def weighted_resample_gather(
@@ -396,6 +429,7 @@ def weighted_resample_gather(
     prev: NDArray[np.float64],
     ll: NDArray[np.float64],
     log_g: NDArray[np.float64],
+    placed: NDArray[np.bool_] | None = None,
 ) -> tuple[NDArray[np.float64], NDArray[np.int64], NDArray[np.float64], NDArray[np.float64],
            NDArray[np.float64], NDArray[np.float64]] | None:
     """Weighted resampling of every group (``weighted_resample_groups``) and the gather.
@@ -417,6 +451,11 @@ def weighted_resample_gather(
     ll : ndarray of shape (N, K)
     log_g : ndarray of shape (N,)
         Per-particle arrays to gather by the drawn ancestors.
+    placed : ndarray of shape (N, K), bool, optional
+        None (``resample_scope="joint"``): every object of a row comes from its ancestor.
+        Otherwise only the objects marked True (those placed so far in the row's
+        ordering) do, and the others keep the row's own x, prev and ll
+        (``resample_scope="placed"``); ``log_g`` always comes from the ancestor.
 
     Returns
     -------
@@ -425,15 +464,16 @@ def weighted_resample_gather(
         gathered); None if ``a`` or ``b`` is negative or not finite or a group's π g sums
         to zero (the caller then takes the checked numpy path, which raises).
     """
-    out = _weighted_resample_gather(a, b, sizes, uniforms, int(mode), x, prev, ll, log_g)
+    out = _weighted_resample_gather(a, b, sizes, uniforms, int(mode), x, prev, ll, log_g,
+                                    *_scope(placed))
     return None if out[0].shape[0] == 0 else out
 
 
 @njit(cache=True)
 def _resample_propagate(a, b, sizes, uniforms, mode, x, prev, ll, log_g, obj, noise, mean,
-                        sigma, a1, a2):
+                        sigma, a1, a2, scoped, placed):
     w, idx, x2, prev2, ll2, g2 = _weighted_resample_gather(a, b, sizes, uniforms, mode, x,
-                                                           prev, ll, log_g)
+                                                           prev, ll, log_g, scoped, placed)
     if w.shape[0] == 0:
         return w, x2, prev2, ll2, g2, np.empty((0, 3))
     new = _propagate_objects(x2, prev2, obj, noise, mean, sigma, a1, a2)
@@ -456,16 +496,18 @@ def resample_propagate(
     sigma: NDArray[np.float64],
     a1: float,
     a2: float,
+    placed: NDArray[np.bool_] | None = None,
 ) -> tuple[NDArray[np.float64], ...] | None:
     """``weighted_resample_gather`` then ``propagate_objects`` of the next stage, one call.
 
     The arguments are those of the two functions (``noise`` (N, 3) the next stage's
-    normals, drawn after ``uniforms``; ``obj`` (N,) its objects). Returns (new weights
+    normals, drawn after ``uniforms``; ``obj`` (N,) its objects; ``placed`` (N, K) or
+    None, the scope of the gather). Returns (new weights
     (N,), x, prev, ll, log_g gathered, with x and prev propagated, and the new states
     (N, 3) of the stage's objects), or None where ``weighted_resample_gather`` is None.
     """
     out = _resample_propagate(a, b, sizes, uniforms, int(mode), x, prev, ll, log_g, obj,
-                              noise, mean, sigma, float(a1), float(a2))
+                              noise, mean, sigma, float(a1), float(a2), *_scope(placed))
     return None if out[0].shape[0] == 0 else out
 
 
