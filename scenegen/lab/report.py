@@ -22,6 +22,7 @@ from typing import Any
 from scenegen.errors import DataError
 from scenegen.io.sealed import write_sealed_json
 from scenegen.lab.experiments import get, names, run_experiment, verdict_counts
+from scenegen.lab.experiments.definitions import DEMO_PLAN
 from scenegen.lab.experiments.outputs import read_results, report_entry
 from scenegen.lab.experiments.tables import render_table
 from scenegen.lab.experiments.why import WHY
@@ -29,17 +30,6 @@ from scenegen.lab.experiments.why import WHY
 __all__ = ["DEMO_PLAN", "FULL_COMMAND", "build_report", "markdown_to_html", "run_all",
            "run_demo_experiments"]
 
-# Per experiment: (scenes S, runs R per scene, quick mode) of `make demo`. Chosen so that
-# the whole demo (presets, previews, experiments, report) stays within 10 minutes on 2
-# cores; its verdicts are indicative. The full reproduction is `scenegen experiment all`.
-DEMO_PLAN: dict[str, tuple[int, int, bool]] = {
-    "dps-synthetic": (4, 2, False),
-    "dps-occlusion": (4, 2, False),
-    "kams-accuracy": (3, 1, False),
-    "kams-robustness": (3, 1, False),
-    "shm-depth": (6, 1, False),
-    "dps-dancers": (4, 2, False),
-}
 FULL_COMMAND = "scenegen experiment all -o out/"
 """The command of the full reproduction (every experiment at its default S x R)."""
 

@@ -13,7 +13,7 @@ from typing import Any
 
 from scenegen.errors import ConfigError
 
-__all__ = ["EXPERIMENTS", "PAPER", "Experiment", "Method", "get", "names"]
+__all__ = ["DEMO_PLAN", "EXPERIMENTS", "PAPER", "Experiment", "Method", "get", "names"]
 
 
 @dataclass(frozen=True)
@@ -257,6 +257,19 @@ EXPERIMENTS: dict[str, Experiment] = {
     e.name: e
     for e in (DPS_SYNTHETIC, DPS_OCCLUSION, KAMS_ACCURACY, KAMS_ROBUSTNESS, SHM_DEPTH,
               DPS_DANCERS)
+}
+
+# Per experiment: (scenes S, runs R per scene, quick mode) of `make demo` (`scenegen demo`,
+# always base seed 0). Chosen so that the whole demo (presets, previews, experiments,
+# report) stays within 10 minutes on 2 cores; its verdicts are indicative. The full
+# reproduction is `scenegen experiment all`, at each experiment's own S x R.
+DEMO_PLAN: dict[str, tuple[int, int, bool]] = {
+    "dps-synthetic": (4, 2, False),
+    "dps-occlusion": (4, 2, False),
+    "kams-accuracy": (3, 1, False),
+    "kams-robustness": (3, 1, False),
+    "shm-depth": (6, 1, False),
+    "dps-dancers": (4, 2, False),
 }
 
 # The papers' figures, keyed like our summaries. Percentages unless marked.

@@ -46,6 +46,7 @@ __all__ = [
     "read_results",
     "record_problems",
     "report_entry",
+    "report_rerun_command",
     "rerun_command",
     "sweep_of",
     "warn",
@@ -295,6 +296,14 @@ def rerun_command(exp: Any, keys: list[dict[str, Any]], folder: str | Path) -> s
         args += ["--seed", str(seed)]
     if quick:
         args.append("--quick")
+    return shlex.join([*args, *_restriction_args(exp, keys), "-o", str(folder)])
+
+
+def _restriction_args(exp: Any, keys: list[dict[str, Any]]) -> list[str]:
+    """The ``--method``, ``--value`` and ``--param`` options that plan the runs of ``keys``
+    (none for a sweep of every method and value without overrides)."""
+    args: list[str] = []
+    quick = sweep_of(keys)[3]
     chosen = {k["method"] for k in keys}
     if chosen != {m.slug for m in exp.methods}:
         for m in exp.methods:
@@ -307,6 +316,53 @@ def rerun_command(exp: Any, keys: list[dict[str, Any]], folder: str | Path) -> s
     for name, value in sorted(map(tuple, keys[0].get("overrides") or ())):
         text = value if isinstance(value, str) else json.dumps(value)
         args += ["--param", f"{name}={text}"]
+    return args
+
+
+def report_rerun_command(sweeps: dict[str, list[dict[str, Any]]], folder: str | Path
+                         ) -> str | None:  # fmt: skip
+    """The command that writes a report folder's ``results.json`` and ``index.html`` again
+    from its intact experiments, or None when no one command planned them all.
+
+    Parameters
+    ----------
+    sweeps : dict
+        Per experiment name, the ``key`` of each of its run records.
+    folder : str or Path
+        The report folder.
+
+    Returns
+    -------
+    str or None
+        ``scenegen demo -o DIR`` for the demo's counts (:data:`DEMO_PLAN`, base seed 0),
+        else ``scenegen experiment all ... -o DIR`` when every experiment ran every method
+        and value without ``--param`` and one ``--scenes``/``--runs``/``--seed``/``--quick``
+        fits them all; run into the folder, either resumes without computing a run again.
+    """
+    from scenegen.lab.experiments.definitions import DEMO_PLAN, get, names
+
+    if set(sweeps) != set(names()):
+        return None  # `all` would run the missing experiments: not a repair
+    exps = {name: get(name) for name in sweeps}
+    if any(_restriction_args(exps[n], keys) for n, keys in sweeps.items()):
+        return None
+    plans = {n: sweep_of(keys) for n, keys in sweeps.items()}  # (R, S, seed, quick)
+    if len({p[2] for p in plans.values()}) != 1 or len({p[3] for p in plans.values()}) != 1:
+        return None
+    seed, quick = next(iter(plans.values()))[2:]
+    if all((s, r, q) == DEMO_PLAN[n] for n, (r, s, _, q) in plans.items()) and seed == 0:
+        return shlex.join(["scenegen", "demo", "-o", str(folder)])
+    args = ["scenegen", "experiment", "all"]
+    for flag, at, default in (("--scenes", 1, "scenes"), ("--runs", 0, "runs")):
+        if all(p[at] == getattr(exps[n], default) for n, p in plans.items()):
+            continue
+        if len({p[at] for p in plans.values()}) != 1:
+            return None
+        args += [flag, str(next(iter(plans.values()))[at])]
+    if seed:
+        args += ["--seed", str(seed)]
+    if quick:
+        args.append("--quick")
     return shlex.join([*args, "-o", str(folder)])
 
 
@@ -326,6 +382,11 @@ def check_experiment(folder: str | Path, *, deep: bool = False) -> list[str]:
     list of str
         Each line names the file at fault (at most a few per kind, then a count).
     """
+    return _check_experiment(folder, deep)[0]
+
+
+def _check_experiment(folder: str | Path, deep: bool) -> tuple[list[str], list[dict[str, Any]]]:
+    """:func:`check_experiment`'s lines, and the ``key`` of every record it read."""
     from scenegen.lab.experiments import results_document
     from scenegen.lab.experiments.definitions import get
     from scenegen.lab.experiments.runner import Task, run_task
@@ -337,7 +398,7 @@ def check_experiment(folder: str | Path, *, deep: bool = False) -> list[str]:
     try:
         results = read_results(res_path)
     except DataError as err:
-        return [str(err)]
+        return [str(err)], []
     exp = get(results["experiment"])
     problems: list[str] = []
     records: list[dict[str, Any]] = []
@@ -358,23 +419,24 @@ def check_experiment(folder: str | Path, *, deep: bool = False) -> list[str]:
             problems.append(f"{path}: is not the run {res_path.name} was computed from "
                             "(edited or replaced since)")  # fmt: skip
         records.append(rec)
+    keys = [r["key"] for r in records]
     if problems:
-        return _more(problems)
+        return _more(problems), keys
     try:
         fresh = results_document(exp, records)
     except Exception as err:  # noqa: BLE001 - sound digests, yet contents no summary expects
         return [f"{res_path}: its runs cannot be summarised ({type(err).__name__}: "
-                f"{str(err)[:80]})"]  # fmt: skip
+                f"{str(err)[:80]})"], keys  # fmt: skip
     # The runs are intact (digests above), so a summary or table that differs was edited,
     # or written by a scenegen that summarises differently; the hint says how to redo it.
     def redo() -> str:
-        command = rerun_command(exp, [r["key"] for r in records], root)
+        command = rerun_command(exp, keys, root)
         return f"or written by another version of scenegen: `{command}` recomputes it from the runs"
 
     if fresh != results:
-        keys = sorted(k for k in set(fresh) | set(results) if fresh.get(k) != results.get(k))
-        verb = "differs" if len(keys) == 1 else "differ"
-        problems.append(f"{res_path}: {', '.join(keys)} {verb} from the summary of its runs "
+        changed = sorted(k for k in set(fresh) | set(results) if fresh.get(k) != results.get(k))
+        verb = "differs" if len(changed) == 1 else "differ"
+        problems.append(f"{res_path}: {', '.join(changed)} {verb} from the summary of its runs "
                         f"(edited, {redo()})")  # fmt: skip
     table = root / "table.md"
     try:
@@ -392,7 +454,7 @@ def check_experiment(folder: str | Path, *, deep: bool = False) -> list[str]:
             again = json.loads(json.dumps(run_task(Task(**rec["key"])), sort_keys=True))
             if again != rec:
                 problems.append(f"{root / 'runs' / name}: differs from the run computed again")
-    return _more(problems)
+    return _more(problems), keys
 
 
 def check_report(folder: str | Path) -> list[str]:
@@ -404,11 +466,12 @@ def check_report(folder: str | Path) -> list[str]:
     root = Path(folder)
     problems: list[str] = []
     expected: dict[str, Any] = {}
+    sweeps: dict[str, list[dict[str, Any]]] = {}
     for name in names():
         sub = root / "experiments" / name
         if not (sub / "results.json").exists():
             continue
-        found = check_experiment(sub)
+        found, sweeps[name] = _check_experiment(sub, False)
         problems += found
         if not found:
             expected[name] = report_entry(read_results(sub / "results.json", name))
@@ -418,8 +481,10 @@ def check_report(folder: str | Path) -> list[str]:
     except DataError as err:
         return [*problems, str(err)]
     if doc.get("experiments") != expected and not problems:
+        command = report_rerun_command(sweeps, root)
+        redo = f"; `{command}` writes it again from them" if command else ""
         problems.append(f"{path}: does not hold the results of {root / 'experiments'} "
-                        "(edited or stale)")  # fmt: skip
+                        f"(edited or stale{redo})")  # fmt: skip
     return problems
 
 

@@ -399,6 +399,40 @@ def test_experiment_all_writes_one_report(tmp_path, monkeypatch, capsys):
     assert main(["experiment", "all", "--value", "20", "-o", str(tmp_path)]) == 2
 
 
+def test_a_stale_report_names_the_command_that_writes_it_again(tmp_path, monkeypatch, capsys):
+    # The report's results.json no longer holds its experiments' results (edited, or written
+    # by another version): `validate` names the command, which rewrites it from the intact
+    # experiments without computing a run again.
+    import shlex
+
+    from scenegen.cli import main
+    from scenegen.io.sealed import seal
+    from scenegen.lab import report
+    from scenegen.lab.experiments import definitions
+
+    monkeypatch.setattr(report, "names", lambda: ["shm-depth"])
+    monkeypatch.setattr(definitions, "names", lambda: ["shm-depth"])
+    assert main(["experiment", "all", "--scenes", "1", "--quick", "--jobs", "1",
+                 "-o", str(tmp_path)]) == 0
+    res = tmp_path / "results.json"
+    doc = json.loads(res.read_text())
+    doc.pop("sha256")
+    doc["experiments"]["shm-depth"]["scenes"] = 2
+    res.write_text(json.dumps(seal(doc), indent=1))
+    capsys.readouterr()
+    assert main(["validate", str(tmp_path)]) == 1
+    (line,) = capsys.readouterr().err.splitlines()
+    command = f"scenegen experiment all --scenes 1 --quick -o {tmp_path}"
+    assert line == (f"{res}: does not hold the results of {tmp_path / 'experiments'} "
+                    f"(edited or stale; `{command}` writes it again from them)")
+    runs = tmp_path / "experiments" / "shm-depth" / "runs"
+    before = {p.name: p.read_bytes() for p in runs.iterdir()}
+    assert main(shlex.split(command)[1:]) == 0
+    assert {p.name: p.read_bytes() for p in runs.iterdir()} == before
+    capsys.readouterr()
+    assert main(["validate", str(tmp_path)]) == 0
+
+
 def _pool_records(successes: dict[str, int], n: int = 50, scenes: int = 10) -> tuple[dict, dict]:
     """Fake runs: method label -> ``successes[label]`` successful runs of ``n`` on
     ``scenes`` scenes (n / scenes runs each, the successes on the first runs), and the

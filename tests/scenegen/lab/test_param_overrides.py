@@ -159,3 +159,74 @@ def test_rerun_command_plans_exactly_the_runs_it_was_made_from(name, plan, optio
                        seed=args.seed, quick=args.quick, methods=args.method,
                        values=args.value, overrides=parse_overrides(args.param))
     assert again == tasks
+
+
+def _sweeps(plan, seed=0, **restrict):
+    """Per experiment, the run keys of `scenegen experiment all` with per-experiment
+    (S, R, quick) ``plan`` (missing: the experiment's own S x R, not quick)."""
+    import dataclasses
+
+    from scenegen.lab.experiments import names
+
+    out = {}
+    for name in names():
+        exp = get(name)
+        s, r, q = plan.get(name, (exp.scenes, exp.runs, False))
+        tasks = plan_tasks(exp, runs=r, scenes=s, seed=seed, quick=q,
+                           **restrict.get(name, {}))
+        out[name] = [dataclasses.asdict(t) for t in tasks]
+    return out
+
+
+def _uniform(s, r, q):
+    from scenegen.lab.experiments import names
+
+    return dict.fromkeys(names(), (s, r, q))
+
+
+@pytest.mark.parametrize(("plan", "seed", "restrict", "command"), [
+    ({}, 0, {}, "scenegen experiment all -o out/x"),
+    ({}, 7, {}, "scenegen experiment all --seed 7 -o out/x"),
+    ("demo", 0, {}, "scenegen demo -o out/x"),
+    ("uniform", 3, {}, "scenegen experiment all --scenes 2 --runs 1 --seed 3 --quick -o out/x"),
+    # The demo's counts on another seed: `scenegen demo` runs seed 0 only, and its S
+    # differ by experiment, which `all` cannot say.
+    ("demo", 5, {}, None),
+    # A restricted sweep, or one with a tracker parameter: `all` cannot plan it.
+    ({}, 0, {"shm-depth": {"methods": ["kalman"]}}, None),
+    ({}, 0, {"kams-accuracy": {"methods": ["kams"], "overrides": {"n_layers": 4}}}, None),
+])
+def test_report_rerun_command_plans_exactly_the_folders_runs(plan, seed, restrict, command):
+    import shlex
+
+    from scenegen.cli import _parser
+    from scenegen.lab.experiments.definitions import DEMO_PLAN
+    from scenegen.lab.experiments.outputs import report_rerun_command
+
+    if isinstance(plan, str):
+        plan = {"demo": DEMO_PLAN, "uniform": _uniform(2, 1, True)}[plan]
+    sweeps = _sweeps(plan, seed, **restrict)
+    assert report_rerun_command(sweeps, "out/x") == command
+    if command is None:
+        return
+    args = _parser().parse_args(shlex.split(command)[1:])
+    if args.func.__name__ == "cmd_demo":
+        again = _sweeps(DEMO_PLAN, 0)  # what run_demo_experiments plans
+    else:
+        again = _sweeps({n: (args.scenes or get(n).scenes, args.runs or get(n).runs,
+                             args.quick) for n in sweeps}, args.seed)  # fmt: skip
+    assert again == sweeps
+
+
+def test_report_rerun_command_needs_every_experiment_and_one_seed():
+    from scenegen.lab.experiments.outputs import report_rerun_command
+
+    sweeps = _sweeps({})
+    assert report_rerun_command({k: v for k, v in sweeps.items() if k != "shm-depth"},
+                                "d") is None  # fmt: skip
+    other = _sweeps({}, seed=1)
+    assert report_rerun_command({**sweeps, "shm-depth": other["shm-depth"]}, "d") is None
+    mixed = _sweeps({"shm-depth": (3, 1, False)})
+    assert report_rerun_command(mixed, "d") is None  # S = 3 for one, defaults elsewhere
+    same = _sweeps(_uniform(3, 2, False))
+    assert report_rerun_command(same, "d") == "scenegen experiment all --scenes 3 --runs 2 -o d"
