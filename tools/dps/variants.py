@@ -24,6 +24,11 @@ It runs ``scenegen experiment NAME`` once per base seed into ``OUT/seed-<N>/`` (
   path), so that seven objects are tracked as on ``dps-synthetic``, with its N = 300
   and its seven circular-shift PS orderings; the paper expects impoverishment to "only
   become more pronounced as ... more objects are added" (DPS §3.3);
+- ``--preset NAME``: run only this preset of the experiment (``dps-occlusion`` has two);
+- ``--tune KEY=VALUE`` (repeatable): set one of the preset's tuned quantities, the entries
+  of its ``*_TUNING`` dict in :mod:`scenegen.presets` (``OCCLUSION_TUNING``,
+  ``OCCLUSION2_TUNING``, ``DANCERS_TUNING``), VALUE read as JSON with lists as tuples, e.g.
+  ``--preset dps-occlusion-2 --tune 'shirt2=[[40, 140, 40]]' --tune speed=1.4``;
 - ``--param KEY=VALUE``, ``--method SLUG``, ``--scenes S`` and ``--runs R`` as for
   ``scenegen experiment``.
 
@@ -99,6 +104,30 @@ def with_lam(exp: definitions.Experiment, lams: tuple[float, ...]) -> definition
     return dataclasses.replace(exp, methods=methods)
 
 
+TUNING = {"dps-occlusion": "OCCLUSION_TUNING", "dps-occlusion-2": "OCCLUSION2_TUNING",
+          "dps-dancers": "DANCERS_TUNING"}
+"""The dict of :mod:`scenegen.presets` that holds each tunable preset's tuned quantities."""
+
+
+def _tuples(v):
+    return tuple(_tuples(x) for x in v) if isinstance(v, list) else v
+
+
+def tune(preset: str, items: list[str]) -> dict[str, object]:
+    """Set ``KEY=VALUE`` items in ``preset``'s tuning dict (in this process); returns them."""
+    if preset not in TUNING:
+        raise SystemExit(f"--tune: preset {preset} has no tuned quantities; "
+                         f"tunable: {', '.join(TUNING)}")
+    table = getattr(presets, TUNING[preset])
+    done: dict[str, object] = {}
+    for key, value in parse_overrides(items).items():
+        if key not in table:
+            raise SystemExit(f"--tune: {preset} has no tuned quantity {key!r}; "
+                             f"its quantities: {', '.join(table)}")
+        table[key] = done[key] = _tuples(value)
+    return done
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("experiment", choices=DPS_EXPERIMENTS)
@@ -113,8 +142,23 @@ def main() -> None:
     ap.add_argument("--runs", type=int, default=None)
     ap.add_argument("--param", action="append", default=None, metavar="KEY=VALUE")
     ap.add_argument("--method", action="append", default=None, metavar="SLUG")
+    ap.add_argument("--preset", default=None, help="run only this preset of the experiment")
+    ap.add_argument("--tune", action="append", default=[], metavar="KEY=VALUE",
+                    help="a tuned quantity of the preset, VALUE as JSON (lists as tuples)")
     args = ap.parse_args()
     exp = definitions.EXPERIMENTS[args.experiment]
+    if args.preset is not None:
+        if args.preset not in exp.presets:
+            raise SystemExit(f"--preset: {args.experiment} has the presets "
+                             f"{', '.join(exp.presets)}")
+        exp = definitions.EXPERIMENTS[args.experiment] = dataclasses.replace(
+            exp, presets=(args.preset,))
+    tuned = {}
+    if args.tune:
+        if args.preset is None and len(exp.presets) != 1:
+            raise SystemExit(f"--tune: name the preset (--preset), {args.experiment} has "
+                             f"{', '.join(exp.presets)}")
+        tuned = tune(exp.presets[0], args.tune)
     if args.astray:
         if args.experiment != "dps-synthetic":
             raise SystemExit("--astray applies to dps-synthetic only")
@@ -133,7 +177,8 @@ def main() -> None:
     overrides = parse_overrides(args.param)
     variant = {"experiment": args.experiment, "astray": args.astray, "crowd": args.crowd,
                "lam": args.lam, "overrides": overrides, "methods": args.method,
-               "scenes": args.scenes, "runs": args.runs}
+               "scenes": args.scenes, "runs": args.runs, "preset": args.preset,
+               "tune": {k: v for k, v in tuned.items()}}
     for seed in (int(s) for s in args.seeds.split(",")):
         out = args.output / f"seed-{seed}"
         results = run_experiment(args.experiment, out, seed=seed, jobs=1, methods=args.method,

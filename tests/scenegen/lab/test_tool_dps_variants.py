@@ -89,3 +89,38 @@ def test_crowd_experiment_tracks_seven_objects_with_every_ordering(tool):
                            "ps-5671234", "ps-6712345", "ps-7123456"]
     assert all(m.param_dict()["n_particles"] == 300 for m in exp.methods)
     assert all(m.param_dict()["lam"] == 20.0 for m in exp.methods)
+
+
+def test_tune_sets_a_presets_tuned_quantities_in_this_process(tool, monkeypatch):
+    table = dict(presets.OCCLUSION2_TUNING)
+    monkeypatch.setattr(presets, "OCCLUSION2_TUNING", table)
+    done = tool.tune("dps-occlusion-2", ["shirt2=[[40, 140, 40]]", "speed=1.4"])
+    assert done == {"shirt2": ((40, 140, 40),), "speed": 1.4}
+    assert table["shirt2"] == ((40, 140, 40),) and table["speed"] == 1.4
+    cfg = presets.get("dps-occlusion-2")
+    walker, _, second = cfg.entities
+    assert walker.motion.velocity == (1.4, 0.0)
+    assert (40, 140, 40) in second.appearance.colors
+    assert (200, 60, 40) not in second.appearance.colors  # the preset's shirt is replaced
+    with pytest.raises(SystemExit, match="no tuned quantity 'shirt3'; its quantities: speed"):
+        tool.tune("dps-occlusion-2", ["shirt3=1"])
+    with pytest.raises(SystemExit, match="has no tuned quantities"):
+        tool.tune("dps-synthetic", ["speed=1"])
+
+
+def test_preset_runs_one_preset_and_tune_needs_it_named(tmp_path):
+    out = subprocess.run([sys.executable, str(TOOL), "dps-occlusion", "--seeds", "1",
+                          "--tune", "speed=1.4", "-o", str(tmp_path)], capture_output=True,
+                         text=True, timeout=120)
+    assert out.returncode != 0 and "name the preset (--preset)" in out.stderr
+    out = subprocess.run([sys.executable, str(TOOL), "dps-occlusion", "--seeds", "1",
+                          "--preset", "dps-occlusion-2", "--tune", "speed=1.4", "--scenes", "1",
+                          "--runs", "1", "--method", "nonps", "-o", str(tmp_path)],
+                         capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    runs = sorted(p.name for p in (tmp_path / "seed-1" / "runs").iterdir())
+    assert runs == ["nonps__dps-occlusion-2__s000__r000.json"]
+    import json
+
+    variant = json.loads((tmp_path / "seed-1" / "variant.json").read_text())
+    assert variant["preset"] == "dps-occlusion-2" and variant["tune"] == {"speed": 1.4}
