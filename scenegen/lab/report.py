@@ -27,8 +27,8 @@ from scenegen.lab.experiments.outputs import read_results, report_entry
 from scenegen.lab.experiments.tables import render_table
 from scenegen.lab.experiments.why import WHY
 
-__all__ = ["DEMO_PLAN", "FULL_COMMAND", "build_report", "markdown_to_html", "run_all",
-           "run_demo_experiments"]
+__all__ = ["DEMO_PLAN", "FULL_COMMAND", "build_report", "index_problem", "markdown_to_html",
+           "render_report", "run_all", "run_demo_experiments"]
 
 FULL_COMMAND = "scenegen experiment all -o out/"
 """The command of the full reproduction (every experiment at its default S x R)."""
@@ -232,6 +232,33 @@ def build_report(out_dir: str | Path) -> Path:
     """
     root = Path(out_dir)
     root.mkdir(parents=True, exist_ok=True)
+    page, all_results = render_report(root)
+    index = root / "index.html"
+    _write_atomic(index, page)
+    write_sealed_json(root / "results.json", {"experiments": all_results}, indent=1)
+    return index
+
+
+def index_problem(out_dir: str | Path) -> str | None:
+    """What is wrong with ``out_dir/index.html``: ``"missing"``, ``"unreadable (...)"``,
+    ``"stale"`` (not the page :func:`build_report` writes from the folder as it is: edited,
+    damaged, or written from other results), or None (``scenegen validate``)."""
+    index = Path(out_dir) / "index.html"
+    try:
+        text = index.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        return "missing"
+    except (OSError, UnicodeDecodeError) as err:
+        return f"unreadable ({type(err).__name__})"
+    if text != render_report(out_dir)[0]:
+        return "stale"
+    return None
+
+
+def render_report(out_dir: str | Path) -> tuple[str, dict[str, dict[str, Any]]]:
+    """The text of ``index.html`` and the experiments' entries of the report's
+    ``results.json``, from what ``out_dir`` holds (nothing is written)."""
+    root = Path(out_dir)
     parts = [
         "<!DOCTYPE html>",
         "<html><head><meta charset='utf-8'><title>scenegen report</title>",
@@ -286,7 +313,4 @@ def build_report(out_dir: str | Path) -> Path:
             parts.append(f"<p><a href='{_rel(h5, root)}'>{html.escape(h5.name)}</a></p>")
         parts.append("</div>")
     parts.append("</body></html>")
-    index = root / "index.html"
-    _write_atomic(index, "\n".join(parts) + "\n")
-    write_sealed_json(root / "results.json", {"experiments": all_results}, indent=1)
-    return index
+    return "\n".join(parts) + "\n", all_results

@@ -29,6 +29,7 @@ import functools
 import json
 import shlex
 import sys
+from collections.abc import Callable
 from dataclasses import MISSING, fields
 from pathlib import Path
 from typing import Any
@@ -457,10 +458,12 @@ def _check_experiment(folder: str | Path, deep: bool) -> tuple[list[str], list[d
     return _more(problems), keys
 
 
-def check_report(folder: str | Path) -> list[str]:
+def check_report(folder: str | Path,
+                 index_problem: Callable[[Path], str | None] | None = None) -> list[str]:
     """Check a report folder (``scenegen experiment all -o DIR``): every experiment in
     ``DIR/experiments/`` (:func:`check_experiment`) and ``DIR/results.json``, which must
-    hold exactly their results."""
+    hold exactly their results; and, given ``index_problem`` (what is wrong with
+    ``DIR/index.html``, or None: :func:`scenegen.lab.report.index_problem`), the page."""
     from scenegen.lab.experiments.definitions import names
 
     root = Path(folder)
@@ -480,11 +483,19 @@ def check_report(folder: str | Path) -> list[str]:
         doc = read_sealed_json(path)
     except DataError as err:
         return [*problems, str(err)]
-    if doc.get("experiments") != expected and not problems:
-        command = report_rerun_command(sweeps, root)
+    if problems:
+        return problems
+    command = report_rerun_command(sweeps, root)
+    if doc.get("experiments") != expected:
         redo = f"; `{command}` writes it again from them" if command else ""
-        problems.append(f"{path}: does not hold the results of {root / 'experiments'} "
-                        f"(edited or stale{redo})")  # fmt: skip
+        return [f"{path}: does not hold the results of {root / 'experiments'} "
+                f"(edited or stale{redo})"]  # fmt: skip
+    page = index_problem(root) if index_problem is not None else None
+    if page == "stale":
+        redo = f"; `{command}` writes it again" if command else ""
+        page = f"is not the report of this folder (damaged, edited, or stale{redo})"
+    if page is not None:
+        problems.append(f"{root / 'index.html'}: {page}")
     return problems
 
 

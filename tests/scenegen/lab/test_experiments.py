@@ -431,6 +431,26 @@ def test_a_stale_report_names_the_command_that_writes_it_again(tmp_path, monkeyp
     assert {p.name: p.read_bytes() for p in runs.iterdir()} == before
     capsys.readouterr()
     assert main(["validate", str(tmp_path)]) == 0
+    capsys.readouterr()
+    # The page itself: edited, truncated or missing is one line; the command rebuilds it.
+    index = tmp_path / "index.html"
+    page = index.read_bytes()
+    for damage, what in [
+        (lambda: index.write_bytes(page.replace(b"reproduced", b"reprodvced", 1)),
+         f"is not the report of this folder (damaged, edited, or stale; `{command}` writes "
+         "it again)"),
+        (lambda: index.write_bytes(page[: len(page) // 2]),
+         f"is not the report of this folder (damaged, edited, or stale; `{command}` writes "
+         "it again)"),
+        (lambda: index.write_bytes(b"\xff\xfe" + page), "unreadable (UnicodeDecodeError)"),
+        (index.unlink, "missing"),
+    ]:
+        damage()
+        assert main(["validate", str(tmp_path)]) == 1
+        assert capsys.readouterr().err.splitlines() == [f"{index}: {what}"]
+        index.write_bytes(page)
+    assert main(shlex.split(command)[1:]) == 0
+    assert index.read_bytes() == page
 
 
 def _pool_records(successes: dict[str, int], n: int = 50, scenes: int = 10) -> tuple[dict, dict]:
