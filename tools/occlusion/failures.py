@@ -42,9 +42,10 @@ HIDDEN = 0.05  # visible fraction below which the walker counts as hidden
 
 
 @functools.lru_cache(maxsize=64)
-def events(preset: str, base: int, scene: int, grace: int) -> tuple[tuple[str, int, int], ...]:
-    """The scene's events, in time order: (name, first frame, last frame + grace) per
-    person whose box the walker's overlaps."""
+def _scene(preset: str, base: int, scene: int) -> tuple[tuple[tuple[str, int, int], ...],
+                                                         np.ndarray]:  # fmt: skip
+    """The scene's crossings (name, first frame, last frame) and the walker's visible
+    fraction per frame, shape (T,), from one generation of the scene."""
     seq = scenegen.generate(preset, seed=scene_seed(base, EXPERIMENT, preset, scene))
     gt = seq.gt
     walker = int(seq.initial_targets(0)[0])  # the walker is the first target of both presets
@@ -61,16 +62,20 @@ def events(preset: str, base: int, scene: int, grace: int) -> tuple[tuple[str, i
             continue
         mid = int(frames[frames.size // 2])
         where = "behind" if depth[mid, walker] > depth[mid, j] else "in front of"
-        out.append((f"{where} {seq.entities.name[j]}", int(frames[0]),
-                    int(frames[-1]) + grace))
-    return tuple(sorted(out, key=lambda e: e[1]))
+        out.append((f"{where} {seq.entities.name[j]}", int(frames[0]), int(frames[-1])))
+    vis = np.asarray(gt.visibility[:, walker], dtype=np.float64)
+    return tuple(sorted(out, key=lambda e: e[1])), vis
 
 
-@functools.lru_cache(maxsize=64)
+def events(preset: str, base: int, scene: int, grace: int) -> tuple[tuple[str, int, int], ...]:
+    """The scene's events, in time order: (name, first frame, last frame + grace) per
+    person whose box the walker's overlaps."""
+    return tuple((n, a, b + grace) for n, a, b in _scene(preset, base, scene)[0])
+
+
 def visibility(preset: str, base: int, scene: int) -> np.ndarray:
     """The walker's visible fraction per frame, shape (T,)."""
-    seq = scenegen.generate(preset, seed=scene_seed(base, EXPERIMENT, preset, scene))
-    return np.asarray(seq.gt.visibility[:, int(seq.initial_targets(0)[0])], dtype=np.float64)
+    return _scene(preset, base, scene)[1]
 
 
 def first_lost(state: list[int | None]) -> int | None:

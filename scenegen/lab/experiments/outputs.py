@@ -485,15 +485,17 @@ def check_report(folder: str | Path,
         return [*problems, str(err)]
     if problems:
         return problems
-    command = report_rerun_command(sweeps, root)
+
+    def redo(tail: str) -> str:  # the hint, computed only for a line that needs it
+        command = report_rerun_command(sweeps, root)
+        return f"; `{command}` writes it again{tail}" if command else ""
+
     if doc.get("experiments") != expected:
-        redo = f"; `{command}` writes it again from them" if command else ""
         return [f"{path}: does not hold the results of {root / 'experiments'} "
-                f"(edited or stale{redo})"]  # fmt: skip
+                f"(edited or stale{redo(' from them')})"]  # fmt: skip
     page = index_problem(root) if index_problem is not None else None
     if page == "stale":
-        redo = f"; `{command}` writes it again" if command else ""
-        page = f"is not the report of this folder (damaged, edited, or stale{redo})"
+        page = f"is not the report of this folder (damaged, edited, or stale{redo('')})"
     if page is not None:
         problems.append(f"{root / 'index.html'}: {page}")
     return problems
