@@ -13,6 +13,7 @@ experiments' full counts.
 from __future__ import annotations
 
 import html
+import json
 import re
 import sys
 from collections.abc import Callable
@@ -23,7 +24,12 @@ from scenegen.errors import DataError
 from scenegen.io.sealed import write_sealed_json
 from scenegen.lab.experiments import get, names, run_experiment, verdict_counts
 from scenegen.lab.experiments.definitions import DEMO_PLAN
-from scenegen.lab.experiments.outputs import read_results, report_entry
+from scenegen.lab.experiments.outputs import (
+    WRITTEN_BY,
+    read_results,
+    report_entry,
+    versions_text,
+)
 from scenegen.lab.experiments.tables import render_table
 from scenegen.lab.experiments.why import WHY
 
@@ -207,6 +213,16 @@ def _overview(all_results: dict[str, dict[str, Any]]) -> list[str]:
             f"<td class='yes'>{c['reproduced']}</td><td class='no'>{c['not reproduced']}</td>"
             f"<td>{c['inconclusive']}</td><td>{agree}</td></tr>")
     parts.append("</table>")
+    who = {name: res.get(WRITTEN_BY) for name, res in all_results.items()}
+    if len({json.dumps(w, sort_keys=True) for w in who.values()}) == 1:
+        versions = next(iter(who.values()))
+        if versions:
+            parts.append(f"<p>Computed with {html.escape(versions_text(versions))}.</p>")
+    else:  # experiments computed by different installations: say which by which
+        lines = [f"{html.escape(name)}: " + (html.escape(versions_text(w)) if w
+                                             else "no versions recorded (an older scenegen)")
+                 for name, w in who.items()]  # fmt: skip
+        parts.append("<p>Computed with different software: " + "; ".join(lines) + ".</p>")
     return parts
 
 

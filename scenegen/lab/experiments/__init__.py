@@ -37,7 +37,14 @@ from typing import Any
 
 from scenegen.errors import ConfigError
 from scenegen.lab.experiments.definitions import EXPERIMENTS, PAPER, Experiment, Method, get, names
-from scenegen.lab.experiments.outputs import RECORDS, listing, sweep_of, write_results
+from scenegen.lab.experiments.outputs import (
+    RECORDS,
+    WRITTEN_BY,
+    listing,
+    sweep_of,
+    write_results,
+    written_by,
+)
 from scenegen.lab.experiments.runner import (
     Task,
     derive_seed,
@@ -112,6 +119,7 @@ def results_document(exp: Experiment, records: list[dict[str, Any]]) -> dict[str
         ],
         **summarize(exp, records),
         RECORDS: listing(records),
+        WRITTEN_BY: written_by(),
     }
     over = keys[0].get("overrides")
     if over:

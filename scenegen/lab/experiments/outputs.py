@@ -20,7 +20,8 @@ tied to exactly those records.
   an edit whose digest was recomputed is still found); ``table.md`` is the table of
   ``results.json``. With ``deep``, every run is also computed again and compared. When
   only the summary or the table differs, the line names :func:`rerun_command`, which
-  recomputes both from the intact runs.
+  recomputes both from the intact runs, and the versions (:data:`WRITTEN_BY`) that
+  differ between the software that wrote ``results.json`` and this one.
 """
 
 from __future__ import annotations
@@ -39,6 +40,7 @@ from scenegen.io.sealed import content_digest, read_sealed_json, write_sealed_js
 
 __all__ = [
     "RECORDS",
+    "WRITTEN_BY",
     "check_experiment",
     "check_report",
     "listed_digest",
@@ -50,14 +52,22 @@ __all__ = [
     "report_rerun_command",
     "rerun_command",
     "sweep_of",
+    "versions_text",
     "warn",
     "write_record",
     "write_results",
+    "written_by",
 ]
 
 RECORDS = "records"
 """Key of ``results.json``: ``["RUN_FILE SHA256", ...]``, every run it was computed from
 (the file's name under ``runs/`` and its digest), in run order."""
+WRITTEN_BY = "written_by"
+"""Key of ``results.json``: the software that computed it, ``{NAME: VERSION}`` for
+scenegen, Python and the libraries the scenes and trackers compute with (absent in files
+written by older versions). It is provenance, not a result: ``scenegen validate`` recomputes
+the rest and compares it, and names these versions when the rest differs."""
+_COMPUTING = ("numpy", "scipy", "numba", "cv2", "skimage", "h5py")
 _PER_FRAME = ("state", "precision", "recall", "iou", "centre_error", "path_error")
 _MAX_LISTED = 5  # problem lines per folder before "and N more"
 
@@ -198,6 +208,50 @@ def listed_digest(record_path: Path, seed: int, quick: bool) -> str | None:
     return listed.get(record_path.name)
 
 
+@functools.lru_cache(maxsize=1)
+def _versions() -> tuple[tuple[str, str], ...]:
+    import importlib
+    import platform
+
+    import scenegen
+
+    names = {"cv2": "opencv", "skimage": "scikit-image"}
+    out = [("scenegen", scenegen.__version__), ("python", platform.python_version())]
+    for module in _COMPUTING:
+        out.append((names.get(module, module), str(importlib.import_module(module).__version__)))
+    return tuple(out)
+
+
+def written_by() -> dict[str, str]:
+    """The :data:`WRITTEN_BY` entry for results computed here.
+
+    Returns
+    -------
+    dict of str to str
+        ``{"scenegen": ..., "python": ..., "numpy": ..., "scipy": ..., "numba": ...,
+        "opencv": ..., "scikit-image": ..., "h5py": ...}``, the installed versions.
+    """
+    return dict(_versions())
+
+
+def versions_text(who: dict[str, str]) -> str:
+    """A :data:`WRITTEN_BY` entry as a phrase, ``"scenegen 0.1.0, python 3.11.7, ..."``, in
+    :func:`written_by`'s order whatever the file's key order (sealed files sort keys)."""
+    known = [name for name, _ in _versions()]
+    order = sorted(who, key=lambda k: (known.index(k) if k in known else len(known), k))
+    return ", ".join(f"{k} {who[k]}" for k in order)
+
+
+def _version_change(then: Any, now: dict[str, str]) -> str:
+    """What differs between the software that wrote a ``results.json`` and this one, as a
+    phrase (empty when nothing is known to differ)."""
+    if not isinstance(then, dict):
+        return " (it records no versions: an older scenegen)"
+    diff = [f"{k} {then.get(k, '?')} there, {v} here" for k, v in now.items()
+            if then.get(k) != v]  # fmt: skip
+    return f" ({'; '.join(diff)})" if diff else ""
+
+
 def write_results(path: Path, results: dict[str, Any]) -> None:
     """Write ``results.json`` sealed and atomically (indented: users read it)."""
     write_sealed_json(path, results, indent=1)
@@ -249,6 +303,10 @@ def _results_problem(data: dict[str, Any], name: str | None) -> str | None:
         return "claims has an entry without a verdict"
     if _entries(data) is None:
         return f"{RECORDS} is missing or not a list of 'RUN_FILE SHA256'"
+    who = data.get(WRITTEN_BY, {})
+    if not (isinstance(who, dict) and all(isinstance(k, str) and isinstance(v, str)
+                                          for k, v in who.items())):  # fmt: skip
+        return f"{WRITTEN_BY} is not a mapping of names to versions"
     return None
 
 
@@ -429,13 +487,17 @@ def _check_experiment(folder: str | Path, deep: bool) -> tuple[list[str], list[d
         return [f"{res_path}: its runs cannot be summarised ({type(err).__name__}: "
                 f"{str(err)[:80]})"], keys  # fmt: skip
     # The runs are intact (digests above), so a summary or table that differs was edited,
-    # or written by a scenegen that summarises differently; the hint says how to redo it.
+    # or written by a scenegen that summarises differently; the hint says how to redo it,
+    # and which versions differ. Who wrote the file is provenance, not compared.
     def redo() -> str:
         command = rerun_command(exp, keys, root)
-        return f"or written by another version of scenegen: `{command}` recomputes it from the runs"
+        change = _version_change(results.get(WRITTEN_BY), fresh[WRITTEN_BY])
+        return (f"or written by another version of scenegen{change}: `{command}` "
+                "recomputes it from the runs")  # fmt: skip
 
-    if fresh != results:
-        changed = sorted(k for k in set(fresh) | set(results) if fresh.get(k) != results.get(k))
+    changed = sorted(k for k in set(fresh) | set(results)
+                     if k != WRITTEN_BY and fresh.get(k) != results.get(k))  # fmt: skip
+    if changed:
         verb = "differs" if len(changed) == 1 else "differ"
         problems.append(f"{res_path}: {', '.join(changed)} {verb} from the summary of its runs "
                         f"(edited, {redo()})")  # fmt: skip
@@ -447,7 +509,10 @@ def _check_experiment(folder: str | Path, deep: bool) -> tuple[list[str], list[d
     except (OSError, UnicodeDecodeError) as err:
         problems.append(f"{table}: unreadable ({type(err).__name__})")
     else:
-        if text != render_table(exp, fresh, WHY.get(exp.name, "")):
+        shown = {k: v for k, v in fresh.items() if k != WRITTEN_BY}
+        if WRITTEN_BY in results:  # the table names who wrote results.json
+            shown[WRITTEN_BY] = results[WRITTEN_BY]
+        if text != render_table(exp, shown, WHY.get(exp.name, "")):
             problems.append(f"{table}: is not the table of {res_path.name} (damaged, edited, "
                             f"{redo()})")  # fmt: skip
     if deep and not problems:

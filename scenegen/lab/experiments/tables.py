@@ -6,6 +6,7 @@ from __future__ import annotations
 from typing import Any
 
 from scenegen.lab.experiments.definitions import Experiment
+from scenegen.lab.experiments.outputs import WRITTEN_BY, versions_text
 from scenegen.lab.experiments.stats import ALPHA, LEVEL, MIN_RUNS
 from scenegen.lab.experiments.summary import AGREE_POINTS, AGREE_PX, table_lines
 
@@ -84,6 +85,9 @@ def render_table(exp: Experiment, results: dict[str, Any], why: str = "") -> str
                   "the full run, `scenegen experiment all -o out/`."]
     lines += ["", "Intervals: Wilson for rates, seeded percentile bootstrap for means; frame 0 "
               "is excluded from every measure.", ""]
+    who = results.get(WRITTEN_BY)
+    if who:  # provenance (absent in results written by older versions)
+        lines[-1:-1] = ["", f"Computed with {versions_text(who)}."]
     lines += table_lines(exp, results)
     lines += ["", "## The paper's claims", "", VERDICT_RULE, ""]
     lines += claims_table(results)

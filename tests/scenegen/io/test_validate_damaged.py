@@ -645,6 +645,51 @@ def test_an_edited_results_json_is_found_even_resealed(exp_copy, capsys):
     assert err == [f"{res}: not an experiment's results (runs is missing or not a int)"]
 
 
+def test_results_json_names_the_software_that_computed_it(exp_copy, capsys):
+    # Provenance, not a result: other versions alone are valid (the runs give the same
+    # summary); older files without it stay valid; a summary that differs names the
+    # versions that differ; a malformed entry is refused.
+    import numpy as np
+
+    import scenegen
+    from scenegen.lab.experiments.outputs import written_by
+
+    res = exp_copy / "results.json"
+    doc = json.loads(res.read_text())
+    assert doc["written_by"] == written_by()
+    assert written_by()["scenegen"] == scenegen.__version__
+    assert written_by()["numpy"] == np.__version__
+    assert list(written_by()) == ["scenegen", "python", "numpy", "scipy", "numba", "opencv",
+                                  "scikit-image", "h5py"]  # fmt: skip
+    table = exp_copy / "table.md"
+    assert f"Computed with scenegen {scenegen.__version__}, python " in table.read_text()
+    other = {**written_by(), "numpy": "0.0.1"}
+    _reseal(res, lambda d: d.__setitem__("written_by", other))
+    table.write_text(table.read_text().replace(f"numpy {np.__version__},", "numpy 0.0.1,"))
+    assert _validate(exp_copy, capsys)[:2] == (0, [])
+    _reseal(res, lambda d: d["summary"].__setitem__("extra", 1))
+    code, err, _ = _validate(exp_copy, capsys)
+    assert code == 1 and err == [
+        f"{res}: summary differs from the summary of its runs (edited, "
+        + _redo(exp_copy).replace("of scenegen:", f"of scenegen (numpy 0.0.1 there, "
+                                  f"{np.__version__} here):") + ")"]  # fmt: skip
+    _reseal(res, lambda d: (d.pop("written_by"), d["summary"].pop("extra")))
+    table.write_text("\n".join(ln for ln in table.read_text().split("\n")
+                               if not ln.startswith("Computed with")))  # fmt: skip
+    # an older file: no versions, and its table never had the line (nor its blank line)
+    text = table.read_text().replace("measure.\n\n\n", "measure.\n\n")
+    table.write_text(text)
+    assert _validate(exp_copy, capsys)[:2] == (0, [])
+    _reseal(res, lambda d: d["summary"].__setitem__("extra", 1))
+    err = _validate(exp_copy, capsys)[1]
+    assert err[0].endswith(_redo(exp_copy).replace(
+        "of scenegen:", "of scenegen (it records no versions: an older scenegen):") + ")")
+    _reseal(res, lambda d: d.__setitem__("written_by", {"numpy": 2}))
+    assert _validate(exp_copy, capsys)[1] == [
+        f"{res}: not an experiment's results (written_by is not a mapping of names to "
+        "versions)"]
+
+
 def test_a_damaged_table_md_is_named(exp_copy, capsys):
     table = exp_copy / "table.md"
     table.write_text(table.read_text().replace("reproduced", "rEproduced", 1))

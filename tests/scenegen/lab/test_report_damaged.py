@@ -16,3 +16,22 @@ def test_damaged_results_json_is_one_data_error(tmp_path, content):
     (folder / "results.json").write_bytes(content)
     with pytest.raises(DataError, match="results.json"):
         build_report(tmp_path)
+
+
+def test_the_overview_names_the_software_once_or_per_experiment():
+    # One line when every experiment was computed by the same installation; when they
+    # differ (one rerun elsewhere, one from an older scenegen), which by which.
+    from scenegen.lab.report import _overview
+
+    def res(**who):
+        return {"scenes": 1, "runs": 1, "quick": True, "claims": [],
+                **({"written_by": who} if who else {})}  # fmt: skip
+
+    same = "\n".join(_overview({"a": res(scenegen="0.1.0", numpy="2.4.6"),
+                                "b": res(numpy="2.4.6", scenegen="0.1.0")}))  # fmt: skip
+    assert "<p>Computed with scenegen 0.1.0, numpy 2.4.6.</p>" in same
+    mixed = "\n".join(_overview({"a": res(scenegen="0.1.0", numpy="2.4.6"),
+                                 "b": res(scenegen="0.1.0", numpy="1.26.4"), "c": res()}))
+    assert ("<p>Computed with different software: a: scenegen 0.1.0, numpy 2.4.6; b: scenegen "
+            "0.1.0, numpy 1.26.4; c: no versions recorded (an older scenegen).</p>") in mixed
+    assert "Computed with" not in "\n".join(_overview({"a": res()}))
