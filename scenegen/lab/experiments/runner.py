@@ -229,11 +229,17 @@ def check_overrides(exp: Experiment, method: str, overrides: dict[str, Any]) -> 
     fields = cls.Params.names()
     swept = exp.sweep[0][0] if exp.sweep else None
     for name in overrides:
-        if name not in fields or name == swept:
-            why = (f"cannot override the swept parameter {name!r}" if name == swept
-                   else f"has no parameter {name!r}")
-            raise ConfigError(f"method {m.slug!r} (tracker {m.tracker!r}) {why}; its "
-                              f"parameters: {', '.join(fields)}")
+        if name == swept:
+            raise ConfigError(f"method {m.slug!r} (tracker {m.tracker!r}) cannot override the "
+                              f"swept parameter {name!r}; its parameters: {', '.join(fields)}")
+        if name not in fields:
+            having = [x.slug for x in exp.methods
+                      if name in tracker_class(x.tracker).Params.names()]  # fmt: skip
+            hint = (f"; of {exp.name}'s methods only {', '.join(having)} have it: name them, "
+                    + " ".join(f"--method {x}" for x in having) if having
+                    else f"; no method of {exp.name} has it")  # fmt: skip
+            raise ConfigError(f"method {m.slug!r} (tracker {m.tracker!r}) has no parameter "
+                              f"{name!r}{hint}; its parameters: {', '.join(fields)}")
     params = {**m.param_dict(), **overrides}
     try:
         cls.Params(**params)

@@ -62,6 +62,23 @@ def test_overrides_a_method_does_not_accept_are_refused_before_running(over, mat
         plan_tasks(EXP, runs=1, seed=0, quick=True, overrides=over)
 
 
+def test_a_parameter_only_some_methods_have_names_those_methods():
+    # resample_scope belongs to PS and DPS, not to Non-PS: the line says which to name.
+    occ = get("dps-occlusion")
+    with pytest.raises(ConfigError) as err:
+        plan_tasks(occ, runs=1, seed=0, quick=True, overrides={"resample_scope": "placed"})
+    assert str(err.value).startswith(
+        "method 'nonps' (tracker 'joint-pf') has no parameter 'resample_scope'; of "
+        "dps-occlusion's methods only ps-123, ps-231, ps-312, dps have it: name them, "
+        "--method ps-123 --method ps-231 --method ps-312 --method dps; its parameters: ")
+    named = ["ps-123", "ps-231", "ps-312", "dps"]
+    tasks = plan_tasks(occ, runs=1, scenes=1, seed=0, quick=True, methods=named,
+                       overrides={"resample_scope": "placed"})
+    assert sorted({t.method for t in tasks}) == sorted(named)
+    with pytest.raises(ConfigError, match="; no method of dps-occlusion has it; its param"):
+        plan_tasks(occ, runs=1, seed=0, quick=True, overrides={"kernl": "box"})
+
+
 def test_kams_trackers_refuse_the_box_kernel():
     with pytest.raises(ConfigError, match="method 'kams'"):
         plan_tasks(get("kams-robustness"), runs=1, seed=0, quick=True,
