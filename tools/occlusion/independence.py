@@ -33,6 +33,7 @@ import numpy as np
 
 from scenegen.lab.experiments.definitions import get
 from scenegen.lab.experiments.outputs import read_record
+from scenegen.lab.experiments.summary import drop_first_frame, succeeded
 
 EXPERIMENT = "dps-occlusion"
 
@@ -43,11 +44,11 @@ def outcomes(folder: str | Path) -> dict[str, dict[str, dict[tuple[int, int], bo
     labels = {m.slug: m.label for m in exp.methods}
     out: dict[str, dict[str, dict[tuple[int, int], bool]]] = defaultdict(dict)
     for path in sorted(glob.glob(str(Path(folder) / "runs" / "*.json"))):
-        rec = read_record(path)  # sealed: a damaged record is one DataError line
+        rec = drop_first_frame(read_record(path))  # a damaged record: one DataError line
         key = rec["key"]
         walker = next(t for t in rec["targets"] if t["name"] == exp.hard_target)
-        ok = all(s is None or bool(s) for s in walker["state"][1:])
-        out[key["preset"]].setdefault(labels[key["method"]], {})[(key["scene"], key["run"])] = ok
+        cases = out[key["preset"]].setdefault(labels[key["method"]], {})
+        cases[(key["scene"], key["run"])] = succeeded(walker)  # the experiment's success
     return dict(out)
 
 

@@ -55,6 +55,7 @@ __all__ = [
     "AGREE_PX",
     "FAILURE_PERSIST",
     "drop_first_frame",
+    "succeeded",
     "summarize",
 ]
 
@@ -93,7 +94,9 @@ def _state(target: dict[str, Any]) -> np.ndarray:
     return np.array([s for s in target["state"] if s is not None], dtype=bool)
 
 
-def _success(target: dict[str, Any]) -> bool:
+def succeeded(target: dict[str, Any]) -> bool:
+    """Whether a run tracked ``target`` (an entry of the ``targets`` of a record passed
+    through :func:`drop_first_frame`) in every scored frame: the success of DPS §3.1."""
     s = _state(target)
     return bool(s.size) and metrics.success_rate(s[None]) == 100.0
 
@@ -301,7 +304,7 @@ def _object_stats(records: Records, hard: int, key: tuple[Any, ...]) -> dict[str
     out: dict[str, Any] = {
         "runs": len(records),
         "hard": {
-            "success": _rate([_success(t) for t in hard_t]),
+            "success": _rate([succeeded(t) for t in hard_t]),
             "recovery": _rate([_recovered(t) for t in hard_t]),
             "precision": _mean([_run_mean(t, "precision", tracked_only=True) for t in hard_t],
                                (*key, "hard-precision")),
@@ -311,7 +314,7 @@ def _object_stats(records: Records, hard: int, key: tuple[Any, ...]) -> dict[str
     }
     if others:
         out["others"] = {
-            "success": _rate([_success(t) for t in others]),
+            "success": _rate([succeeded(t) for t in others]),
             "precision": _mean(
                 [np.mean([_run_mean(t, "precision", tracked_only=False) for t in ts])
                  for ts in others_runs], (*key, "others-precision")),
@@ -587,7 +590,7 @@ def _dps_real(exp: Experiment, records: Records) -> dict[str, Any]:
                 a, b = ("DPS", label) if gap > 0 else (label, "DPS")
                 _mcnemar_claim(
                     claims, f"{preset}: occluded object's success of {a} above {b}'s",
-                    recs[a], recs[b], lambda r: _success(r["targets"][hard]), abs(gap), a, b,
+                    recs[a], recs[b], lambda r: succeeded(r["targets"][hard]), abs(gap), a, b,
                     delta_source="paper's difference")
             _pooled_ps_claims(claims, exp, preset, rows, recs, paper, hard)
     return {"summary": {"hard_target": exp.hard_target, "presets": by_preset},
@@ -604,7 +607,7 @@ def _pooled_ps_claims(claims: list[dict[str, Any]], exp: Experiment, preset: str
         return
 
     def ok(r: dict[str, Any]) -> bool:
-        return _success(r["targets"][hard])
+        return succeeded(r["targets"][hard])
 
     pool = [r for m in ps for r in recs[m]]
     gap = paper["DPS"][0] - float(np.mean([paper[m][0] for m in ps]))
@@ -816,7 +819,7 @@ def _table_kams_robustness(res: dict[str, Any]) -> list[str]:
 def _shm_run(r: dict[str, Any]) -> dict[str, Any]:
     err = np.concatenate([_arr(t["centre_error"]) for t in r["targets"]])
     out = {"error": float(np.nanmean(err)) if np.any(np.isfinite(err)) else float("nan"),
-           "both": all(_success(t) for t in r["targets"]),
+           "both": all(succeeded(t) for t in r["targets"]),
            "tracked": float(np.mean([bool(s) for t in r["targets"] for s in t["state"]
                                      if s is not None]))}
     if "order_prob" in r:
