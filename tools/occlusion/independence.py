@@ -17,9 +17,20 @@ walker is tracked in every frame but frame 0, the experiment's success):
   success;
 - ``any``: the success a DPS would have if it kept the walker whenever one of its PS
   orderings did, were the orderings' outcomes independent, 1 − Π (1 − p_o); beside it
-  DPS's success and the orderings' mean.
+  DPS's success and the orderings' mean;
+- the scene x method interaction: DPS's lead over the PS orderings pooled, per scene,
+  its variance over the scenes and its largest value, each with a permutation p-value
+  (DPS's and the orderings' outcomes of a scene shuffled within that scene, 4,000
+  times, seeded). A small p says that on some scenes DPS leads far more than on
+  others, as the paper's one-sequence gap would need; a large p says the lead is the
+  same on every scene up to chance;
+- with ``--power K``: how often that test (the largest lead, p < 0.05) would flag K
+  scenes planted with the paper's RealSeq1 rates (DPS keeps the walker in every run,
+  each PS ordering in 31 %, the mean of its 18 / 40 / 34 %) in place of K of this
+  folder's scenes chosen at random, over 200 trials.
 
-docs/experiments.md ("The re-tuned `dps-occlusion-2` on the same 30 scenes") used it.
+docs/experiments.md ("The re-tuned `dps-occlusion-2` on the same 30 scenes" and "Is there
+a scene on which DPS leads?") used it.
 """
 
 from __future__ import annotations
@@ -79,9 +90,96 @@ def summary(runs: dict[str, dict[tuple[int, int], bool]]) -> dict[str, object]:
             "pairs": len(pairs), "scenes": len(scenes)}  # fmt: skip
 
 
+def interaction(runs: dict[str, dict[tuple[int, int], bool]], n_perm: int = 4000,
+                rng: np.random.Generator | int | None = 0) -> dict[str, object] | None:
+    """Whether DPS's lead over the PS orderings pooled differs between scenes.
+
+    Parameters
+    ----------
+    runs : dict
+        :func:`outcomes`' entry of one preset (label -> (scene, run) -> success); the
+        labels ``DPS`` and ``PS(…)`` are used.
+    n_perm : int, optional
+        Permutations of the null distribution.
+    rng : numpy.random.Generator, int or None, optional
+        The permutations' randomness (seeded by default: the same folder, the same p).
+
+    Returns
+    -------
+    dict or None
+        ``lead`` (S,) per-scene DPS − PS pooled success; ``var`` and ``max`` of it, with
+        ``p_var`` and ``p_max``, the share of permutations at least as large; ``argmax``,
+        the scene of the largest lead. None without DPS or a PS ordering.
+    """
+    ps = [lb for lb in runs if lb.startswith("PS(")]
+    if "DPS" not in runs or not ps:
+        return None
+    gen = np.random.default_rng(rng)
+    scenes = sorted({s for s, _ in runs["DPS"]} & set.intersection(
+        *({s for s, _ in runs[lb]} for lb in ps)))
+    lead, null = [], []
+    for s in scenes:
+        d = np.array([v for (sc, _), v in sorted(runs["DPS"].items()) if sc == s], float)
+        p = np.array([v for lb in ps for (sc, _), v in sorted(runs[lb].items()) if sc == s],
+                     float)  # fmt: skip
+        lead.append(d.mean() - p.mean())
+        both = gen.permuted(np.tile(np.concatenate([d, p]), (n_perm, 1)), axis=1)
+        null.append(both[:, :d.size].mean(axis=1) - both[:, d.size:].mean(axis=1))
+    lead_a, null_a = np.array(lead), np.array(null)  # (S,), (S, n_perm)
+    var, nvar = lead_a.var(), null_a.var(axis=0)
+    top, ntop = lead_a.max(), null_a.max(axis=0)
+    return {"lead": lead_a, "var": float(var), "p_var": float(np.mean(nvar >= var - 1e-12)),
+            "max": float(top), "p_max": float(np.mean(ntop >= top - 1e-12)),
+            "argmax": scenes[int(lead_a.argmax())]}  # fmt: skip
+
+
+#: The paper's RealSeq1 success (Table 3): DPS, and the mean of the three PS orderings.
+PAPER_DPS, PAPER_PS = 1.0, (0.18 + 0.40 + 0.34) / 3
+
+
+def power(runs: dict[str, dict[tuple[int, int], bool]], k: int, trials: int = 200,
+          n_perm: int = 1000, rng: np.random.Generator | int | None = 0) -> float:
+    """Share of trials in which :func:`interaction` flags (``p_max`` < 0.05) ``k`` scenes
+    replaced by draws at the paper's RealSeq1 rates (``PAPER_DPS``, ``PAPER_PS``).
+
+    Parameters
+    ----------
+    runs : dict
+        :func:`outcomes`' entry of one preset.
+    k : int
+        Planted scenes per trial (at most the number of scenes).
+    trials, n_perm : int, optional
+        Trials, and permutations of each trial's test.
+    rng : numpy.random.Generator, int or None, optional
+        The planting and the permutations' randomness.
+
+    Returns
+    -------
+    float
+        The detection rate, in [0, 1].
+    """
+    gen = np.random.default_rng(rng)
+    ps = [lb for lb in runs if lb.startswith("PS(")]
+    scenes = sorted({s for s, _ in runs["DPS"]})
+    if not 0 < k <= len(scenes):
+        raise ValueError(f"--power {k}: between 1 and the {len(scenes)} scenes")
+    hits = 0
+    for _ in range(trials):
+        planted = set(gen.choice(scenes, k, replace=False).tolist())
+        trial = {lb: dict(v) for lb, v in runs.items()}
+        for lb, rate in [("DPS", PAPER_DPS)] + [(lb, PAPER_PS) for lb in ps]:
+            for key in sorted(trial[lb]):
+                if key[0] in planted:
+                    trial[lb][key] = bool(gen.random() < rate)
+        hits += interaction(trial, n_perm=n_perm, rng=gen)["p_max"] < 0.05
+    return hits / trials
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("folder", help="a folder of `scenegen experiment dps-occlusion`")
+    ap.add_argument("--power", type=int, metavar="K", default=0,
+                    help="also print how often K planted paper-like scenes are flagged")
     args = ap.parse_args()
     order = [m.label for m in get(EXPERIMENT).methods]
     for preset, runs in sorted(outcomes(args.folder).items()):
@@ -98,6 +196,14 @@ def main() -> None:
         if s["dps"] is not None and s["ps_mean"] is not None:
             print(f"  any ordering keeps it: {100 * s['any']:.1f} %; DPS {100 * s['dps']:.0f} %;"
                   f" orderings' mean {100 * s['ps_mean']:.0f} %")  # fmt: skip
+        it = interaction(runs)
+        if it is not None:
+            print(f"  DPS's lead per scene: variance {it['var']:.4f} (permutation p "
+                  f"{it['p_var']:.2f}), largest {100 * it['max']:+.0f} points on scene "
+                  f"{it['argmax']} (p {it['p_max']:.2f})")
+            if args.power:
+                print(f"  {args.power} planted paper-like scene(s) flagged in "
+                      f"{100 * power(runs, args.power):.0f} % of 200 trials")
 
 
 if __name__ == "__main__":

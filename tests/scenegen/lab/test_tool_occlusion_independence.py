@@ -7,6 +7,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from scenegen.cli import main
@@ -60,3 +61,42 @@ def test_the_tool_reads_an_experiment_folder(tmp_path, capsys):
     assert any(ln.startswith("  any ordering keeps it: ") for ln in lines)
     assert sum(ln.startswith("dps-occlusion-2: 2 scenes, 2 (scene") for ln in lines) == 1
     assert sum(ln.startswith("  per-scene success ") for ln in lines) == 2
+    assert sum(ln.startswith("  DPS's lead per scene: variance ") for ln in lines) == 2
+
+
+def _alike(n_scenes: int, seed: int) -> dict[str, dict[tuple[int, int], bool]]:
+    """DPS and three orderings with the same success chance, 50 %, on every scene."""
+    rng = np.random.default_rng(seed)
+    return _runs({lb: rng.integers(0, 2, (n_scenes, 5)).tolist()
+                  for lb in ("PS(1,2,3)", "PS(2,3,1)", "PS(3,1,2)", "DPS")})  # fmt: skip
+
+
+def test_the_interaction_is_flat_when_dps_leads_alike_on_every_scene(tool):
+    same = [[1, 0, 1, 0, 1], [0, 1, 0, 1, 0]] * 4
+    it = tool.interaction(_runs({"PS(1,2,3)": same, "PS(2,3,1)": same, "DPS": same}))
+    assert np.allclose(it["lead"], 0.0) and it["p_var"] == 1.0 and it["p_max"] == 1.0
+    assert tool.interaction(_runs({"PS(1,2,3)": same})) is None  # no DPS: nothing to test
+
+
+def test_the_interaction_flags_scenes_on_which_dps_alone_keeps_the_walker(tool):
+    runs = _alike(20, 0)
+    for r in range(5):  # scene 7: DPS always keeps the walker, no ordering ever does
+        runs["DPS"][(7, r)] = True
+        for lb in ("PS(1,2,3)", "PS(2,3,1)", "PS(3,1,2)"):
+            runs[lb][(7, r)] = False
+    it = tool.interaction(runs)
+    assert it["argmax"] == 7 and it["max"] == pytest.approx(1.0) and it["p_max"] < 0.01
+    # Without an interaction the test keeps its level: of 40 folders of alike methods,
+    # about 2 give p < 0.05 (7 or more has chance 0.001).
+    flat = [tool.interaction(_alike(20, seed), n_perm=300, rng=seed) for seed in range(40)]
+    assert sum(f["p_var"] < 0.05 for f in flat) < 7 and sum(f["p_max"] < 0.05 for f in flat) < 7
+    # Seeded: the same outcomes give the same p-values.
+    assert tool.interaction(runs)["p_var"] == it["p_var"]
+
+
+def test_planted_paper_like_scenes_are_found_more_often_the_more_there_are(tool):
+    runs = _alike(20, 1)
+    one, four = (tool.power(runs, k, trials=40, n_perm=300, rng=2) for k in (1, 4))
+    assert 0.0 < one < four and four > 0.8
+    with pytest.raises(ValueError, match="--power 21: between 1 and the 20 scenes"):
+        tool.power(runs, 21)
