@@ -51,6 +51,7 @@ __all__ = [
     "report_entry",
     "report_rerun_command",
     "rerun_command",
+    "source_commit",
     "sweep_of",
     "versions_text",
     "warn",
@@ -64,9 +65,10 @@ RECORDS = "records"
 (the file's name under ``runs/`` and its digest), in run order."""
 WRITTEN_BY = "written_by"
 """Key of ``results.json``: the software that computed it, ``{NAME: VERSION}`` for
-scenegen, Python and the libraries the scenes and trackers compute with (absent in files
-written by older versions). It is provenance, not a result: ``scenegen validate`` recomputes
-the rest and compares it, and names these versions when the rest differs."""
+scenegen (and its git commit, when run from a checkout), Python and the libraries the
+scenes and trackers compute with (absent in files written by older versions). It is
+provenance, not a result: ``scenegen validate`` recomputes the rest and compares it, and
+names these versions when the rest differs."""
 _COMPUTING = ("numpy", "scipy", "numba", "cv2", "skimage", "h5py")
 _PER_FRAME = ("state", "precision", "recall", "iou", "centre_error", "path_error")
 _MAX_LISTED = 5  # problem lines per folder before "and N more"
@@ -208,6 +210,49 @@ def listed_digest(record_path: Path, seed: int, quick: bool) -> str | None:
     return listed.get(record_path.name)
 
 
+def source_commit(root: str | Path | None = None, timeout: float = 5.0) -> str | None:
+    """The git commit of the scenegen source that runs, when it runs from a checkout.
+
+    Parameters
+    ----------
+    root : str or Path, optional
+        The checkout to ask (a folder with ``pyproject.toml`` and ``.git``); by default
+        the one the imported ``scenegen`` package lies in.
+    timeout : float, optional
+        Seconds each ``git`` call may take (a slow or damaged repository gives None,
+        never a hang).
+
+    Returns
+    -------
+    str or None
+        The commit's first 12 hex digits, with ``+dirty`` when tracked files differ
+        from it; None for an installed wheel, without git, or outside a scenegen checkout.
+    """
+    import subprocess
+
+    import scenegen
+
+    src = Path(scenegen.__file__).resolve().parent.parent if root is None else Path(root)
+    if not (src / "pyproject.toml").is_file() or not (src / ".git").exists():
+        return None
+
+    def git(*args: str) -> str | None:
+        try:
+            done = subprocess.run(["git", "-C", str(src), *args], capture_output=True,
+                                  text=True, timeout=timeout, check=False)  # fmt: skip
+        except (OSError, subprocess.TimeoutExpired):
+            return None
+        return done.stdout.strip() if done.returncode == 0 else None
+
+    head = git("rev-parse", "--verify", "--quiet", "HEAD")
+    if not head:
+        return None
+    changed = git("status", "--porcelain", "--untracked-files=no")
+    if changed is None:
+        return None
+    return head[:12] + ("+dirty" if changed else "")
+
+
 @functools.lru_cache(maxsize=1)
 def _versions() -> tuple[tuple[str, str], ...]:
     import importlib
@@ -216,7 +261,11 @@ def _versions() -> tuple[tuple[str, str], ...]:
     import scenegen
 
     names = {"cv2": "opencv", "skimage": "scikit-image"}
-    out = [("scenegen", scenegen.__version__), ("python", platform.python_version())]
+    out = [("scenegen", scenegen.__version__)]
+    commit = source_commit()
+    if commit is not None:
+        out.append(("scenegen commit", commit))
+    out.append(("python", platform.python_version()))
     for module in _COMPUTING:
         out.append((names.get(module, module), str(importlib.import_module(module).__version__)))
     return tuple(out)
@@ -229,7 +278,9 @@ def written_by() -> dict[str, str]:
     -------
     dict of str to str
         ``{"scenegen": ..., "python": ..., "numpy": ..., "scipy": ..., "numba": ...,
-        "opencv": ..., "scikit-image": ..., "h5py": ...}``, the installed versions.
+        "opencv": ..., "scikit-image": ..., "h5py": ...}``, the installed versions, with
+        ``"scenegen commit"`` after ``"scenegen"`` when it runs from a git checkout
+        (:func:`source_commit`: a version number cannot tell two commits apart).
     """
     return dict(_versions())
 
