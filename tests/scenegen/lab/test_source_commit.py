@@ -78,3 +78,14 @@ def test_written_by_names_this_checkout_commit_after_the_version():
         assert list(who)[:2] == ["scenegen", "scenegen commit"]
     else:  # an installed wheel or an exported tree: no commit to name
         assert "scenegen commit" not in who
+
+
+def test_the_version_has_one_definition():
+    import importlib.metadata
+    import tomllib
+
+    import scenegen
+
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
+    assert "version" not in project and "version" in project["dynamic"]
+    assert importlib.metadata.version("scenegen") == scenegen.__version__
