@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import functools
 import json
+import re
 import shlex
 import sys
 from collections.abc import Callable
@@ -72,6 +73,7 @@ names these versions when the rest differs."""
 _COMPUTING = ("numpy", "scipy", "numba", "cv2", "skimage", "h5py")
 _PER_FRAME = ("state", "precision", "recall", "iou", "centre_error", "path_error")
 _MAX_LISTED = 5  # problem lines per folder before "and N more"
+_HEX64 = re.compile(r"[0-9a-f]{64}")
 
 
 _warned: set[str] = set()
@@ -180,9 +182,11 @@ def _entries(results: dict[str, Any]) -> list[tuple[str, str]] | None:
         return None
     out = []
     for e in entries:
-        if not isinstance(e, str) or e.count(" ") != 1:
+        # The digest is the last word; a run's file name may hold spaces (a list-valued
+        # --param gives "sigma-(1, 1, 0.001)").
+        name, _, digest = e.rpartition(" ") if isinstance(e, str) else ("", "", "")
+        if not name or not _HEX64.fullmatch(digest):
             return None
-        name, digest = e.split(" ")
         out.append((name, digest))
     return out
 

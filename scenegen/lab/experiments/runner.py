@@ -112,6 +112,12 @@ class Task:
     quick: bool
     overrides: tuple[tuple[str, Any], ...] = ()
 
+    def __post_init__(self) -> None:
+        # A key read back from a record gives the overrides as JSON lists; the task (its
+        # file name, its hash) must be the one planned, with tuples.
+        object.__setattr__(self, "overrides",
+                           tuple((str(k), _frozen(v)) for k, v in self.overrides))  # fmt: skip
+
     @property
     def sweep_label(self) -> str:
         return f"{self.param}={self.value:g}" if self.param else ""

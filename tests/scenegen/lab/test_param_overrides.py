@@ -11,7 +11,7 @@ from scenegen.cli.experiment import parse_overrides
 from scenegen.errors import ConfigError
 from scenegen.lab import kernel_quality as kq
 from scenegen.lab.experiments import get, run_experiment
-from scenegen.lab.experiments.runner import load_record, plan_tasks, tracker_params
+from scenegen.lab.experiments.runner import Task, load_record, plan_tasks, tracker_params
 
 NAME = "dps-synthetic"
 EXP = get(NAME)
@@ -99,6 +99,31 @@ def test_an_overridden_run_is_recorded_and_stale_for_the_default(tmp_path):
     # The default run's file is another one, and the overridden record does not pass for it.
     assert not (tmp_path / "runs" / plain.filename()).exists()
     assert load_record(tmp_path / "runs" / task.filename(), plain) is None
+
+
+def test_a_list_valued_override_resumes_and_validates(tmp_path, capsys):
+    # Read back from a record, the key gives the override as a JSON list; the task must
+    # still name the file it was stored in, or every resume recomputes every run (with a
+    # warning each) and results.json lists files that do not exist.
+    from scenegen.cli import main
+
+    kw = dict(runs=1, scenes=1, quick=True, methods=["dps"], jobs=1, progress=False,
+              figures=False, overrides={"sigma": [1.0, 1.0, 0.01]})  # fmt: skip
+    run_experiment(NAME, tmp_path, **kw)
+    (path,) = (tmp_path / "runs").iterdir()
+    (task,) = plan_tasks(EXP, runs=1, scenes=1, seed=0, quick=True, methods=["dps"],
+                         overrides={"sigma": [1.0, 1.0, 0.01]})
+    record = json.loads(path.read_text())
+    assert path.name == task.filename() == Task(**record["key"]).filename()
+    assert Task(**record["key"]) == task and load_record(path, task) is not None
+    before = path.read_bytes(), path.stat().st_mtime_ns
+    capsys.readouterr()
+    run_experiment(NAME, tmp_path, **kw)
+    assert capsys.readouterr().err == ""  # no "holds another run" warning
+    assert (path.read_bytes(), path.stat().st_mtime_ns) == before  # not computed again
+    listed = json.loads((tmp_path / "results.json").read_text())["records"]
+    assert [ln.rsplit(" ", 1)[0] for ln in listed] == [path.name]
+    assert main(["validate", str(tmp_path)]) == 0
 
 
 def _rate(k, n, lo, hi):
