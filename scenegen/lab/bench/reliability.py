@@ -3,9 +3,10 @@ whose cost is proportional to the frame range (equal per-frame cost for 10 and 1
 wherever they lie in the file).
 
 Generation runs ``scenegen generate`` in a subprocess so that its peak resident memory can
-be measured on its own (``os.wait4``); the import-only peak of the same interpreter
-(``scenegen presets``) is the baseline. Reads of 10 and 100 frames from the middle, and of
-10 frames from the end, of the generated file are timed side by side.
+be measured on its own (its ``VmHWM`` on Linux, see :func:`peak_rss`); the import-only
+peak of the same interpreter (``scenegen presets``) is the baseline. Reads of 10 and 100
+frames from the middle, and of 10 frames from the end, of the generated file are timed
+side by side.
 """
 
 from __future__ import annotations
@@ -50,6 +51,24 @@ SCENE = {
 }  # fmt: skip
 
 
+# Run in the child: scenegen's CLI, then, at exit, the peak resident memory of this
+# program alone: VmHWM of its own address space, which starts at exec. The rusage that
+# wait4 returns would not do on Linux: the child's ru_maxrss carries the resident set of
+# the process that forked it, so a child of a large parent (a long bench run, a pytest
+# session) would read as large as its parent.
+_PEAK_WRAPPER = """
+import atexit, runpy, sys
+def _peak(path=sys.argv.pop(1)):
+    with open("/proc/self/status") as f:
+        kib = next(ln.split()[1] for ln in f if ln.startswith("VmHWM:"))
+    with open(path, "w") as out:
+        out.write(kib)
+atexit.register(_peak)
+sys.argv[0] = "scenegen"
+runpy.run_module("scenegen.cli", run_name="__main__")
+"""
+
+
 def peak_rss(args: list[str]) -> tuple[float, float]:
     """Run ``scenegen ARGS`` in a subprocess.
 
@@ -61,26 +80,32 @@ def peak_rss(args: list[str]) -> tuple[float, float]:
     Returns
     -------
     (seconds, megabytes) : (float, float)
-        Wall time and peak resident memory of the subprocess.
+        Wall time and peak resident memory of the subprocess: on Linux its own high-water
+        mark (``VmHWM``), not counting the memory of the process that started it;
+        elsewhere ``ru_maxrss`` from ``os.wait4``.
 
     Raises
     ------
     RuntimeError
         If the command fails.
     """
-    t0 = time.perf_counter()
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "scenegen.cli", *args],
-        stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-    )  # fmt: skip
-    _, status, usage = os.wait4(proc.pid, 0)
-    seconds = time.perf_counter() - t0
-    proc.returncode = os.waitstatus_to_exitcode(status)
-    err = proc.stderr.read().decode(errors="replace").strip() if proc.stderr else ""
-    if proc.stderr:
-        proc.stderr.close()
-    if proc.returncode != 0:
-        raise RuntimeError(f"scenegen {' '.join(args)} failed: {err}")
+    own = Path("/proc/self/status").exists()
+    with tempfile.TemporaryDirectory() as tmp:
+        peak = Path(tmp) / "peak-kib"
+        cmd = ([sys.executable, "-c", _PEAK_WRAPPER, str(peak), *args] if own
+               else [sys.executable, "-m", "scenegen.cli", *args])  # fmt: skip
+        t0 = time.perf_counter()
+        proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+        _, status, usage = os.wait4(proc.pid, 0)
+        seconds = time.perf_counter() - t0
+        proc.returncode = os.waitstatus_to_exitcode(status)
+        err = proc.stderr.read().decode(errors="replace").strip() if proc.stderr else ""
+        if proc.stderr:
+            proc.stderr.close()
+        if proc.returncode != 0:
+            raise RuntimeError(f"scenegen {' '.join(args)} failed: {err}")
+        if own:
+            return seconds, int(peak.read_text()) / 1024
     scale = 1 if sys.platform == "darwin" else 1024  # ru_maxrss: bytes on macOS, else KiB
     return seconds, usage.ru_maxrss * scale / 2**20
 
