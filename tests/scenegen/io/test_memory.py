@@ -110,11 +110,12 @@ def test_copying_a_lazy_sequence_reads_block_by_block(tmp_path):
 
 @needs_proc_io
 def test_the_peak_is_the_childs_own_not_the_parents():
-    # A parent holding 300 MB: the child's measured peak stays that of a small program
-    # (with the rusage of wait4 it would read above 300 MB).
-    ballast = np.ones(300 * MB // 8)
-    _, mb = peak_rss(["--help"])
-    assert mb < 250, f"{mb:.0f} MB"
+    # The same small command measured beside a parent holding 600 MB more reads about the
+    # same (with the rusage of wait4 it would read above 600 MB).
+    _, alone = peak_rss(["--help"])
+    ballast = np.ones(600 * MB // 8)
+    _, beside = peak_rss(["--help"])
+    assert beside < min(alone + 100, 600), f"{alone:.0f} MB alone, {beside:.0f} MB beside"
     assert ballast.sum() > 0
 
 
