@@ -94,10 +94,11 @@ def table(out: Path, sigmas: list[float], seeds: list[int]) -> list[str]:
 
         lo, hi = min(sigmas), max(sigmas)
         if lo != hi:
-            d, (a, b), _ = bootstrap_clustered_diff(pooled(hi), pooled(lo), rng=0)
+            low = pooled(lo)
+            d, (a, b), _ = bootstrap_clustered_diff(pooled(hi), low, rng=0)
             lines.append(f"{preset}: PS and DPS pooled, sigma {hi:g} - sigma {lo:g}: "
                          f"{100 * d:+.1f} points (95 % interval {100 * a:+.1f} to "
-                         f"{100 * b:+.1f}; {len(pooled(lo))} scenes)")  # fmt: skip
+                         f"{100 * b:+.1f}; {len(low)} scenes)")  # fmt: skip
     return lines
 
 
