@@ -89,6 +89,7 @@ from trackers.params import TrackerParams, check_choice, check_integer, check_nu
 
 __all__ = [
     "ASSIGNMENTS",
+    "MIXTURES",
     "Condensation",
     "DPSParams",
     "DistributedPartitionedSampling",
@@ -104,6 +105,9 @@ __all__ = [
 
 #: Rules that assign particles to the DPS mixture components (``assignment``).
 ASSIGNMENTS: tuple[str, ...] = ("random", "interleaved", "persistent")
+
+#: How DPS weighs its components when it reassembles them (``mixture``).
+MIXTURES: tuple[str, ...] = ("evidence", "prior")
 
 #: Weighting functions of PS's weighted resampling stages (``weighting``).
 WEIGHTINGS: tuple[str, ...] = ("stage", "placed", "g-only")
@@ -259,17 +263,23 @@ class DPSParams(PartitionedParams):
     n_groups : int or None, optional
         C, the number of mixture components, in [1, n_particles]; None: one per target
         (the paper's C = M).
-    assignment : {"random", "interleaved"}, optional
+    assignment : {"random", "interleaved", "persistent"}, optional
         How particles are assigned to components (``DistributedPartitionedSampling``).
+    mixture : {"evidence", "prior"}, optional
+        The components' mixture weights at reassembly: "evidence" (π_c,t ∝ π_c,t−1 times
+        the component's evidence, Vermaak et al.) or "prior" (π_c,t = π_c,t−1, each
+        component keeps its share; ``DistributedPartitionedSampling``).
     """
 
     n_groups: int | None = None
     assignment: str = "random"
+    mixture: str = "evidence"
 
     def __post_init__(self) -> None:
         super().__post_init__()
         check_integer(self, "n_groups", low=1, high=self.n_particles, optional=True)
         check_choice(self, "assignment", ASSIGNMENTS)
+        check_choice(self, "mixture", MIXTURES)
 
 
 def check_sigma3(params: TrackerParams, name: str) -> None:
@@ -513,7 +523,9 @@ class _Partitioned(_ParticleTracker):
         # The set {x, π'} still represents the predicted joint state (weighted resampling
         # preserves it), so π' Π_i p(Z | X_i) are the unnormalised posterior weights w̃.
         logw = logpi + ll.sum(axis=1)
-        weights, mixture, self._log_mixture = self._reassemble(logw, logpi, sizes, log_prior)
+        weights, mixture, self._log_mixture = self._reassemble(
+            logw, logpi, sizes, log_prior,
+            evidence=getattr(self.params, "mixture", "evidence") == "evidence")  # PS: 1 group
         self._logw = logw
         self.particles = x
         self._prev = prev
@@ -523,7 +535,8 @@ class _Partitioned(_ParticleTracker):
 
     @staticmethod
     def _reassemble(logw: NDArray[np.float64], logpi: NDArray[np.float64],
-                    sizes: NDArray[np.int64], log_prior: NDArray[np.float64] | None = None
+                    sizes: NDArray[np.int64], log_prior: NDArray[np.float64] | None = None,
+                    evidence: bool = True
                     ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
         """Mixture reassembly (DPS §4, after Vermaak, Doucet & Pérez 2003).
 
@@ -533,7 +546,9 @@ class _Partitioned(_ParticleTracker):
         evidence. Groups drawn afresh from an equally weighted (resampled) set start with
         π_c,t−1 = N_c / N (``log_prior`` None); groups that keep their particles pass the
         previous step's log π_c (``log_prior`` (C,)). With one group this is plain
-        normalisation. Returns the weights (N,), the mixture weights (C,) and their logs.
+        normalisation. ``evidence`` False (DPS ``mixture="prior"``): π_c,t = π_c,t−1, so
+        every group keeps its share of the mass whatever its evidence. Returns the
+        weights (N,), the mixture weights (C,) and their logs.
         """
         if sizes.size == 1:
             return normalised_weights(logw), np.ones(1), np.zeros(1)
@@ -542,7 +557,7 @@ class _Partitioned(_ParticleTracker):
         # mixture_c − log_total_c), in compiled glue between numpy's exp and log.
         if log_prior is None:
             log_prior = np.log(sizes / sizes.sum())
-        return reassemble(logw, logpi, sizes, log_prior)
+        return reassemble(logw, logpi, sizes, log_prior, evidence)
 
 
 class PartitionedSampling(_Partitioned):
@@ -600,7 +615,10 @@ class DistributedPartitionedSampling(_Partitioned):
     Eq. 3, as in Vermaak, Doucet & Pérez's mixture tracking, without their
     re-clustering). DPS is then a mixture of C PS filters, one per ordering, weighted by
     their evidence. The components start as contiguous blocks of the initial set (all
-    its particles are equal).
+    its particles are equal). **(open)** ``mixture``: "evidence" (the formula above) or
+    "prior", π_c,t = π_c,t−1: each component keeps its share whatever its evidence (the
+    other reading of the paper's "multiplied by the prior factor π_C,t to ensure a fair
+    representation"; docs/algorithms.md §2.6).
     """
 
     name = "dps"

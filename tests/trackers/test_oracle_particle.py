@@ -158,6 +158,8 @@ CONFIGS = [
     ("dps", {"n_groups": 7, "resampler": "stratified"}),   # 286 x 5, 285 x 2
     ("dps", {"n_groups": 3, "assignment": "interleaved", "resampler": "residual"}),
     ("dps", {"n_groups": 3, "assignment": "persistent"}),  # a mixture of three PS filters
+    ("dps", {"n_groups": 3, "mixture": "prior"}),  # each group keeps its share
+    ("dps", {"n_groups": 3, "assignment": "persistent", "mixture": "prior"}),
     ("dps", {"n_groups": 3, "weighting": "placed"}),
     ("dps", {"n_groups": 2, "weighting": "g-only", "resampler": "residual"}),
     ("dps", {"n_groups": 3, "resample_scope": "placed"}),

@@ -168,6 +168,7 @@ def test_bad_boxes_and_frames_raise(name):
     ("dps", {"n_groups": 0}, "n_groups"),
     ("dps", {"assignment": "greedy"},
      "unknown assignment 'greedy'; valid: random, interleaved, persistent"),
+    ("dps", {"mixture": "equal"}, "unknown mixture 'equal'; valid: evidence, prior"),
     ("ps", {"weighting": "joint"}, "unknown weighting 'joint'; valid: stage, placed, g-only"),
     ("dps", {"resample_scope": "all"}, "unknown resample_scope 'all'; valid: joint, placed"),
     ("joint-pf", {"weighting": "stage"}, "unknown parameter 'weighting' for tracker 'joint-pf'"),
@@ -235,6 +236,39 @@ def test_mixture_reassembly_weights_groups_by_size_and_evidence():
         np.log(lik), np.zeros(5), np.array([5]))
     np.testing.assert_allclose(weights, lik / lik.sum())
     assert mixture.tolist() == [1.0] and log_mixture.tolist() == [0.0]
+
+
+def test_prior_mixture_keeps_each_groups_share_whatever_its_evidence():
+    """``mixture="prior"``: π_c,t = π_c,t−1; inside a group the weights are π' p, normalised."""
+    sizes = np.array([3, 2])
+    logpi = np.log(np.array([1.0, 1.0, 2.0, 5.0, 5.0]))
+    lik = np.array([0.5, 1.0, 2.0, 1e-6, 3e-6])  # group 2's evidence is a millionth
+    w = np.exp(logpi) * lik
+    for prior, share in ((None, sizes / 5), (np.log([0.9, 0.1]), np.array([0.9, 0.1]))):
+        weights, mixture, log_mixture = DistributedPartitionedSampling._reassemble(
+            logpi + np.log(lik), logpi, sizes, prior, evidence=False)
+        np.testing.assert_allclose(mixture, share)
+        np.testing.assert_allclose(np.exp(log_mixture), share)
+        np.testing.assert_allclose(weights, np.concatenate(
+            [share[0] * w[:3] / w[:3].sum(), share[1] * w[3:] / w[3:].sum()]))
+    # With the evidence the second group weighs next to nothing.
+    _, mixture, _ = DistributedPartitionedSampling._reassemble(logpi + np.log(lik), logpi,
+                                                               sizes)
+    assert mixture[1] < 1e-5
+
+
+@pytest.mark.parametrize("mixture", ["evidence", "prior"])
+def test_dps_reports_the_mixture_weights_its_rule_gives(mixture):
+    frames, boxes = _scene(3)
+    runs = _run(DistributedPartitionedSampling(mixture=mixture, n_particles=61, rng=2),
+                frames, boxes)
+    sizes = np.array([21, 20, 20]) / 61
+    for (box, _, _, extras), truth in zip(runs, boxes[1:], strict=True):
+        assert np.all(_iou(box, truth) > 0.5)
+        if mixture == "prior":
+            np.testing.assert_allclose(extras["mixture_weights"], sizes)
+        else:
+            assert not np.allclose(extras["mixture_weights"], sizes)
 
 
 @pytest.mark.parametrize("assignment, kept", [("persistent", True), ("random", False)])

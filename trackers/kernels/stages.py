@@ -594,7 +594,8 @@ def _final_log_weights(logw, log_mixture, log_total, sizes):
 
 
 def reassemble(logw: NDArray[np.float64], logpi: NDArray[np.float64],
-               sizes: NDArray[np.int64], log_prior: NDArray[np.float64]
+               sizes: NDArray[np.int64], log_prior: NDArray[np.float64],
+               evidence: bool = True
                ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """The DPS mixture reassembly (``_Partitioned._reassemble``) with compiled glue.
 
@@ -608,6 +609,9 @@ def reassemble(logw: NDArray[np.float64], logpi: NDArray[np.float64],
         log π_c,t−1: log(N_c / N), ``np.log(sizes / sizes.sum())``, for groups drawn
         afresh, or the previous step's log mixture weights for groups that keep their
         particles.
+    evidence : bool, optional
+        True: π_c,t ∝ π_c,t−1 times the group's evidence (DPS ``mixture="evidence"``);
+        False: π_c,t = π_c,t−1, every group keeps its share (``mixture="prior"``).
 
     Returns
     -------
@@ -631,7 +635,7 @@ def reassemble(logw: NDArray[np.float64], logpi: NDArray[np.float64],
     logs = np.log(_reassemble_sums(np.exp(shifted), sizes))
     log_total = top_w + logs[0]
     log_evidence = log_total - (top_p + logs[1])
-    top = _max_shift(log_prior + log_evidence)
+    top = _max_shift(log_prior + log_evidence if evidence else log_prior)
     e = np.exp(top)
     mixture = _divide_by_sum(e)
     with np.errstate(divide="ignore"):  # a component far below the others: π_c = 0
