@@ -23,6 +23,11 @@ parameter of every method that has it, as ``scenegen experiment --param`` reads 
 ``--param lam=150`` or ``--param resample_scope=placed`` (PS and DPS only).
 It reads the walker's states before each propagation through the trackers'
 ``propagation_hook`` (tested in ``tests/trackers/test_ps_cycle.py``).
+
+``--mixture`` prints instead, per scene and run, DPS's largest mixture weight
+(median and 90th percentile over the frames): how far the evidence moves the components'
+shares from 1/3 (docs/experiments.md, "A fair share for every component"; ``--param
+mixture=prior`` keeps them at 1/3).
 """
 
 from __future__ import annotations
@@ -80,6 +85,22 @@ def measure(preset: str, base: int, scene: int, slug: str, run: int,
     return np.concatenate([rows_a.mean(axis=0), rows_a[hidden].mean(axis=0)])
 
 
+def largest_mixture_weight(preset: str, base: int, scene: int, run: int,
+                           extra: dict[str, object] | None = None) -> np.ndarray:
+    """DPS's largest mixture weight max_c π_c,t over frames 1..T-1: its median and 90th
+    percentile (2,). 1/C (C = 3) means that every component kept its share; with the
+    evidence (``mixture="evidence"``, the default) one component takes more."""
+    exp = get("dps-occlusion")
+    seq = scenegen.generate(preset, seed=scene_seed(base, exp.name, preset, scene))
+    params = {**exp.method("dps").param_dict(), **(extra or {})}
+    tr = trackers.make("dps", rng=derive_seed(base, "mixture", preset, scene, run), **params)
+    frames = seq.frames
+    tr.init(np.asarray(frames[0]), seq.init_boxes(0))
+    top = [tr.step(np.asarray(frames[t])).extras["mixture_weights"].max()
+           for t in range(1, len(frames))]
+    return np.quantile(top, [0.5, 0.9])
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("preset", choices=("dps-occlusion", "dps-occlusion-2"))
@@ -90,10 +111,20 @@ def main() -> None:
                     help="PS/DPS weighting (default: the trackers'; round 3 used placed)")
     ap.add_argument("--param", action="append", default=[], metavar="KEY=VALUE",
                     help="a tracker parameter for every method that has it, e.g. lam=150")
+    ap.add_argument("--mixture", action="store_true",
+                    help="print DPS's largest mixture weight per scene instead")
     args = ap.parse_args()
     extra = parse_overrides(args.param)
     bases = [int(b) for b in args.seeds.split(",")]
     numba.set_num_threads(1)
+    if args.mixture:
+        print("seed scene run  largest mixture weight: median  90th percentile")
+        for b in bases:
+            for s in range(args.scenes):
+                for r in range(args.runs):
+                    q = largest_mixture_weight(args.preset, b, s, r, extra)
+                    print(f"{b:4d} {s:5d} {r:3d} {q[0]:33.3f} {q[1]:16.3f}", flush=True)
+        return
     print("method   ancestors %  spread px  end uniq. %  | hidden: ancestors %  spread px")
     for m in get("dps-occlusion").methods:
         v = np.mean([measure(args.preset, b, s, m.slug, r, args.weighting,

@@ -42,3 +42,19 @@ def test_command_line_prints_one_row_per_method():
     assert rows[0].startswith("method")
     assert [r.split()[0] for r in rows[1:]] == ["Non-PS", "PS(1,2,3)", "PS(2,3,1)",
                                                "PS(3,1,2)", "DPS"]
+
+
+def test_mixture_weights_leave_a_third_only_under_the_prior_mixture(tool):
+    evidence = tool.largest_mixture_weight("dps-occlusion", 1, 0, 0)
+    prior = tool.largest_mixture_weight("dps-occlusion", 1, 0, 0, {"mixture": "prior"})
+    np.testing.assert_allclose(prior, 67 / 200)  # N = 200 in groups of 67, 67, 66
+    assert evidence[0] > 0.38 and evidence[1] >= evidence[0]
+
+
+def test_command_line_prints_the_mixture_weights_per_scene():
+    out = subprocess.run([sys.executable, str(TOOL), "dps-occlusion", "--seeds", "1",
+                          "--scenes", "1", "--mixture", "--param", "mixture=prior"],
+                         capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    rows = out.stdout.strip().splitlines()
+    assert len(rows) == 2 and rows[1].split() == ["1", "0", "0", "0.335", "0.335"]
