@@ -241,7 +241,8 @@ def check_overrides(exp: Experiment, method: str, overrides: dict[str, Any]) -> 
         if name not in fields:
             having = [x.slug for x in exp.methods
                       if name in tracker_class(x.tracker).Params.names()]  # fmt: skip
-            hint = (f"; of {exp.name}'s methods only {', '.join(having)} have it: name them, "
+            them = "have it: name them" if len(having) > 1 else "has it: name it"
+            hint = (f"; of {exp.name}'s methods only {', '.join(having)} {them}, "
                     + " ".join(f"--method {x}" for x in having) if having
                     else f"; no method of {exp.name} has it")  # fmt: skip
             raise ConfigError(f"method {m.slug!r} (tracker {m.tracker!r}) has no parameter "

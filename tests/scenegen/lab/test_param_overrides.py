@@ -75,6 +75,9 @@ def test_a_parameter_only_some_methods_have_names_those_methods():
     tasks = plan_tasks(occ, runs=1, scenes=1, seed=0, quick=True, methods=named,
                        overrides={"resample_scope": "placed"})
     assert sorted({t.method for t in tasks}) == sorted(named)
+    # DPS's mixture belongs to DPS alone: one method, named in the singular.
+    with pytest.raises(ConfigError, match="only dps has it: name it, --method dps; its "):
+        plan_tasks(occ, runs=1, seed=0, quick=True, overrides={"mixture": "prior"})
     with pytest.raises(ConfigError, match="; no method of dps-occlusion has it; its param"):
         plan_tasks(occ, runs=1, seed=0, quick=True, overrides={"kernl": "box"})
 
