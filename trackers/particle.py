@@ -434,6 +434,10 @@ class _Partitioned(_ParticleTracker):
         reordered so that the groups are contiguous, the group sizes (C,) and each
         group's ordering (C, M)."""
 
+    def _mixture_by_evidence(self) -> bool:
+        """Whether the reassembly weighs the groups by their evidence (PS: one group)."""
+        return True
+
     def _ancestors(self) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64],
                                   NDArray[np.float64] | None]:
         """The step's ancestors (N,), group sizes (C,), orderings (C, M) and log π_c,t−1
@@ -524,8 +528,7 @@ class _Partitioned(_ParticleTracker):
         # preserves it), so π' Π_i p(Z | X_i) are the unnormalised posterior weights w̃.
         logw = logpi + ll.sum(axis=1)
         weights, mixture, self._log_mixture = self._reassemble(
-            logw, logpi, sizes, log_prior,
-            evidence=getattr(self.params, "mixture", "evidence") == "evidence")  # PS: 1 group
+            logw, logpi, sizes, log_prior, evidence=self._mixture_by_evidence())
         self._logw = logw
         self.particles = x
         self._prev = prev
@@ -650,6 +653,9 @@ class DistributedPartitionedSampling(_Partitioned):
                                   method=self.params.resampler, rng=self.rng)
             log_prior = self._log_mixture
         return idx, sizes, self._orders, log_prior
+
+    def _mixture_by_evidence(self) -> bool:
+        return self.params.mixture == "evidence"
 
     def _groups(self, idx):
         if self._sizes_c.size > 1:
