@@ -343,6 +343,15 @@ def dps_occlusion() -> SceneConfig:
     there. Not re-tuned, for that reason (docs/experiments.md, "Does the walker's spread
     decide it?").
 
+    Round 11 (tuning seeds 1–3): the wider cloud changes *when* the walker is lost, not
+    where: at σ = 4 as at σ = 1 all but 6–10 of ~100 failures begin at the half-red
+    person, with the walker 70–100 % visible, but about ten frames later (median 26
+    against 16.5 frames since it was last hidden). Dressing both stationary people in the
+    half-red attractor (``--tune 'shirt1=[[200, 60, 40], [40, 90, 200]]'``) does not make
+    the scene spread-limited either (σ = 4 against σ = 1: +5.0 points, −6.7 to +15.9), so
+    the scene is unchanged (docs/experiments.md, "A second candidate for a
+    spread-limited `dps-occlusion`").
+
     Differs from the paper: RealSeq1 is real video of people; ours are banded ellipses
     (hair/face/shirt/trousers), the occluders are a little larger than the walker so that
     occlusion is total for several frames each time, and the walk is nearly straight.
