@@ -350,7 +350,12 @@ def dps_occlusion() -> SceneConfig:
     half-red attractor (``--tune 'shirt1=[[200, 60, 40], [40, 90, 200]]'``) does not make
     the scene spread-limited either (σ = 4 against σ = 1: +5.0 points, −6.7 to +15.9), so
     the scene is unchanged (docs/experiments.md, "A second candidate for a
-    spread-limited `dps-occlusion`").
+    spread-limited `dps-occlusion`"). Swapping the two shirts (the attractor on the first
+    person, green on the second) does: σ = 4 against σ = 1 +17.5 points (+9.2 to +25.8),
+    every failure but one behind the attractor. Judged once, as pre-registered, on base
+    seed 23 (30 x 5): DPS 61 %, PS 72 / 64 / 58 %, Non-PS 55 %; DPS − PS pooled −3.3
+    points (−10.2 to +3.3). Not adopted in round 11 ("A third candidate: the attractor
+    on the first person").
 
     Differs from the paper: RealSeq1 is real video of people; ours are banded ellipses
     (hair/face/shirt/trousers), the occluders are a little larger than the walker so that
