@@ -312,7 +312,12 @@ def test_judged_claims_of_the_full_run(tmp_path):
         assert kams[f"{p}: KAMS completes the sequence (completion rate above 50%)"] \
             == "reproduced"
     occ = verdicts("dps-occlusion")
-    assert occ["dps-occlusion: occluded object's success of DPS above Non-PS's"] == "reproduced"
+    # Round 12 (the attractor on the first person): reproduced on the RealSeq2 analogue
+    # only; on the RealSeq1 analogue DPS and Non-PS keep the walker alike (66 and 64 %).
+    assert occ["dps-occlusion-2: occluded object's success of DPS above Non-PS's"] \
+        == "reproduced"
+    assert occ["dps-occlusion: occluded object's success of DPS above Non-PS's"] \
+        == "not reproduced"
     # Round 4 (the papers' `stage` weighting, Cochran's Q over paired cases): the ordering
     # decides object 1's recovery at every λ, and DPS recovers it more often than PS at
     # λ = 30, 40, 50 (docs/experiments.md, "Other readings of PS").
