@@ -1,8 +1,11 @@
 """Whether a scene decides who loses the walker: paired outcomes of the methods.
 
-Usage (on a folder written by ``scenegen experiment dps-occlusion``)::
+Usage (on one or more folders written by ``scenegen experiment dps-occlusion``)::
 
-    python tools/occlusion/independence.py DIR
+    python tools/occlusion/independence.py DIR [DIR ...]
+
+With several folders (e.g. two base seeds of the same scene version) their scenes are
+pooled: a scene is then (folder, scene), and every measure below is over all of them.
 
 For every preset it prints, from the runs in ``DIR/runs/`` (a run *succeeds* when the
 walker is tracked in every frame but frame 0, the experiment's success):
@@ -18,6 +21,10 @@ walker is tracked in every frame but frame 0, the experiment's success):
 - ``any``: the success a DPS would have if it kept the walker whenever one of its PS
   orderings did, were the orderings' outcomes independent, 1 − Π (1 − p_o); beside it
   DPS's success and the orderings' mean;
+- DPS's lead over the PS orderings pooled, with the experiment's scene-paired bootstrap
+  (``stats.bootstrap_clustered_diff``, seeded with 0): the effect in points, its 95 %
+  interval and the one-sided p of DPS above PS (with one folder, the experiment's own
+  claim up to the bootstrap's seed);
 - the scene x method interaction: DPS's lead over the PS orderings pooled, per scene,
   its variance over the scenes and its largest value, each with a permutation p-value
   (DPS's and the orderings' outcomes of a scene shuffled within that scene, 4,000
@@ -42,6 +49,7 @@ from pathlib import Path
 
 import numpy as np
 
+from scenegen.lab.experiments import stats
 from scenegen.lab.experiments.definitions import get
 from scenegen.lab.experiments.outputs import read_record
 from scenegen.lab.experiments.summary import drop_first_frame, succeeded
@@ -63,7 +71,60 @@ def outcomes(folder: str | Path) -> dict[str, dict[str, dict[tuple[int, int], bo
     return dict(out)
 
 
-def summary(runs: dict[str, dict[tuple[int, int], bool]]) -> dict[str, object]:
+Runs = dict[str, dict[tuple[object, int], bool]]
+"""One preset's outcomes: method label -> (scene, run) -> the walker kept."""
+
+
+def pooled(folders: list[str | Path]) -> dict[str, Runs]:
+    """:func:`outcomes` of several folders, each scene keyed ``(i, scene)`` by the folder's
+    place ``i`` in ``folders`` (one folder: its own keys). Only presets and methods that
+    every folder has are kept."""
+    if len(folders) == 1:
+        return outcomes(folders[0])  # type: ignore[return-value]
+    each = [outcomes(f) for f in folders]
+    out: dict[str, Runs] = {}
+    for preset in sorted(set.intersection(*(set(e) for e in each))):
+        labels = set.intersection(*(set(e[preset]) for e in each))
+        out[preset] = {lb: {((i, sc), r): v for i, e in enumerate(each)
+                            for (sc, r), v in e[preset][lb].items()}
+                       for lb in sorted(labels)}  # fmt: skip
+    return out
+
+
+def lead(runs: Runs, rng: np.random.Generator | int = 0) -> tuple[float, tuple[float, float],
+                                                                  float] | None:
+    """DPS's success minus the PS orderings' pooled, in points, over paired scenes.
+
+    Parameters
+    ----------
+    runs : dict
+        One preset's outcomes (:func:`outcomes` or :func:`pooled`); labels ``DPS`` and
+        ``PS(…)`` are used.
+    rng : numpy.random.Generator or int, optional
+        The bootstrap's randomness.
+
+    Returns
+    -------
+    (float, (float, float), float) or None
+        The mean over scenes of the per-scene difference, its 95 % interval and the
+        one-sided p of DPS above PS (``stats.bootstrap_clustered_diff``); None without DPS
+        or a PS ordering.
+    """
+    ps = [lb for lb in runs if lb.startswith("PS(")]
+    if "DPS" not in runs or not ps:
+        return None
+    by_dps: dict[object, list[float]] = defaultdict(list)
+    by_ps: dict[object, list[float]] = defaultdict(list)
+    for (sc, _), v in sorted(runs["DPS"].items()):
+        by_dps[sc].append(100.0 * v)
+    for lb in ps:
+        for (sc, _), v in sorted(runs[lb].items()):
+            by_ps[sc].append(100.0 * v)
+    mean, ci, test = stats.bootstrap_clustered_diff(by_dps, by_ps, rng)
+    return float(mean), (float(ci[0]), float(ci[1])), float(test.p_value)
+
+
+def summary(runs: Runs) -> dict[str, object]:
     """The printed measures of one preset (see the module docstring), from
     :func:`outcomes`' entry. Only (scene, run) pairs every method ran are used."""
     labels = list(runs)
@@ -90,7 +151,7 @@ def summary(runs: dict[str, dict[tuple[int, int], bool]]) -> dict[str, object]:
             "pairs": len(pairs), "scenes": len(scenes)}  # fmt: skip
 
 
-def interaction(runs: dict[str, dict[tuple[int, int], bool]], n_perm: int = 4000,
+def interaction(runs: Runs, n_perm: int = 4000,
                 rng: np.random.Generator | int | None = 0) -> dict[str, object] | None:
     """Whether DPS's lead over the PS orderings pooled differs between scenes.
 
@@ -137,7 +198,7 @@ def interaction(runs: dict[str, dict[tuple[int, int], bool]], n_perm: int = 4000
 PAPER_DPS, PAPER_PS = 1.0, (0.18 + 0.40 + 0.34) / 3
 
 
-def power(runs: dict[str, dict[tuple[int, int], bool]], k: int, trials: int = 200,
+def power(runs: Runs, k: int, trials: int = 200,
           n_perm: int = 1000, rng: np.random.Generator | int | None = 0) -> float:
     """Share of trials in which :func:`interaction` flags (``p_max`` < 0.05) ``k`` scenes
     replaced by draws at the paper's RealSeq1 rates (``PAPER_DPS``, ``PAPER_PS``).
@@ -165,7 +226,7 @@ def power(runs: dict[str, dict[tuple[int, int], bool]], k: int, trials: int = 20
         raise ValueError(f"--power {k}: between 1 and the {len(scenes)} scenes")
     hits = 0
     for _ in range(trials):
-        planted = set(gen.choice(scenes, k, replace=False).tolist())
+        planted = {scenes[i] for i in gen.choice(len(scenes), k, replace=False).tolist()}
         trial = {lb: dict(v) for lb, v in runs.items()}
         for lb, rate in [("DPS", PAPER_DPS)] + [(lb, PAPER_PS) for lb in ps]:
             for key in sorted(trial[lb]):
@@ -175,14 +236,24 @@ def power(runs: dict[str, dict[tuple[int, int], bool]], k: int, trials: int = 20
     return hits / trials
 
 
+def _scene(key: object, folders: list[str]) -> str:
+    """A scene key as printed: ``scene 5``, or ``scene 5 of FOLDER`` when pooled."""
+    if isinstance(key, tuple):
+        return f"scene {key[1]} of {folders[key[0]]}"
+    return f"scene {key}"
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("folder", help="a folder of `scenegen experiment dps-occlusion`")
+    ap.add_argument("folder", nargs="+",
+                    help="folders of `scenegen experiment dps-occlusion` (several: pooled)")
     ap.add_argument("--power", type=int, metavar="K", default=0,
                     help="also print how often K planted paper-like scenes are flagged")
     args = ap.parse_args()
     order = [m.label for m in get(EXPERIMENT).methods]
-    for preset, runs in sorted(outcomes(args.folder).items()):
+    if len(args.folder) > 1:
+        print(f"pooled over {len(args.folder)} folders: " + ", ".join(args.folder))
+    for preset, runs in sorted(pooled(args.folder).items()):
         runs = {lb: runs[lb] for lb in order if lb in runs}
         s = summary(runs)
         rates = ", ".join(f"{lb} {100 * r:.0f} %" for lb, r in s["rate"].items())
@@ -196,11 +267,15 @@ def main() -> None:
         if s["dps"] is not None and s["ps_mean"] is not None:
             print(f"  any ordering keeps it: {100 * s['any']:.1f} %; DPS {100 * s['dps']:.0f} %;"
                   f" orderings' mean {100 * s['ps_mean']:.0f} %")  # fmt: skip
+        ld = lead(runs)
+        if ld is not None:
+            print(f"  DPS - PS pooled: {ld[0]:+.1f} points [{ld[1][0]:+.1f}, {ld[1][1]:+.1f}], "
+                  f"one-sided p {ld[2]:.2f}")
         it = interaction(runs)
         if it is not None:
             print(f"  DPS's lead per scene: variance {it['var']:.4f} (permutation p "
-                  f"{it['p_var']:.2f}), largest {100 * it['max']:+.0f} points on scene "
-                  f"{it['argmax']} (p {it['p_max']:.2f})")
+                  f"{it['p_var']:.2f}), largest {100 * it['max']:+.0f} points on "
+                  f"{_scene(it['argmax'], args.folder)} (p {it['p_max']:.2f})")
             if args.power:
                 print(f"  {args.power} planted paper-like scene(s) flagged in "
                       f"{100 * power(runs, args.power):.0f} % of 200 trials")

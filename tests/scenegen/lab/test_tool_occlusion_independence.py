@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import json
 import subprocess
 import sys
 from pathlib import Path
@@ -47,7 +48,7 @@ def test_only_pairs_every_method_ran_are_used(tool):
     assert s["pairs"] == 2 and s["rate"]["PS(1,2,3)"] == pytest.approx(0.5)
 
 
-def test_the_tool_reads_an_experiment_folder(tmp_path, capsys):
+def test_the_tool_reads_an_experiment_folder(tool, tmp_path, capsys):
     out = tmp_path / "occ"
     assert main(["experiment", "dps-occlusion", "--scenes", "2", "--runs", "1", "--quick",
                  "--method", "nonps", "--method", "ps-123", "--method", "dps", "--jobs", "1",
@@ -62,6 +63,25 @@ def test_the_tool_reads_an_experiment_folder(tmp_path, capsys):
     assert sum(ln.startswith("dps-occlusion-2: 2 scenes, 2 (scene") for ln in lines) == 1
     assert sum(ln.startswith("  per-scene success ") for ln in lines) == 2
     assert sum(ln.startswith("  DPS's lead per scene: variance ") for ln in lines) == 2
+    assert sum(ln.startswith("  DPS - PS pooled: ") for ln in lines) == 2
+
+    # The pooled lead is the experiment's own claim (one definition: the same bootstrap
+    # over the same per-scene differences), and pooling a folder with itself keeps it.
+    claims = {c["claim"]: c for c in json.loads((out / "results.json").read_text())["claims"]}
+    claim = claims["dps-occlusion: occluded object's success of DPS above the PS orderings' "
+                   "(pooled)"]  # fmt: skip
+    one = tool.lead(tool.outcomes(out)["dps-occlusion"])
+    assert one[0] == pytest.approx(claim["effect"], abs=1e-3)
+    twice = tool.pooled([out, out])
+    assert sorted({sc for sc, _ in twice["dps-occlusion"]["DPS"]}) == [(0, 0), (0, 1),
+                                                                       (1, 0), (1, 1)]
+    assert tool.lead(twice["dps-occlusion"])[0] == pytest.approx(one[0])
+    res = subprocess.run([sys.executable, str(TOOL), str(out), str(out)], capture_output=True,
+                         text=True, timeout=300)  # fmt: skip
+    assert res.returncode == 0, res.stderr
+    lines = res.stdout.strip().splitlines()
+    assert lines[0] == f"pooled over 2 folders: {out}, {out}"
+    assert lines[1].startswith("dps-occlusion: 4 scenes, 4 (scene, run) pairs; Non-PS ")
 
 
 def _alike(n_scenes: int, seed: int) -> dict[str, dict[tuple[int, int], bool]]:
@@ -69,6 +89,38 @@ def _alike(n_scenes: int, seed: int) -> dict[str, dict[tuple[int, int], bool]]:
     rng = np.random.default_rng(seed)
     return _runs({lb: rng.integers(0, 2, (n_scenes, 5)).tolist()
                   for lb in ("PS(1,2,3)", "PS(2,3,1)", "PS(3,1,2)", "DPS")})  # fmt: skip
+
+
+def test_the_lead_is_the_mean_per_scene_difference_with_a_scene_bootstrap(tool):
+    runs = _runs({"PS(1,2,3)": [[0, 0], [1, 0], [0, 0]], "PS(2,3,1)": [[0, 0], [1, 1], [0, 1]],
+                  "DPS": [[1, 1], [1, 1], [0, 0]]})  # fmt: skip
+    effect, (lo, hi), p = tool.lead(runs)
+    # Per scene: 100 - 0, 100 - 75, 0 - 25 points; their mean.
+    assert effect == pytest.approx((100 + 25 - 25) / 3)
+    assert lo <= effect <= hi and 0 < p < 0.5
+    assert tool.lead(runs, rng=3) == tool.lead(runs, rng=3)  # seeded
+    every = _runs({"PS(1,2,3)": [[0, 0]] * 4, "DPS": [[1, 1]] * 4})
+    effect, ci, p = tool.lead(every)
+    assert (effect, ci) == (100.0, (100.0, 100.0)) and p < 0.001  # the bootstrap's floor
+    assert tool.lead(_runs({"PS(1,2,3)": [[1]]})) is None
+
+
+def test_pooled_folders_key_scenes_by_folder(tool, monkeypatch):
+    a = {"dps-occlusion": _runs({"PS(1,2,3)": [[1], [0]], "DPS": [[1], [1]]}),
+         "dps-occlusion-2": _runs({"DPS": [[0]]})}
+    b = {"dps-occlusion": _runs({"PS(1,2,3)": [[0]], "DPS": [[0]], "Non-PS": [[1]]})}
+    monkeypatch.setattr(tool, "outcomes", lambda f: {"a": a, "b": b}[f])
+    out = tool.pooled(["a", "b"])
+    assert list(out) == ["dps-occlusion"]  # only presets and methods every folder has
+    assert out["dps-occlusion"]["DPS"] == {((0, 0), 0): True, ((0, 1), 0): True,
+                                           ((1, 0), 0): False}
+    assert set(out["dps-occlusion"]) == {"DPS", "PS(1,2,3)"}
+    assert tool.pooled(["a"]) is a
+    s = tool.summary(out["dps-occlusion"])
+    assert (s["scenes"], s["pairs"]) == (3, 3)
+    # The permutation test and the planted-scene power take (folder, scene) keys too.
+    assert tool.interaction(out["dps-occlusion"])["argmax"] in {(0, 1), (0, 0)}
+    assert 0.0 <= tool.power(out["dps-occlusion"], 1, trials=3, n_perm=20) <= 1.0
 
 
 def test_the_interaction_is_flat_when_dps_leads_alike_on_every_scene(tool):
