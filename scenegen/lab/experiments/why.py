@@ -60,8 +60,9 @@ WHY: dict[str, str] = {
         "paper's (81–89 % against 55–72 %) and our recall lower (68–78 % against "
         "86–100 %) because the paper's estimated boxes were larger than its ground truth "
         "and ours are not: by the definitions recall / precision = |E| / |G|, 1.2–1.7 "
-        "in the paper's Table 3 and 0.8–1.0 here (median per run, seed 0). The readings "
-        "and scenes tried are in docs/experiments.md."
+        "in the paper's Table 3 and 0.8–1.0 here (median per run, seed 0). Every judged "
+        "set, the readings and scenes tried: docs/experiments.md, \"DPS Table 3 in one "
+        "page\"."
     ),
     "kams-accuracy": (
         "Measured against the noise-free path (`gt/path_center`) as in the paper, KAMS's "
