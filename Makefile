@@ -30,7 +30,8 @@ bench: $(STAMP)
 	$(BIN)/scenegen bench
 
 # Mutation score of the formula modules (cosmic-ray; long, not part of `make test`).
-# MODULES: a subset (resampling particle meanshift annealed shm kalman metrics);
+# MODULES: a subset (resampling particle meanshift annealed shm kalman metrics stats
+# summary);
 # SAMPLE: mutants per module (0: all). Results in build/mutate/<module>.txt.
 MODULES ?=
 SAMPLE ?= 60

@@ -123,6 +123,28 @@ MODULES: dict[str, Module] = {
          "idf1", "ordering_index", "overlap_fraction", "depth_order_accuracy"),
         ("tests/scenegen/evaluation",),
     ),
+    "stats": Module(
+        "scenegen/lab/experiments/stats.py",
+        ("norm_sf", "norm_ppf", "wilson", "newcombe_diff", "newcombe_paired_diff",
+         "two_proportion_z", "mcnemar_exact", "binomial_greater", "chi2_sf",
+         "chi2_homogeneity", "cochran_q", "bootstrap_clustered_diff", "_rng",
+         "bootstrap_mean", "bootstrap_paired_diff", "verdict"),
+        ("tests/scenegen/lab/test_stats.py",),
+    ),
+    "summary": Module(
+        "scenegen/lab/experiments/summary.py",
+        ("drop_first_frame", "_arr", "_state", "succeeded", "_recovered", "_run_mean", "_rate",
+         "_mean", "_val", "_group", "_case", "_target_index", "_compare", "_claim",
+         "_paired_table", "_paired_rates", "_mcnemar_claim", "_scene_claim",
+         "_orderings_claim", "_boot_claim", "_object_stats", "_pool_rate", "_dps_synthetic",
+         "_other_mean", "_dps_real", "_pooled_ps_claims", "_error", "_kams_fails",
+         "_kams_accuracy", "_kams_robustness", "_shm_run", "_shm_depth", "summarize"),
+        ("tests/scenegen/lab/test_summary_oracle.py",
+         "tests/scenegen/lab/test_experiments.py::test_dps_limitation_pools_the_orderings_"
+         "the_paper_puts_above_dps",
+         "tests/scenegen/lab/test_experiments.py::test_mcnemar_claims_carry_the_paired_interval",
+         "tests/scenegen/lab/test_experiments.py::test_clustered_claims_count_scenes_not_runs"),
+    ),
 }
 
 # One replacement per operator site (cosmic-ray's operator names).

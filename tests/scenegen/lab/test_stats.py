@@ -1,5 +1,6 @@
 """The experiments' statistics against reference values computed by hand or printed in
-standard tables (Wilson 1927; Newcombe 1998; χ² critical values)."""
+standard tables (Wilson 1927; Newcombe 1998; χ² critical values), and against
+``scipy.stats`` over drawn counts."""
 
 from __future__ import annotations
 
@@ -7,6 +8,9 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+from scipy import stats as sps
 
 from scenegen.lab.experiments import stats
 
@@ -162,3 +166,167 @@ def test_a_resampling_test_needs_enough_cases_to_reproduce():
     assert stats.verdict(0.001, (5.0, 20.0), 10.0, 10, min_n=10) == "reproduced"
     _, _, t = stats.bootstrap_paired_diff([1.0, 2.0], [0.0, 0.0], 0)
     assert t.min_n == stats.MIN_RUNS and stats.mcnemar_exact(5, 0).min_n == 0
+
+
+# ---------------------------------------------------------------------------------------
+# Against scipy.stats, over drawn counts (scipy is the oracle; the module does not use it)
+
+counts = st.integers(1, 400).flatmap(lambda n: st.tuples(st.integers(0, n), st.just(n)))
+
+
+@given(counts)
+def test_wilson_is_scipys_wilson_interval(kn):
+    k, n = kn
+    ci = sps.binomtest(k, n).proportion_ci(0.95, method="wilson")
+    assert stats.wilson(k, n) == pytest.approx((ci.low, ci.high), abs=1e-9)
+    ci = sps.binomtest(k, n).proportion_ci(0.8, method="wilson")
+    assert stats.wilson(k, n, 0.8) == pytest.approx((ci.low, ci.high), abs=1e-9)
+
+
+@given(st.integers(0, 60), st.integers(0, 60))
+def test_exact_mcnemar_is_scipys_one_sided_binomial_test(n_sf, n_fs):
+    p = (sps.binomtest(n_sf, n_sf + n_fs, 0.5, alternative="greater").pvalue
+         if n_sf + n_fs else 1.0)
+    assert stats.mcnemar_exact(n_sf, n_fs).p_value == pytest.approx(p, rel=1e-9, abs=1e-300)
+
+
+@given(counts, st.floats(0.05, 0.95))
+def test_binomial_greater_is_scipys(kn, p0):
+    k, n = kn
+    p = sps.binomtest(k, n, p0, alternative="greater").pvalue
+    assert stats.binomial_greater(k, n, p0).p_value == pytest.approx(p, rel=1e-7, abs=1e-12)
+
+
+@given(st.floats(0.0, 80.0), st.integers(1, 12))
+def test_chi2_tail_is_scipys(x, df):
+    assert stats.chi2_sf(x, df) == pytest.approx(sps.chi2.sf(x, df), rel=1e-9, abs=1e-15)
+
+
+@given(st.lists(st.integers(1, 80).flatmap(lambda n: st.tuples(st.integers(0, n), st.just(n))),
+                min_size=2, max_size=7))
+def test_chi2_homogeneity_is_scipys_uncorrected_contingency_test(rates):
+    s = [k for k, _ in rates]
+    n = [m for _, m in rates]
+    t = stats.chi2_homogeneity(s, n)
+    if sum(s) in (0, sum(n)):
+        assert (t.statistic, t.p_value) == (0.0, 1.0)
+        return
+    chi2, p, dof, _ = sps.chi2_contingency(np.array([s, [m - k for k, m in rates]]).T,
+                                           correction=False)
+    assert t.statistic == pytest.approx(chi2, rel=1e-9, abs=1e-12)
+    assert t.p_value == pytest.approx(p, rel=1e-7, abs=1e-15)
+    assert f"df {dof}" in t.name
+
+
+@given(st.floats(-8.0, 8.0), st.floats(1e-6, 1 - 1e-6))
+def test_normal_tail_and_quantile_are_scipys(z, q):
+    assert stats.norm_sf(z) == pytest.approx(sps.norm.sf(z), rel=1e-9, abs=1e-300)
+    assert stats.norm_ppf(q) == pytest.approx(sps.norm.ppf(q), abs=1e-9)
+
+
+@given(counts, counts)
+def test_two_proportion_z_is_the_pooled_score_statistic(a, b):
+    (k1, n1), (k2, n2) = a, b
+    p = (k1 + k2) / (n1 + n2)
+    se = math.sqrt(p * (1 - p) * (1 / n1 + 1 / n2))
+    t = stats.two_proportion_z(k1, n1, k2, n2)
+    if se == 0:
+        assert t.p_value == 0.5 and t.statistic == 0.0
+        return
+    z = (k1 / n1 - k2 / n2) / se
+    assert t.statistic == pytest.approx(z) and t.p_value == pytest.approx(sps.norm.sf(z))
+
+
+@given(st.lists(st.tuples(*[st.booleans()] * 4), min_size=1, max_size=60))
+def test_cochran_q_is_the_textbook_form_and_scipys_tail(rows):
+    x = np.array(rows, dtype=float)
+    k = x.shape[1]
+    c, r = x.sum(axis=0), x.sum(axis=1)
+    den = float(np.sum(r * (k - r)))
+    t = stats.cochran_q(x)
+    if den == 0:
+        assert (t.statistic, t.p_value) == (0.0, 1.0)
+        return
+    q = k * (k - 1) * float(np.sum((c - c.mean()) ** 2)) / den
+    assert t.statistic == pytest.approx(q, abs=1e-9)
+    assert t.p_value == pytest.approx(sps.chi2.sf(q, k - 1), rel=1e-9, abs=1e-15)
+
+
+def test_bootstrap_without_pairs_and_the_verdicts_boundaries():
+    m, (lo, hi), t = stats.bootstrap_paired_diff([np.nan], [1.0], 0)
+    assert math.isnan(m) and math.isnan(lo) and math.isnan(hi) and t.p_value == 1.0
+    # p exactly alpha is not significant; an interval reaching delta does not rule it out
+    assert stats.verdict(stats.ALPHA, (-1.0, 1.0), 2.0, 50) == "not reproduced"
+    assert stats.verdict(stats.ALPHA, (-1.0, 2.0), 2.0, 50) == "inconclusive"
+    assert stats.verdict(0.5, (-1.0, float("nan")), 2.0, 50) == "inconclusive"
+    assert stats.verdict(0.5, (-1.0, 1.0), 2.0, stats.MIN_RUNS) == "not reproduced"
+    assert stats.verdict(0.5, (-1.0, 1.0), 2.0, stats.MIN_RUNS - 1) == "inconclusive"
+
+
+def test_percentile_bootstrap_level_and_draws():
+    # 95 %: about mean ± 1.96 s / sqrt(n) for a large normal sample; 80 %: ± 1.28
+    v = np.random.default_rng(8).normal(10.0, 2.0, 400)
+    se = v.std() / math.sqrt(v.size)
+    for level, z in ((0.95, 1.959964), (0.8, 1.281552)):
+        lo, hi = stats.bootstrap_mean(v, 1, level=level)
+        assert (hi - lo) / 2 == pytest.approx(z * se, rel=0.08)
+        assert (lo + hi) / 2 == pytest.approx(v.mean(), abs=0.15 * se)
+        m, (plo, phi_), _ = stats.bootstrap_paired_diff(v, np.zeros_like(v), 1, level=level)
+        assert (phi_ - plo) / 2 == pytest.approx(z * se, rel=0.08) and plo < m < phi_
+    # Every case is drawn with probability 1/n: one 1 among 19 zeros, first or last. A
+    # resampled mean is 0 with probability (19/20)^20 = 0.358, and 3/20 is the 97.5 %
+    # quantile of Binomial(20, 1/20) / 20.
+    for d in (np.r_[1.0, np.zeros(19)], np.r_[np.zeros(19), 1.0]):
+        _, _, t = stats.bootstrap_paired_diff(d, np.zeros(20), 2)
+        assert t.p_value == pytest.approx(0.95**20, abs=0.035)
+        assert stats.bootstrap_mean(d, 2) == (0.0, 0.15)
+    assert stats.bootstrap_mean([3.0], 0) == (3.0, 3.0)
+    assert all(math.isnan(x) for x in stats.bootstrap_mean([], 0))
+    assert all(math.isnan(x) for x in stats.bootstrap_mean([np.nan], 0))
+
+
+def test_the_edges_of_the_closed_forms():
+    assert stats.chi2_sf(-0.5, 1) == 1.0 and stats.chi2_sf(-0.5, 2) == 1.0
+    with pytest.raises(ValueError, match="df must be >= 1"):
+        stats.chi2_sf(1.0, 0)
+    for q in (0.0, 1.0, -0.5, 1.5):
+        with pytest.raises(ValueError, match="q must be in"):
+            stats.norm_ppf(q)
+    with pytest.raises(ValueError, match="0 <= k <= n"):
+        stats.wilson(-1, 3)
+    # all successes or all failures: no difference to test
+    for s in ([5, 7], [0, 0]):
+        t = stats.chi2_homogeneity(s, [5, 7])
+        assert (t.statistic, t.p_value) == (0.0, 1.0)
+    with pytest.raises(ValueError, match="two rates"):
+        stats.chi2_homogeneity([3], [5])
+    # one discordant case between two methods: McNemar's χ² (1 − 0)² / 1
+    assert stats.cochran_q([[1, 0]]).statistic == pytest.approx(1.0)
+    assert stats.cochran_q([[0, 1], [1, 1]]).statistic == pytest.approx(1.0)
+
+
+def test_newcombe_paired_interval_and_the_correlation_of_the_outcomes():
+    def independent(n_ss, n_sf, n_fs, n_ff):
+        n = n_ss + n_sf + n_fs + n_ff
+        return stats.newcombe_diff(n_ss + n_sf, n, n_ss + n_fs, n)
+
+    def with_phi(n_ss, n_sf, n_fs, n_ff, phi):
+        n = n_ss + n_sf + n_fs + n_ff
+        ka, kb = n_ss + n_sf, n_ss + n_fs
+        (l1, u1), (l2, u2) = stats.wilson(ka, n), stats.wilson(kb, n)
+        p1, p2 = ka / n, kb / n
+        dl1, du1, dl2, du2 = p1 - l1, u1 - p1, p2 - l2, u2 - p2
+        return (p1 - p2 - math.sqrt(dl1**2 + du2**2 - 2 * phi * dl1 * du2),
+                p1 - p2 + math.sqrt(dl2**2 + du1**2 - 2 * phi * dl2 * du1))
+
+    # cross-product n_ss n_ff − n_sf n_fs within [0, n/2]: φ = 0 (7 cases, cross 3)
+    assert stats.newcombe_paired_diff(4, 1, 1, 1) == pytest.approx(independent(4, 1, 1, 1))
+    # above n/2 (5 cases, cross 3): φ = (3 − 2.5) / √(4·1·3·2)
+    assert stats.newcombe_paired_diff(3, 1, 0, 1) == pytest.approx(
+        with_phi(3, 1, 0, 1, 0.5 / math.sqrt(24)))
+    # below 0: the plain correlation, φ = −80 / √(10⁴) = −0.8 and φ = −1
+    assert stats.newcombe_paired_diff(1, 9, 9, 1) == pytest.approx(
+        with_phi(1, 9, 9, 1, -0.8))
+    assert stats.newcombe_paired_diff(0, 1, 1, 0) == pytest.approx(with_phi(0, 1, 1, 0, -1.0))
+    # one case is a case
+    assert all(math.isfinite(x) for x in stats.newcombe_paired_diff(1, 0, 0, 0))
