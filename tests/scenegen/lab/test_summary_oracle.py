@@ -829,6 +829,14 @@ def test_a_sweep_over_some_methods_judges_what_it_ran(occlusion, synthetic):
         assert any("recovery of DPS above" in c for c in claims) is ("dps" in slugs)
         assert any("above Non-PS's" in c and "recovery" in c for c in claims) is \
             ("nonps" in slugs)
+        # each method that ran has its columns beside the paper's, whichever did not
+        shown = {c["what"].split(" objects")[0].split(" object 1")[0].split(" ", 3)[3]
+                 for c in res["comparisons"] if c["what"].startswith(("Table 1 λ=20 ",
+                                                                      "Table 2 λ=20 "))}
+        want = {"Non-PS"} if "nonps" in slugs else set()
+        want |= {"DPS"} if "dps" in slugs else set()
+        want |= {"PS", "PS mean", "PS worst"}
+        assert shown == want, shown
 
 
 def test_kams_accuracy_of_kams_alone(kams):
