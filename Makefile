@@ -31,7 +31,7 @@ bench: $(STAMP)
 
 # Mutation score of the formula modules (cosmic-ray; long, not part of `make test`).
 # MODULES: a subset (resampling particle meanshift annealed shm kalman metrics stats
-# summary);
+# runner summary);
 # SAMPLE: mutants per module (0: all). Results in build/mutate/<module>.txt.
 MODULES ?=
 SAMPLE ?= 60

@@ -47,6 +47,7 @@ __all__ = [
     "depth_order_accuracy",
     "ordering_index",
     "overlap_fraction",
+    "overlapping_pairs",
     "otb_curves",
     "precision_recall",
     "recovery_rate",
@@ -623,6 +624,31 @@ def overlap_fraction(a: ArrayLike, b: ArrayLike) -> FloatArray:
         return np.where(small > 0, inter / np.where(small > 0, small, 1.0), 0.0)
 
 
+def overlapping_pairs(boxes: ArrayLike, *, min_overlap: float = 0.1) -> NDArray[np.bool_]:
+    """Which pairs of distinct targets overlap, per frame: the depth-order criterion.
+
+    (open) Two boxes "overlap" when their intersection covers at least ``min_overlap`` of
+    the smaller box's area: a grazing contact of a few pixels says nothing about depth.
+
+    Parameters
+    ----------
+    boxes : array_like of shape (T, M, 4)
+        Boxes of the targets (NaN where absent: an absent box overlaps nothing).
+    min_overlap : float
+        Smallest intersection / smaller-box area that counts, in (0, 1].
+
+    Returns
+    -------
+    ndarray of bool, shape (T, M, M)
+        Symmetric, False on the diagonal.
+    """
+    if not 0.0 < min_overlap <= 1.0:
+        raise ValueError(f"min_overlap must be in (0, 1], got {min_overlap}")
+    b = _boxes(boxes)
+    over = overlap_fraction(b[:, :, None, :], b[:, None, :, :])
+    return (over >= min_overlap) & ~np.eye(b.shape[1], dtype=bool)
+
+
 def depth_order_accuracy(
     order_prob: ArrayLike,
     orderings: ArrayLike,
@@ -636,10 +662,9 @@ def depth_order_accuracy(
     Depth order is only observable where targets overlap (SHM §5: non-overlapping objects
     give identical measurements under every ordering), so the score counts, over frames
     and unordered target pairs whose ground-truth boxes overlap, how often the most
-    probable ordering puts the pair in the true front/back order. (open) "Overlap" means
-    the intersection covers at least ``min_overlap`` of the smaller box: a grazing contact
-    of a few pixels says nothing about depth. Frames whose probabilities are NaN (frame 0)
-    are skipped.
+    probable ordering puts the pair in the true front/back order. "Overlap" is
+    :func:`overlapping_pairs` (at least ``min_overlap`` of the smaller box). Frames whose
+    probabilities are NaN (frame 0) are skipped.
 
     Parameters
     ----------
@@ -670,9 +695,7 @@ def depth_order_accuracy(
             f"boxes {b.shape}"
         )
     rank = np.argsort(o, axis=1)  # rank[l, m]: position of target m in ordering l
-    if not 0.0 < min_overlap <= 1.0:
-        raise ValueError(f"min_overlap must be in (0, 1], got {min_overlap}")
-    over = overlap_fraction(b[:, :, None, :], b[:, None, :, :])
+    pairs = overlapping_pairs(b, min_overlap=min_overlap)
     right = total = 0
     for t in range(t_n):
         if not np.all(np.isfinite(p[t])):
@@ -680,7 +703,7 @@ def depth_order_accuracy(
         best = rank[int(np.argmax(p[t]))]
         for i in range(m_n):
             for j in range(i + 1, m_n):
-                if over[t, i, j] >= min_overlap and d[t, i] != d[t, j]:
+                if pairs[t, i, j] and d[t, i] != d[t, j]:
                     total += 1
                     right += int((best[i] < best[j]) == (d[t, i] < d[t, j]))
     return 100.0 * right / total if total else float("nan")

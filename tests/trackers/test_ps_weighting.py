@@ -100,7 +100,7 @@ def test_estimate_is_the_weighted_mean_box_of_each_of_many_objects(name):
         np.testing.assert_allclose(est.boxes, want, atol=1e-9)
 
 
-@pytest.mark.parametrize("name", ["ps", "dps"])
+@pytest.mark.parametrize("name", ["ps", "dps", "joint-pf"])
 def test_the_hook_gets_each_moved_objects_own_state(name):
     # Without noise and at rest, AR2 leaves every state where it is: the hook's "before"
     # must be the moved object's own state, equal to "after" row for row.

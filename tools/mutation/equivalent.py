@@ -25,6 +25,16 @@ EQUIVALENT["particle"] = [  # noqa: F821
     ("self._sizes_c = np.array([n // c + (i < n % c) for i in range(c)], dtype=np.int64)",
      "self._sizes_c = np.array([n / c + (i < n % c) for i in range(c)], dtype=np.int64)",
      "the int64 cast truncates the positive n / c + 0 or 1 to n // c + 0 or 1"),
+    # Round 15, every mutant of the module:
+    ("ll = obs.log_likelihoods(self._boxes(new.reshape(-1, 3), objects), objects)",
+     "ll = obs.log_likelihoods(self._boxes(new.reshape(- 2, 3), objects), objects)",
+     "numpy reads any negative size in reshape as the one unknown dimension"),
+    ("sizes: NDArray[np.int64], log_prior: NDArray[np.float64] | None = None,",
+     "sizes: NDArray[np.int64], log_prior: NDArray[np.float64] & None = None,",
+     "an annotation: never evaluated (from __future__ import annotations)"),
+    ("break", "continue",
+     "the module's only break ends the stage loop at its last pass (j == m - 1): "
+     "continue ends it too"),
 ]
 EQUIVALENT["resampling"] += [  # noqa: F821
     ("sizes = _check_sizes(sizes, w.shape[0] if w.ndim == 1 else -1)",
@@ -32,6 +42,15 @@ EQUIVALENT["resampling"] += [  # noqa: F821
      "-1 is only a size no group list can sum to; -2 is one too"),
     ("resid[np.repeat(totals <= 0, sizes)] = 1.0", "resid[np.repeat(totals <= 0, sizes)] = 2.0",
      "dummy mass of a group that receives no draw: any positive value"),
+    # Round 15, every mutant of the module:
+    ("sizes: NDArray[np.integer] | None = None,", "sizes: NDArray[np.integer] & None = None,",
+     "an annotation: never evaluated (from __future__ import annotations)"),
+    *[("if (isinstance(weights, np.ndarray) and weights.dtype == np.float64 and weights.ndim == 1",
+       f"if (isinstance(weights, np.ndarray) and weights.dtype {dt} np.float64 and weights.ndim {nd}",
+       "only chooses which of the two normalisations runs, the compiled one or numpy's; "
+       "they give the same bits for every input form (test_resampling.py::"
+       "test_every_input_form_is_normalised_per_group_as_the_compiled_path)")
+      for dt, nd in (("==", "!= 1"), ("==", "== 0"), ("==", "== 2"), ("!=", "== 1"))],
 ]
 
 EQUIVALENT["shm"] = [  # noqa: F821
@@ -344,4 +363,35 @@ EQUIVALENT["summary"] = [  # noqa: F821
     ('if m.slug == "kams" or m.slug not in by_method or not ref:',
      'if m.slug == "kams" or m.slug not in by_method and not ref:',
      "KAMS's runs are always there (ref), and every other method ran"),
+]
+
+# The runs an experiment plans and what each run records (round 15).
+EQUIVALENT["runner"] = [  # noqa: F821
+    *[(f"{arg}: {ann} | None = None,", f"{arg}: {ann} & None = None,",
+       "an annotation: never evaluated (from __future__ import annotations)")
+      for arg, ann in (("scenes", "int"), ("methods", "Iterable[str]"),
+                       ("values", "Iterable[float]"), ("overrides", "dict[str, Any]"))],
+    ("state: list[int | None] = [", "state: list[int & None] = [",
+     "a local variable's annotation: never evaluated"),
+    ('int(s) if p else None for s, p in zip(fm["state"][:, m], present[:, m], strict=True)',
+     'int(s) if p else None for s, p in zip(fm["state"][:, m], present[:, m], strict=False)',
+     "both columns come from the same (T, M) ground truth: their lengths are equal"),
+    ("done = run(seq, method.tracker, params, task.tracker_seed(), single_thread=True)",
+     "done = run(seq, method.tracker, params, task.tracker_seed(), single_thread=False)",
+     "the kernels give the same bits on any thread count (tests/trackers/models/"
+     "test_box_kernel.py::test_results_do_not_depend_on_the_thread_count); "
+     "one thread per worker is for speed on a shared machine"),
+    ("return int(np.random.SeedSequence(words).generate_state(1, dtype=np.uint64)[0] >> 1)",
+     "return int(np.random.SeedSequence(words).generate_state( 2, dtype=np.uint64)[0] >> 1)",
+     "SeedSequence.generate_state(n) is a prefix of the same stream: its first word "
+     "does not depend on n"),
+    ("return int(np.random.SeedSequence(words).generate_state(1, dtype=np.uint64)[0] >> 1)",
+     "return int(np.random.SeedSequence(words).generate_state(1, dtype=np.uint64)[ -1] >> 1)",
+     "the state has one word: [-1] is [0]"),
+    ("ed, components=ed.ndim == 3", "ed, components=ed.ndim == 4",
+     "every tracker of the experiments reports effective dynamics of shape (T, K), "
+     "never (T, K, C) or (T, K, C, D): both tests are False"),
+    ('if "order_prob" in extras and orderings is not None:',
+     'if "order_prob" in extras or orderings is not None:',
+     "only the SHM trackers have orderings, and every one of them reports order_prob"),
 ]

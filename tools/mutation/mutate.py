@@ -131,6 +131,15 @@ MODULES: dict[str, Module] = {
          "bootstrap_mean", "bootstrap_paired_diff", "verdict"),
         ("tests/scenegen/lab/test_stats.py",),
     ),
+    "runner": Module(
+        "scenegen/lab/experiments/runner.py",
+        ("derive_seed", "scene_seed", "Task.__post_init__", "Task.sweep_label", "Task.case",
+         "Task.scene_seed", "Task.tracker_seed", "Task.filename", "Task.key", "plan_tasks",
+         "_frozen", "_round", "tracker_params", "run_task"),
+        ("tests/scenegen/lab/test_run_records.py",
+         "tests/scenegen/lab/test_experiments.py::test_seed_derivation_is_stable",
+         "tests/scenegen/lab/test_param_overrides.py"),
+    ),
     "summary": Module(
         "scenegen/lab/experiments/summary.py",
         ("drop_first_frame", "_arr", "_state", "succeeded", "_recovered", "_run_mean", "_rate",

@@ -378,9 +378,8 @@ def run_task(task: Task) -> dict[str, Any]:
             np.asarray(extras["order_prob"])[1:], orderings, depth[1:], gt[1:],
             min_overlap=_MIN_OVERLAP,
         )
-        over = metrics.overlap_fraction(gt[:, :, None, :], gt[:, None, :, :])
-        off_diagonal = ~np.eye(len(idx), dtype=bool)
-        record["overlap"] = np.any((over >= _MIN_OVERLAP) & off_diagonal, axis=(1, 2))
+        pairs = metrics.overlapping_pairs(gt, min_overlap=_MIN_OVERLAP)
+        record["overlap"] = np.any(pairs, axis=(1, 2))
     return _round(record)
 
 

@@ -71,3 +71,21 @@ def test_depth_order_counts_a_pair_overlapping_exactly_min_overlap():
     prob = np.array([[0.9, 0.1]])
     assert depth_order_accuracy(prob, orderings, depth, boxes, min_overlap=0.5) == 100.0
     assert np.isnan(depth_order_accuracy(prob, orderings, depth, boxes, min_overlap=0.6))
+
+
+def test_overlapping_pairs_counts_exactly_min_overlap_and_no_absent_box():
+    from scenegen.evaluation.metrics import overlapping_pairs
+
+    # Frame 0: a 10x10 box and a 20x20 box covering 5x10 of it (half the smaller box);
+    # frame 1: the second box absent.
+    boxes = np.array([[[0.0, 0.0, 10.0, 10.0], [5.0, 0.0, 20.0, 20.0], [50.0, 50, 5, 5]],
+                      [[0.0, 0.0, 10.0, 10.0], [np.nan] * 4, [50.0, 50, 5, 5]]])
+    pairs = overlapping_pairs(boxes, min_overlap=0.5)
+    want = np.zeros((2, 3, 3), dtype=bool)
+    want[0, 0, 1] = want[0, 1, 0] = True
+    np.testing.assert_array_equal(pairs, want)
+    assert not overlapping_pairs(boxes, min_overlap=0.51).any()
+    # A box overlaps itself fully, yet is not a pair.
+    assert not overlapping_pairs(boxes[:, :1], min_overlap=1.0).any()
+    with pytest.raises(ValueError, match="min_overlap"):
+        overlapping_pairs(boxes, min_overlap=0.0)

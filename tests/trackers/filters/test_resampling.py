@@ -117,3 +117,36 @@ def test_same_seed_same_draw():
 def test_bad_input_raises(call, match):
     with pytest.raises(ValueError, match=match):
         call(np.random.default_rng(0))
+
+
+# Inputs that are not float64, 1-d and C-contiguous are normalised by numpy instead of
+# the compiled kernel: both paths must give the same bits, and the definition.
+INPUT_FORMS = {
+    "float32": lambda w: w.astype(np.float32),
+    "strided": lambda w: np.repeat(w, 2)[::2],
+    "list": lambda w: w.tolist(),
+}
+
+
+@pytest.mark.parametrize("form", sorted(INPUT_FORMS))
+def test_every_input_form_is_normalised_per_group_as_the_compiled_path(form):
+    from trackers.filters.resampling import _normalise_groups
+
+    sizes = np.array([3, 5, 4])
+    w = np.random.default_rng(3).random(12) * 0.1  # group sums below 1: the division shows
+    given_ = INPUT_FORMS[form](w)
+    plain = np.ascontiguousarray(given_, dtype=np.float64)
+    starts = np.cumsum(sizes) - sizes
+    want = np.concatenate([plain[s:s + n] / plain[s:s + n].sum()
+                           for s, n in zip(starts, sizes, strict=True)])
+    compiled = _normalise_groups(plain, sizes, "weights")
+    np.testing.assert_allclose(compiled, want, rtol=1e-15)
+    np.testing.assert_array_equal(_normalise_groups(given_, sizes, "weights"), compiled)
+    for method in RESAMPLERS:
+        np.testing.assert_array_equal(
+            resample_groups(given_, sizes, method=method, rng=np.random.default_rng(4)),
+            resample_groups(plain, sizes, method=method, rng=np.random.default_rng(4)))
+    zero = np.array(plain)
+    zero[3:8] = 0.0
+    with pytest.raises(ValueError, match=r"positive sum in every group.*0\.0"):
+        _normalise_groups(INPUT_FORMS[form](zero), sizes, "weights")
