@@ -55,7 +55,8 @@ into one measurement per object, ``ŷ_m = Σ_j P(j) y^{j,m}`` with covariance
 ``r_floor`` give the paper's zero-noise limit), fed to one Kalman filter per object; no
 collapsing stage. Approximations (chosen here): the mixture's cross-object covariance is
 dropped, and an object whose measurement is missing under orderings of total probability
-≥ 1/2 is a missed measurement; otherwise the orderings where it was measured are used.
+> 1/2 is a missed measurement; otherwise (measured under at least half, a tie included)
+the orderings where it was measured are used.
 
 Cost: ``L`` orderings need up to ``M L`` template searches per frame (``M`` when no objects
 are close) and the Gaussian-sum filter ``M L²`` Kalman updates of dimension ``4 M``; more

@@ -179,7 +179,7 @@ def test_fast_shm_update_is_the_kalman_update_with_the_moment_matched_measuremen
     # orderings moment-matched: y = sum_j P_j y^j, R = sum_j P_j (R^j + (y^j - y)(y^j - y)'),
     # fed to the object's Kalman filter; on frame 2 the evidence scale is the moving
     # average of frame 1's. (Here both orderings find the same centres, so the spread
-    # term (y^j - y)(y^j - y)' is zero: a sign error in it is not caught; see README.)
+    # term (y^j - y)(y^j - y)' is zero; test_shm_scripted.py sets centres that differ.)
     xs = np.array([[46.0, 70.0], [58.0, 70.0], [59.0, 70.0]])
     ys = np.array([[30.0, 34.0], [30.0, 34.0], [30.0, 34.0]])
     frames, boxes0 = scene(5, xs, ys)

@@ -133,6 +133,26 @@ EQUIVALENT["shm"] += [  # noqa: F821
     ("np.zeros((boxes.shape[0], m.dim)), m.P0, m.F, m.Q, m.H, np.eye(2) * self.params.r_floor",
      "np.zeros((boxes.shape[0], m.dim)), m.P0, m.F, m.Q, m.H, np.eye(2) / self.params.r_floor",
      "the filter's default R is never used: every update passes its own R"),
+    # Round 15, every mutant of the module:
+    ("self.joint.H, np.eye(2 * n_obj) * self.params.r_floor,",
+     "self.joint.H, np.eye(2 * n_obj) / self.params.r_floor,",
+     "the filter's default R is never used: every update passes its own R"),
+    ("q = q / np.where(mass > 0, mass, 1.0)", "q = q / np.where(mass > 0, mass, 2.0)",
+     "where mass = 0 every q of the object is 0: any positive divisor gives 0"),
+    ("q = q / np.where(mass > 0, mass, 1.0)", "q = q / np.where(mass >= 0, mass, 1.0)",
+     "mass = 0 only for an object missed under every ordering: it is not seen, its y is "
+     "set to NaN and the Kalman update skips it, whatever its (then NaN) R"),
+    ("+ np.log(np.maximum(self.order_prob, 1e-300))[ii]",
+     "+ np.log(np.maximum(self.order_prob, -1.0))[ii]",
+     "differs only for an ordering whose probability underflowed to exactly 0: both "
+     "keep it at 0 unless the evidence favours it by more than e^690"),
+    ("self.log_pi = np.log(np.maximum(self.pi, 1e-300))",
+     "self.log_pi = np.log(np.maximum(self.pi, -1.0))",
+     "Π has zeros only off the diagonal at p_stay = 1; every column keeps its diagonal "
+     "log 1 = 0, next to which e^-690 vanishes in double precision as exp(-inf) does"),
+    ("q = q / np.where(mass > 0, mass, 1.0)", "q = q / np.where(mass > -1, mass, 1.0)",
+     "mass = 0 only for an object missed under every ordering: it is not seen, its y is "
+     "set to NaN and the Kalman update skips it, whatever its (then NaN) R"),
 ]
 
 # The statistics of the experiments' claims. Annotations are never evaluated (``from

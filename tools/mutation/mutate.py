@@ -63,6 +63,12 @@ class Module:
     env: dict[str, str] = field(default_factory=dict)
 
 
+_MEAN_SHIFT_TESTS = (
+    "tests/trackers/test_meanshift_trackers.py", "tests/trackers/test_kams.py",
+    "tests/trackers/test_oracle_meanshift.py", "tests/trackers/test_meanshift_scenes.py",
+    "tests/trackers/test_equivalences.py",
+)
+
 MODULES: dict[str, Module] = {
     "resampling": Module(
         "trackers/filters/resampling.py",
@@ -94,6 +100,16 @@ MODULES: dict[str, Module] = {
         # bounds checks make a mutant that shrinks a buffer fail instead of corrupting.
         {"NUMBA_BOUNDSCHECK": "1"},
     ),
+    # The KAMS paper's trackers around the kernels: per-object sets of windows, the mean
+    # shift tracker, SOK's eight extra starts, the hybrid filter and KAMS's move step.
+    **{key: Module(path, scope, _MEAN_SHIFT_TESTS) for key, path, scope in (
+        ("ms-trackers", "trackers/meanshift.py",
+         ("window_boxes", "set_log_likelihoods", "set_distances", "set_mean_shift",
+          "keep_inside", "MeanShiftTracker._init", "MeanShiftTracker._step")),
+        ("sok", "trackers/sok.py", ("SOK._init", "SOK._step")),
+        ("hybrid", "trackers/hybrid.py", ("HybridPF._init", "HybridPF._step")),
+        ("kams", "trackers/kams.py", ("KAMS._move",)),
+    )},
     "annealed": Module(
         "trackers/annealed.py",
         ("survival_rate", "survival_beta", "_bracket",
@@ -106,7 +122,8 @@ MODULES: dict[str, Module] = {
         ("transition_matrix", "_OrderingEvidence.__init__",
          "_OrderingEvidence.log_evidence", "_SHMBase._init_common", "SHMTracker._init",
          "SHMTracker._step", "FastSHMTracker._init", "FastSHMTracker._step"),
-        ("tests/trackers/test_oracle_shm.py", "tests/trackers/test_shm.py"),
+        ("tests/trackers/test_oracle_shm.py", "tests/trackers/test_shm.py",
+         "tests/trackers/test_shm_scripted.py"),
     ),
     "kalman": Module(
         "trackers/filters/kalman.py",
