@@ -36,7 +36,9 @@ def test_follows_a_slow_disc_on_white(name):
     result = trackers.track(trackers.make(name, rng=1), frames, box_at(path[0]))
     centres = result.boxes[:, 0, :2] + 12.0
     assert np.max(np.hypot(*(centres - path).T)) < 2.0
+    # Confidence is 1 - the Bhattacharyya distance of the estimated window: in [0, 1].
     assert np.all(result.extras["confidence"][1:] > 0.8)
+    assert np.all(result.extras["confidence"][1:] <= 1.0)
 
 
 @pytest.mark.parametrize("name", FAMILY)
@@ -49,6 +51,41 @@ def test_target_leaving_the_frame_keeps_estimates_inside(name):
     assert np.all(np.isfinite(result.boxes))
     assert np.all((centres >= 0) & (centres <= [120, 90]))
     assert np.all(np.isfinite(result.extras["confidence"][1:]))
+
+
+def rectangle(x, y, w=36, h=14, shape=(90, 120)):
+    """A frame with a four-colour w x h rectangle at top-left (x, y) on white."""
+    frame = np.full((*shape, 3), 255, dtype=np.uint8)
+    for q, colour in enumerate(COLOURS):
+        qx, qy = x + (q % 2) * w // 2, y + (q // 2) * h // 2
+        frame[qy:qy + h // 2, qx:qx + w // 2] = colour
+    return frame
+
+
+@pytest.mark.parametrize("name, params", [
+    ("meanshift", {}), ("sok", {}), ("hybrid", {"sigma": 0.0}),
+])
+def test_a_window_that_does_not_move_is_the_box_it_started_from(name, params):
+    # Without mean-shift iterations a window stays where it started: at the centre of a
+    # box that is not square. Its confidence is 1 on the frame it was modelled on, and
+    # between 0 and 1 on a frame where the rectangle moved by 3 px.
+    box = np.array([[40.0, 30.0, 36.0, 14.0]])
+    for frame, moved in ((rectangle(40, 30), False), (rectangle(43, 30), True)):
+        tracker = trackers.make(name, max_iter=0, rng=0, **params)
+        tracker.init(rectangle(40, 30), box)
+        est = tracker.step(frame)
+        np.testing.assert_allclose(est.boxes, box, atol=1e-9)
+        confidence = est.extras["confidence"][0]
+        assert (0.0 < confidence < 0.999) if moved else confidence == pytest.approx(1.0)
+
+
+def test_keep_inside_clips_centres_to_the_frame_in_place():
+    from trackers.meanshift import keep_inside
+
+    centres = np.array([[[-3.0, 5.0], [130.0, -0.5]], [[60.0, 95.0], [0.0, 90.0]]])
+    keep_inside(centres, (90, 120, 3))
+    np.testing.assert_array_equal(
+        centres, [[[0.0, 5.0], [120.0, 0.0]], [[60.0, 90.0], [0.0, 90.0]]])
 
 
 @pytest.mark.parametrize("name", FAMILY)

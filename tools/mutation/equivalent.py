@@ -415,3 +415,28 @@ EQUIVALENT["runner"] = [  # noqa: F821
      'if "order_prob" in extras or orderings is not None:',
      "only the SHM trackers have orderings, and every one of them reports order_prob"),
 ]
+
+# The mean-shift family's trackers around the kernels (round 15, every mutant).
+EQUIVALENT["ms-trackers"] = [  # noqa: F821
+    ('{"confidence": 1.0 - res.distances[:, 0], "n_iter": res.n_iter[:, 0]})',
+     '{"confidence": 1.0 - res.distances[:, 0], "n_iter": res.n_iter[:, -1]})',
+     "the tracker's set has one start per object: column -1 is column 0"),
+    ('{"confidence": 1.0 - res.distances[:, 0], "n_iter": res.n_iter[:, 0]})',
+     '{"confidence": 1.0 - res.distances[:, -1], "n_iter": res.n_iter[:, 0]})',
+     "the tracker's set has one start per object: column -1 is column 0"),
+    ("return Estimate(window_boxes(self.centres[:, None, :], self.sizes)[:, 0],",
+     "return Estimate(window_boxes(self.centres[:, None, :], self.sizes)[:, -1],",
+     "one window per object: column -1 is column 0"),
+    ("self.centres = boxes[:, :2] + 0.5 * boxes[:, 2:4]",
+     "self.centres = boxes[:, :2] + 0.5 * boxes[:, 2: 5]",
+     "boxes have 4 columns: 2:5 is 2:4"),
+    ("self.sizes = boxes[:, 2:4].copy()", "self.sizes = boxes[:, 2: 5].copy()",
+     "boxes have 4 columns: 2:5 is 2:4"),
+    ("which: NDArray[np.integer] | None = None) -> MeanShiftResult:",
+     "which: NDArray[np.integer] & None = None) -> MeanShiftResult:",
+     "an annotation: never evaluated (from __future__ import annotations)"),
+    ("sizes: NDArray[np.float64], *, max_iter: int, eps: float,",
+     "sizes: NDArray[np.float64], /, max_iter: int, eps: float,",
+     "a signature detail no caller depends on: every caller passes max_iter and eps by "
+     "keyword"),
+]
