@@ -167,3 +167,32 @@ def test_bad_boxes_and_frames_raise_value_error(name):
     tracker.init(frames[0], box_at((40.0, 45.0)))
     with pytest.raises(ValueError, match="shape"):
         tracker.step(frames[1, :50])
+
+
+def test_sok_spawns_below_the_threshold_not_at_it():
+    box = np.array([[40.0, 30.0, 36.0, 14.0]])
+
+    def step(threshold):
+        sok = trackers.make("sok", threshold=threshold, max_iter=0)
+        sok.init(rectangle(40, 30), box)
+        return sok.step(rectangle(42, 30)).extras
+
+    confidence = step(0.0)["confidence"][0]
+    assert 0.0 < confidence < 1.0
+    assert not step(confidence)["spawned"][0]
+    assert step(np.nextafter(confidence, 1.0))["spawned"][0]
+
+
+def test_sok_breaks_a_tie_by_the_candidate_nearest_the_primary_window():
+    # The rectangle has left its window; two exact copies sit where two of the eight
+    # extra windows start (spacing 1: offsets of one box size): one 36 px to the right,
+    # one 36 px left and 14 px up (38.6 px away). Both match perfectly: the nearer wins.
+    box = np.array([[50.0, 40.0, 36.0, 14.0]])
+    frame = rectangle(86, 40, shape=(90, 160))
+    frame[26:40, 14:50] = rectangle(14, 26, shape=(90, 160))[26:40, 14:50]
+    sok = trackers.make("sok", threshold=0.9, max_iter=0, spacing=1.0)
+    sok.init(rectangle(50, 40, shape=(90, 160)), box)
+    est = sok.step(frame)
+    assert est.extras["spawned"][0]
+    assert est.extras["confidence"][0] == pytest.approx(1.0)
+    np.testing.assert_allclose(est.boxes, [[86.0, 40.0, 36.0, 14.0]])

@@ -440,3 +440,29 @@ EQUIVALENT["ms-trackers"] = [  # noqa: F821
      "a signature detail no caller depends on: every caller passes max_iter and eps by "
      "keyword"),
 ]
+_ONE_COLUMN = "the primary tracker is one start per object: column -1 is column 0"
+_FOUR_COLUMNS = "boxes have 4 columns: 2:5 is 2:4"
+EQUIVALENT["sok"] = [  # noqa: F821
+    ("centres = res.centres[:, 0]", "centres = res.centres[:, -1]", _ONE_COLUMN),
+    ("confidence = 1.0 - res.distances[:, 0]", "confidence = 1.0 - res.distances[:, -1]",
+     _ONE_COLUMN),
+    ("return Estimate(window_boxes(centres[:, None, :], self.sizes)[:, 0],",
+     "return Estimate(window_boxes(centres[:, None, :], self.sizes)[:, -1],",
+     "one window per object: column -1 is column 0"),
+    ("self.sizes = boxes[:, 2:4].copy()", "self.sizes = boxes[:, 2: 5].copy()", _FOUR_COLUMNS),
+    ("self.centres = boxes[:, :2] + 0.5 * boxes[:, 2:4]",
+     "self.centres = boxes[:, :2] + 0.5 * boxes[:, 2: 5]", _FOUR_COLUMNS),
+    ("tied = cand_conf >= cand_conf.max(axis=1, keepdims=True) - _TIE",
+     "tied = cand_conf > cand_conf.max(axis=1, keepdims=True) - _TIE",
+     "differs only for a candidate exactly 1e-9 below the best: the tolerance is a "
+     "rounding allowance, not a decision"),
+    *[("gap = np.round(np.hypot(*(cand - centres[low, None, :]).transpose(2, 0, 1)), 6)",
+       f"gap = np.round(np.hypot(*(cand - centres[low, None, :]).transpose(2, 0, 1)), {d})",
+       "the rounding only makes distances that differ by rounding equal; 5 or 7 decimals "
+       "decide differently only for tied candidates within 1e-5 px of the same distance")
+      for d in (5, 7)],
+    ("starts = centres[low, None, :] + grid", "starts = centres[low, None, :] - grid",
+     "the eight offsets are symmetric: -grid is the same starts in another order, which "
+     "could matter only for two candidates equally confident and equally near the "
+     "primary window"),
+]
