@@ -196,3 +196,22 @@ def test_sok_breaks_a_tie_by_the_candidate_nearest_the_primary_window():
     assert est.extras["spawned"][0]
     assert est.extras["confidence"][0] == pytest.approx(1.0)
     np.testing.assert_allclose(est.boxes, [[86.0, 40.0, 36.0, 14.0]])
+
+
+def test_sok_on_two_targets_that_spawn_at_once_is_sok_on_each_alone():
+    shape = (90, 200)
+    boxes = np.array([[20.0, 30.0, 36.0, 14.0], [120.0, 30.0, 36.0, 14.0]])
+    before = np.minimum(rectangle(20, 30, shape=shape), rectangle(120, 30, shape=shape))
+    after = np.minimum(rectangle(24, 31, shape=shape), rectangle(117, 33, shape=shape))
+
+    def step(which):
+        sok = trackers.make("sok", threshold=0.999, max_iter=3)
+        sok.init(before, boxes[which])
+        return sok.step(after)
+
+    both = step([0, 1])
+    assert both.extras["spawned"].all()
+    for m in range(2):
+        alone = step([m])
+        np.testing.assert_array_equal(both.boxes[m], alone.boxes[0])
+        np.testing.assert_array_equal(both.extras["confidence"][m], alone.extras["confidence"][0])
