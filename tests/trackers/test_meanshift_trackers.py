@@ -215,3 +215,18 @@ def test_sok_on_two_targets_that_spawn_at_once_is_sok_on_each_alone():
         alone = step([m])
         np.testing.assert_array_equal(both.boxes[m], alone.boxes[0])
         np.testing.assert_array_equal(both.extras["confidence"][m], alone.extras["confidence"][0])
+
+
+def test_hybrid_particles_move_by_their_velocity_then_climb():
+    # Noise-free and without mean-shift iterations, every particle moves by its own
+    # velocity (x + v) and stays there; the weights start equal.
+    box = np.array([[40.0, 30.0, 36.0, 14.0]])
+    frame = rectangle(40, 30)
+    hybrid = trackers.make("hybrid", n_particles=5, sigma=0.0, max_iter=0, rng=0)
+    hybrid.init(frame, box)
+    np.testing.assert_allclose(hybrid.weights, np.full((5, 1), 0.2))
+    hybrid.velocities[...] = (3.0, -2.0)
+    hybrid.step(frame)
+    np.testing.assert_allclose(hybrid.particles, np.broadcast_to([[[61.0, 35.0]]], (5, 1, 2)))
+    np.testing.assert_allclose(hybrid.velocities, np.broadcast_to([[[3.0, -2.0]]], (5, 1, 2)))
+    np.testing.assert_allclose(hybrid.weights.sum(axis=0), 1.0)

@@ -466,3 +466,15 @@ EQUIVALENT["sok"] = [  # noqa: F821
      "could matter only for two candidates equally confident and equally near the "
      "primary window"),
 ]
+EQUIVALENT["hybrid"] = [  # noqa: F821
+    ("self.sizes = boxes[:, 2:4].copy()", "self.sizes = boxes[:, 2: 5].copy()", _FOUR_COLUMNS),
+    ("centres = boxes[:, :2] + 0.5 * boxes[:, 2:4]",
+     "centres = boxes[:, :2] + 0.5 * boxes[:, 2: 5]", _FOUR_COLUMNS),
+    ('return Estimate(window_boxes(centres, self.sizes)[:, 0], {"confidence": confidence})',
+     'return Estimate(window_boxes(centres, self.sizes)[:, -1], {"confidence": confidence})',
+     "one window per object (the weighted mean): column -1 is column 0"),
+    ("pred = x + v + p.sigma * self.rng.standard_normal(x.shape)",
+     "pred = x + v - p.sigma * self.rng.standard_normal(x.shape)",
+     "the noise is a zero-mean normal draw: its negative has the same law (another "
+     "sample of the same filter, as another seed would give)"),
+]
