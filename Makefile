@@ -30,8 +30,8 @@ bench: $(STAMP)
 	$(BIN)/scenegen bench
 
 # Mutation score of the formula modules (cosmic-ray; long, not part of `make test`).
-# MODULES: a subset (resampling particle meanshift ms-trackers sok hybrid kams annealed
-# shm kalman metrics stats runner summary);
+# MODULES: a subset (resampling particle meanshift ms-trackers sok hybrid annealed shm
+# kalman metrics stats runner summary);
 # SAMPLE: mutants per module (0: all). Results in build/mutate/<module>.txt.
 MODULES ?=
 SAMPLE ?= 60

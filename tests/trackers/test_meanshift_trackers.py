@@ -230,3 +230,24 @@ def test_hybrid_particles_move_by_their_velocity_then_climb():
     np.testing.assert_allclose(hybrid.particles, np.broadcast_to([[[61.0, 35.0]]], (5, 1, 2)))
     np.testing.assert_allclose(hybrid.velocities, np.broadcast_to([[[3.0, -2.0]]], (5, 1, 2)))
     np.testing.assert_allclose(hybrid.weights.sum(axis=0), 1.0)
+
+
+def test_hybrid_weights_are_the_likelihoods_where_the_particles_land():
+    # Without mean-shift iterations the particles land at x + v + σ n (σ = 2 px per axis)
+    # and are weighted by exp(−λ d²) of the Bhattacharyya distance there, per object.
+    from trackers.meanshift import set_distances
+
+    boxes = np.array([[20.0, 30.0, 36.0, 14.0], [70.0, 60.0, 36.0, 14.0]])
+    frame = np.minimum(rectangle(20, 30), rectangle(70, 60))
+    hybrid = trackers.make("hybrid", n_particles=400, sigma=2.0, max_iter=0, lam=20.0, rng=4)
+    hybrid.init(frame, boxes)
+    hybrid.step(frame)
+    moved = hybrid.particles - (boxes[:, :2] + boxes[:, 2:] / 2)  # (N, K, 2)
+    np.testing.assert_allclose(moved.std(axis=0), 2.0, rtol=0.15)
+    np.testing.assert_allclose(moved.mean(axis=0), 0.0, atol=0.3)
+    d = set_distances(hybrid.model.observe(frame), hybrid.particles.swapaxes(0, 1),
+                      boxes[:, 2:])  # (K, N)
+    w = np.exp(-20.0 * d**2)
+    np.testing.assert_allclose(hybrid.weights, (w / w.sum(axis=1, keepdims=True)).T,
+                               rtol=1e-9)
+    assert np.ptp(d) > 0.05  # the particles see different windows

@@ -473,6 +473,9 @@ EQUIVALENT["hybrid"] = [  # noqa: F821
     ('return Estimate(window_boxes(centres, self.sizes)[:, 0], {"confidence": confidence})',
      'return Estimate(window_boxes(centres, self.sizes)[:, -1], {"confidence": confidence})',
      "one window per object (the weighted mean): column -1 is column 0"),
+    ("confidence = 1.0 - set_distances(obs, centres, self.sizes)[:, 0]",
+     "confidence = 1.0 - set_distances(obs, centres, self.sizes)[:, -1]",
+     "one window per object (the weighted mean): column -1 is column 0"),
     ("pred = x + v + p.sigma * self.rng.standard_normal(x.shape)",
      "pred = x + v - p.sigma * self.rng.standard_normal(x.shape)",
      "the noise is a zero-mean normal draw: its negative has the same law (another "
