@@ -418,6 +418,8 @@ EQUIVALENT["runner"] = [  # noqa: F821
 
 # The mean-shift family's trackers around the kernels (round 15, every mutant).
 EQUIVALENT["ms-trackers"] = [  # noqa: F821
+    ("self.centres = res.centres[:, 0]", "self.centres = res.centres[:, -1]",
+     "the tracker's set has one start per object: column -1 is column 0"),
     ('{"confidence": 1.0 - res.distances[:, 0], "n_iter": res.n_iter[:, 0]})',
      '{"confidence": 1.0 - res.distances[:, 0], "n_iter": res.n_iter[:, -1]})',
      "the tracker's set has one start per object: column -1 is column 0"),

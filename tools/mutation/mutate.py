@@ -137,7 +137,8 @@ MODULES: dict[str, Module] = {
          "precision_recall", "success_rate", "recovery_rate", "mean_over_tracked",
          "uniqueness_percent", "effective_dynamics_percent", "_nanmean0", "otb_curves",
          "failure_frame", "tracked_fraction", "mcnemar_counts", "mcnemar", "clear_mot",
-         "idf1", "ordering_index", "overlap_fraction", "depth_order_accuracy"),
+         "idf1", "ordering_index", "overlap_fraction", "overlapping_pairs",
+         "depth_order_accuracy"),
         ("tests/scenegen/evaluation",),
     ),
     "stats": Module(
