@@ -90,6 +90,10 @@ EQUIVALENT["meanshift"] = [  # noqa: F821
 ]
 
 EQUIVALENT["kalman"] = [  # noqa: F821
+    # Round 15, every mutant of the module:
+    ("R: ArrayLike | None = None,", "R: ArrayLike & None = None,",
+     "an annotation: never evaluated (from __future__ import annotations)"),
+    ("*,", "/,", "the AR2 constructor's arguments are passed by keyword by every caller"),
     ("cls, *, accel_std: float, position_std: float = 1.0, velocity_std: float = 5.0",
      "cls, /, accel_std: float, position_std: float = 1.0, velocity_std: float = 5.0",
      "the signature's keyword-only marker read as an operator: the mutant only also "

@@ -248,3 +248,58 @@ def test_kalman_tracker_bad_parameters(params, match):
 def test_kalman_tracker_rejects_step_before_init():
     with pytest.raises(ValueError, match="init"):
         trackers.make("kalman").step(np.zeros((10, 10, 3), np.uint8))
+
+
+def test_constant_velocity_matrices_are_the_white_acceleration_model():
+    # Q = var G G' per axis with G = (1/2, 1)' (the acceleration over one frame moves the
+    # position by a/2 and the velocity by a); P0 = diag of the given stds squared.
+    m = MotionModel.constant_velocity(accel_std=3.0, position_std=2.0, velocity_std=7.0)
+    g = np.zeros((4, 2))
+    g[0, 0] = g[1, 1] = 0.5
+    g[2, 0] = g[3, 1] = 1.0
+    np.testing.assert_allclose(m.Q, 9.0 * g @ g.T)
+    np.testing.assert_allclose(m.P0, np.diag([4.0, 4.0, 49.0, 49.0]))
+    np.testing.assert_array_equal(m.F, [[1, 0, 1, 0], [0, 1, 0, 1], [0, 0, 1, 0], [0, 0, 0, 1]])
+    np.testing.assert_array_equal(m.H, np.eye(2, 4))
+    default = MotionModel.constant_velocity(accel_std=1.0)
+    np.testing.assert_allclose(default.P0, np.diag([1.0, 1.0, 25.0, 25.0]))
+
+
+def test_ar2_matrices_follow_from_position_and_velocity():
+    # State (x_t, y_t, x_{t-1}, y_{t-1}): the previous position is the current one minus a
+    # velocity, both independent Gaussians, so P0 = A diag(pv, pv, vv, vv) A'; the noise
+    # enters the current position only.
+    m = MotionModel.ar2(a1=1.7, a2=-0.7, noise_std=3.0, position_std=2.0, velocity_std=7.0)
+    a = np.array([[1, 0, 0, 0], [0, 1, 0, 0], [1, 0, -1, 0], [0, 1, 0, -1]], dtype=float)
+    np.testing.assert_allclose(m.P0, a @ np.diag([4.0, 4.0, 49.0, 49.0]) @ a.T)
+    np.testing.assert_allclose(m.Q, np.diag([9.0, 9.0, 0.0, 0.0]))
+    np.testing.assert_allclose(m.F, [[1.7, 0, -0.7, 0], [0, 1.7, 0, -0.7], [1, 0, 0, 0],
+                                     [0, 1, 0, 0]])
+    default = MotionModel.ar2(a1=2.0, a2=-1.0, noise_std=1.0)
+    np.testing.assert_allclose(default.P0, a @ np.diag([1.0, 1.0, 25.0, 25.0]) @ a.T)
+
+
+def test_the_joint_model_of_one_object_is_the_model():
+    m = MotionModel.ar2(a1=1.7, a2=-0.7, noise_std=3.0)
+    one = m.joint(1)
+    for name in ("F", "Q", "H", "P0"):
+        np.testing.assert_array_equal(getattr(one, name), getattr(m, name))
+    two = m.joint(2)
+    np.testing.assert_array_equal(two.P0[4:, 4:], m.P0)
+    assert not two.P0[:4, 4:].any()
+
+
+def test_a_missed_measurement_leaves_the_prior_and_zero_diagnostics():
+    m = MotionModel.constant_velocity(accel_std=1.0)
+    rng = np.random.default_rng(2)
+    kf = KalmanFilter(rng.normal(size=(2, 4)), m.P0, m.F, m.Q, m.H, np.eye(2) * 4.0)
+    kf.predict()
+    x, p = kf.x.copy(), kf.P.copy()
+    kf.update(np.array([[np.nan, np.nan], [1.0, 2.0]]))
+    np.testing.assert_array_equal(kf.x[0], x[0])
+    np.testing.assert_array_equal(kf.P[0], p[0])
+    np.testing.assert_array_equal(kf.y[0], [0.0, 0.0])
+    np.testing.assert_array_equal(kf.K[0], np.zeros((4, 2)))
+    np.testing.assert_allclose(kf.S[0], m.H @ p[0] @ m.H.T + 4.0 * np.eye(2))
+    assert kf.log_likelihood[0] == 0.0
+    assert kf.y[1].any() and kf.K[1].any()
