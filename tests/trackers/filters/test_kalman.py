@@ -303,3 +303,22 @@ def test_a_missed_measurement_leaves_the_prior_and_zero_diagnostics():
     np.testing.assert_allclose(kf.S[0], m.H @ p[0] @ m.H.T + 4.0 * np.eye(2))
     assert kf.log_likelihood[0] == 0.0
     assert kf.y[1].any() and kf.K[1].any()
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"H": np.eye(2)}, r"H must have shape \(m, 4\), got \(2, 2\)"),
+    ({"H": np.ones(4)}, r"H must have shape \(m, 4\), got \(4,\)"),
+    ({"R": np.eye(3)}, r"R must have shape \(2, 2\) or \(2, 2, 2\), got \(3, 3\)"),
+    ({"H": np.eye(1, 4)}, r"R must have shape \(1, 1\) for this H, got \(2, 2\)$"),
+])
+def test_bad_update_overrides_raise(kwargs, match):
+    kf = KalmanFilter(np.zeros((2, 4)), np.eye(4), np.eye(4), np.eye(4), np.eye(2, 4), np.eye(2))
+    with pytest.raises(ValueError, match=match):
+        kf.update(None, **kwargs)
+
+
+@pytest.mark.parametrize("name", ["a1", "a2"])
+def test_ar2_coefficients_must_be_finite(name):
+    kwargs = {"a1": 2.0, "a2": -1.0, "noise_std": 1.0, name: np.nan}
+    with pytest.raises(ValueError, match=f"{name} must be finite, got nan"):
+        MotionModel.ar2(**kwargs)
