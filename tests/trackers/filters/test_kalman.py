@@ -287,6 +287,8 @@ def test_the_joint_model_of_one_object_is_the_model():
     two = m.joint(2)
     np.testing.assert_array_equal(two.P0[4:, 4:], m.P0)
     assert not two.P0[:4, 4:].any()
+    with pytest.raises(ValueError, match="n_objects must be >= 1, got 0"):
+        m.joint(0)
 
 
 def test_a_missed_measurement_leaves_the_prior_and_zero_diagnostics():
