@@ -96,6 +96,8 @@ EQUIVALENT["kalman"] = [  # noqa: F821
     ("*,", "/,", "the AR2 constructor's arguments are passed by keyword by every caller"),
     ("H: ArrayLike | None = None,", "H: ArrayLike & None = None,",
      "an annotation: never evaluated (from __future__ import annotations)"),
+    ("z: ArrayLike | None,", "z: ArrayLike & None,",
+     "an annotation: never evaluated (from __future__ import annotations)"),
     ("x = x + (k @ y[:, :, None])[:, :, 0]", "x = x + (k @ y[:, :, None])[:, :, -1]",
      "the product's last axis has length 1: index -1 is index 0"),
     ("cls, *, accel_std: float, position_std: float = 1.0, velocity_std: float = 5.0",
