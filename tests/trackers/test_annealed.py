@@ -153,3 +153,29 @@ def test_layers_keep_valid_betas_weights_and_particles(scenegen_sequence, n_laye
     np.testing.assert_allclose(tracker.weights.sum(axis=0), 1.0, atol=1e-12)
     h, w = frames.shape[1:3]
     assert np.all((tracker.particles >= 0) & (tracker.particles <= [w, h]))
+
+
+@pytest.mark.parametrize("alpha", [0.2, 0.5, 0.8])
+def test_the_chosen_beta_never_exceeds_the_survival_rule_on_many_sets(alpha):
+    # Wherever the rate crosses alpha (in any of the fine grid's intervals, the last
+    # included), the chosen β keeps a rate >= alpha, and a β 2 % larger would not.
+    rng = np.random.default_rng(11)
+    log_lik = -rng.uniform(50.0, 2000.0, (400, 1)) * rng.uniform(0.0, 0.5, (400, 60)) ** 2
+    beta = survival_beta(log_lik, alpha)
+    assert np.all(survival_rate(beta[:, None] * log_lik) >= alpha)
+    inner = beta < 1.0
+    assert inner.sum() > 300
+    assert np.all(survival_rate((1.02 * beta[inner])[:, None] * log_lik[inner]) < alpha)
+
+
+def test_layer_noise_may_be_zero_and_then_the_window_stays_at_the_box():
+    # A box that is not square; without noise every particle stays at its centre.
+    frame = np.full((90, 120, 3), 255, np.uint8)
+    frame[30:44, 40:76] = (230, 30, 30)
+    box = np.array([[40.0, 30.0, 36.0, 14.0]])
+    for name in ("annealed", "kams"):
+        tracker = trackers.make(name, sigma=0.0, n_particles=7, rng=0)
+        tracker.init(frame, box)
+        np.testing.assert_allclose(tracker.weights, np.full((7, 1), 1.0 / 7))
+        est = tracker.step(frame)
+        np.testing.assert_allclose(est.boxes, box, atol=1e-9)
