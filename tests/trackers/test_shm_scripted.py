@@ -10,6 +10,8 @@ equations and compared.
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -132,7 +134,7 @@ def test_shm_collapses_each_ordering_s_predictions_by_moment_matching():
     x_pred = kf.x @ kf.F.T
     p_pred = kf.F @ kf.P @ kf.F.T + kf.Q
     assert np.abs(x_pred[0] - x_pred[1]).max() > 1.0
-    tracker.params = tracker.params.__class__(**{**vars(tracker.params), "use_mse": False})
+    tracker.params = dataclasses.replace(tracker.params, use_mse=False)
     tracker.step(frame)
     pi = np.array([[0.8, 0.2], [0.2, 0.8]])
     joint = pi * prob[:, None]  # [i, j]
