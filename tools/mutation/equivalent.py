@@ -89,6 +89,70 @@ EQUIVALENT["meanshift"] = [  # noqa: F821
      "a row at dy2 = 1 has weights 1 - (dx^2 + 1) <= 0 for both kernels: skipped anyway"),
 ]
 
+# Round 16, every mutant of the kernels:
+_WIDER = ("widens the loop's range; every pixel it adds fails the per-pixel ellipse test "
+          "(weight <= 0 in _window, r^2 >= 1 in _shift), which is what decides")
+_MARGIN = ("drops the one-pixel margin of the chord; the exact per-pixel ellipse test "
+           "decides, the margin only guards against a rounded sqrt at the boundary")
+_ONE = "totals has one element: [-1] is [0]"
+EQUIVALENT["meanshift"] += [  # noqa: F821
+    ("cb = int(np.ceil(ex + half - 0.5)) + 1", "cb = int(np.ceil(ex + half - 0.5)) + 2",
+     _WIDER),
+    ("cb = int(np.ceil(ex + half - 0.5)) + 1", "cb = int(np.ceil(ex + half + 0.5)) + 1",
+     _WIDER),
+    ("cb = int(np.ceil(ex + half - 0.5)) + 1", "cb = int(np.ceil(ex + half - -0.5)) + 1",
+     _WIDER),
+    ("cb = int(np.ceil(ex + half - 0.5)) + 1", "cb = int(np.ceil(ex + half - 0.5)) + 0",
+     _MARGIN),
+    ("ca = int(np.ceil(ex - half - 0.5)) - 1", "ca = int(np.ceil(ex - half - 0.5)) - 2",
+     _WIDER),
+    ("ca = int(np.ceil(ex - half - 0.5)) - 1", "ca = int(np.ceil(ex - half - 1.5)) - 1",
+     _WIDER),
+    ("ca = int(np.ceil(ex - half - 0.5)) - 1", "ca = int(np.ceil(ex - half - -0.5)) - 1",
+     _MARGIN),
+    ("ca = int(np.ceil(ex - half - 0.5)) - 1", "ca = int(np.ceil(ex - half + 0.5)) - 1",
+     _MARGIN),
+    ("half = half_w * np.sqrt(1.0 - dy2)", "half = half_w / np.sqrt(1.0 - dy2)", _WIDER),
+    ("half = half_w * np.sqrt(1.0 - dy2)", "half = half_w * np.sqrt(1.0 + dy2)", _WIDER),
+    ("half = half_w * np.sqrt(1.0 - dy2)", "half = half_w * np.sqrt( 2.0 - dy2)", _WIDER),
+    ("ca, cb = _chord(ex, 0.5 * w, dy2, c0, c1)", "ca, cb = _chord(ex, 1.5 * w, dy2, c0, c1)",
+     _WIDER),
+    ("i0 = int(np.ceil(lo - 0.5))", "i0 = int(np.ceil(lo - 1.5))",
+     "widens the box's pixel range by one; the ellipse lies inside the box, so the "
+     "added pixels fail the per-pixel test"),
+    ("i1 = int(np.ceil(lo + size - 0.5))", "i1 = int(np.ceil(lo + size - -0.5))",
+     "as above, the far end of the range"),
+    ("i1 = int(np.ceil(lo + size - 0.5))", "i1 = int(np.ceil(lo + size + 0.5))",
+     "as above, the far end of the range"),
+    ("if dy2 >= 1.0:", "if dy2 >= 2.0:",
+     "rows with 1 <= dy^2 < 2 lie outside the ellipse: every pixel of them fails the "
+     "per-pixel test"),
+    ("if totals[0] > 0.0:", "if totals[ -1] > 0.0:", _ONE),
+    ("scale = 1.0 / totals[0]", "scale = 1.0 / totals[ -1]", _ONE),
+    ("totals[0] = total", "totals[ -1] = total", _ONE),
+    ("x1, y1, sw = _shift(bin_img, x0, y0, w, h, q, hist, totals[0], touched, n,",
+     "x1, y1, sw = _shift(bin_img, x0, y0, w, h, q, hist, totals[ -1], touched, n,", _ONE),
+    ("totals = np.empty(1)", "totals = np.empty( 2)",
+     "a second element that nothing reads"),
+    ("kbuf = np.empty(bin_img.shape[1] + 2)", "kbuf = np.empty(bin_img.shape[1] + 1)",
+     "the chord is clipped to the frame's W columns: W entries suffice (a test with a "
+     "window wider than the frame kills W - 1)"),
+    ("kbuf = np.empty(bin_img.shape[1] + 2)", "kbuf = np.empty(bin_img.shape[1] + 3)",
+     "a larger scratch row"),
+    ("scale = 0.0", "scale = 1.0",
+     "an empty window touches no bin, so the scale multiplies nothing"),
+    ("scale = 0.0", "scale = -1.0",
+     "an empty window touches no bin, so the scale multiplies nothing"),
+    ("return np.sqrt(one_minus) if one_minus > 0.0 else 0.0",
+     "return np.sqrt(one_minus) if one_minus >= 0.0 else 0.0", "sqrt(0) is 0"),
+    ("return cx, cy, 0.0", "return cx, cy, -1.0",
+     "the caller only asks whether the sum of weights is <= 0"),
+    ("weight[b] = np.sqrt(q[b] * total / hist[b])",
+     "weight[b] = np.sqrt(q[b] / total / hist[b])",
+     "scales every weight by the same 1/total: eq. 26 is a weighted mean, and the caller "
+     "only asks whether their sum is <= 0 (the last bits may differ)"),
+]
+
 EQUIVALENT["kalman"] = [  # noqa: F821
     # Round 15, every mutant of the module:
     ("R: ArrayLike | None = None,", "R: ArrayLike & None = None,",
@@ -114,6 +178,93 @@ EQUIVALENT["metrics"] = [  # noqa: F821
      "ov = np.nan_to_num(iou(g[:, :, None, :], e[:, None, :, :]), nan= -1.0)",
      "missing pairs stay below any threshold in (0, 1] (idf1 does not check the "
      "threshold: at iou_threshold = 0 the original counts missing frames as matches)"),
+]
+# Round 16, every mutant of the module. The ratios guard a division twice: an inner
+# np.where that only keeps the denominator away from zero, and an outer one that decides
+# what a zero area gives. The inner guard's replacements change only values the outer one
+# discards.
+_INNER = ("the inner guard only keeps the division away from zero; where the area is 0 "
+          "the outer np.where returns NaN or 0 anyway")
+_ZERO = ("boxes have non-negative sizes, so the area is >= 0; at 0 the intersection is 0 "
+         "too, and 0 / 1 is the 0 the original returns")
+_SIG = "a signature detail: every caller passes these arguments as the signature allows"
+_MISSING = "a missing box gives 0 either way: its intersection and area are both NaN"
+EQUIVALENT["metrics"] += [  # noqa: F821
+    *[(f"{name} = np.where({v} > 0, inter / np.where({v} > 0, {v}, 1.0), {out})",
+       f"{name} = np.where({v} > 0, inter / np.where({v} {op}, {v}, {fill}), {out})",
+       _INNER)
+      for name, v, out in (("p", "ae", "np.nan"), ("r", "ag", "np.nan"))
+      for op, fill in ((">= 0", "1.0"), ("> -1", "1.0"), ("> 0", "2.0"), ("> 0", "0.0"))],
+    *[("out = np.where(union > 0, inter / np.where(union > 0, union, 1.0), 0.0)",
+       f"out = np.where(union > 0, inter / np.where(union {op}, union, {fill}), 0.0)",
+       _INNER)
+      for op, fill in ((">= 0", "1.0"), ("> -1", "1.0"), ("> 0", "2.0"), ("> 0", "0.0"))],
+    *[("return np.where(small > 0, inter / np.where(small > 0, small, 1.0), 0.0)",
+       f"return np.where(small > 0, inter / np.where(small {op}, small, {fill}), 0.0)",
+       _INNER)
+      for op, fill in ((">= 0", "1.0"), ("> -1", "1.0"), ("> 0", "2.0"), ("> 0", "0.0"))],
+    ("return np.where(n > 0, s / np.maximum(n, 1), np.nan)",
+     "return np.where(n > 0, s / np.maximum(n, 0), np.nan)", _INNER),
+    ("out = np.where(union > 0, inter / np.where(union > 0, union, 1.0), 0.0)",
+     "out = np.where(union >= 0, inter / np.where(union > 0, union, 1.0), 0.0)", _ZERO),
+    ("out = np.where(union > 0, inter / np.where(union > 0, union, 1.0), 0.0)",
+     "out = np.where(union > -1, inter / np.where(union > 0, union, 1.0), 0.0)", _ZERO),
+    ("return np.where(small > 0, inter / np.where(small > 0, small, 1.0), 0.0)",
+     "return np.where(small >= 0, inter / np.where(small > 0, small, 1.0), 0.0)", _ZERO),
+    ("return np.where(small > 0, inter / np.where(small > 0, small, 1.0), 0.0)",
+     "return np.where(small > -1, inter / np.where(small > 0, small, 1.0), 0.0)", _ZERO),
+    ("small = np.nan_to_num(np.minimum(box_area(a), box_area(b)), nan=0.0)",
+     "small = np.nan_to_num(np.minimum(box_area(a), box_area(b)), nan= 1.0)", _MISSING),
+    ("small = np.nan_to_num(np.minimum(box_area(a), box_area(b)), nan=0.0)",
+     "small = np.nan_to_num(np.minimum(box_area(a), box_area(b)), nan= -1.0)", _MISSING),
+    ("inter = np.nan_to_num(intersection_area(a, b), nan=0.0)",
+     "inter = np.nan_to_num(intersection_area(a, b), nan= -1.0)", _MISSING),
+    ("inter = np.nan_to_num(intersection_area(a, b), nan=0.0)",
+     "inter = np.nan_to_num(intersection_area(a, b), nan= 1.0)", _MISSING),
+    ("ov = np.nan_to_num(iou(est, g), nan=0.0)[has_gt]",
+     "ov = np.nan_to_num(iou(est, g), nan= -1.0)[has_gt]",
+     "a frame succeeds when IoU > theta with theta >= 0: false for 0 and for -1"),
+    ("for j in range(i + 1, m_n):", "for j in range(i + 0, m_n):",
+     "adds the pair (i, i), which overlapping_pairs marks False"),
+    ("right += int((best[i] < best[j]) == (d[t, i] < d[t, j]))",
+     "right += int((best[i] <= best[j]) == (d[t, i] < d[t, j]))",
+     "positions within an ordering are distinct (i != j)"),
+    ("right += int((best[i] < best[j]) == (d[t, i] < d[t, j]))",
+     "right += int((best[i] < best[j]) == (d[t, i] <= d[t, j]))",
+     "pairs of equal depth are not counted (d[t, i] != d[t, j] above)"),
+    ("return 100.0 * _nanmean0(e.reshape(-1, *e.shape[e.ndim - tail:]))",
+     "return 100.0 * _nanmean0(e.reshape(- 2, *e.shape[e.ndim - tail:]))",
+     "numpy reads a negative size as the unknown one (-2 as -1)"),
+    ("flat = u.reshape(-1, u.shape[-1])", "flat = u.reshape(- 2, u.shape[-1])",
+     "numpy reads a negative size as the unknown one (-2 as -1)"),
+    ("return 1.0 if f < 0 else f / e.shape[0]",
+     "return 1.0 if f < 0 else f / e.shape[ -1]", "the error is one-dimensional"),
+    ("def idf1(gt: ArrayLike, est: ArrayLike, *, iou_threshold: float = 0.5) -> float:",
+     "def idf1(gt: ArrayLike, est: ArrayLike, /, iou_threshold: float = 0.5) -> float:",
+     _SIG),
+    ("def clear_mot(gt: ArrayLike, est: ArrayLike, *, iou_threshold: float = 0.5) -> "
+     "ClearMot:",
+     "def clear_mot(gt: ArrayLike, est: ArrayLike, /, iou_threshold: float = 0.5) -> "
+     "ClearMot:", _SIG),
+    ("def recovery_rate(state: ArrayLike, *, last_k: int = 5) -> float:",
+     "def recovery_rate(state: ArrayLike, /, last_k: int = 5) -> float:", _SIG),
+    ("def overlapping_pairs(boxes: ArrayLike, *, min_overlap: float = 0.1) -> "
+     "NDArray[np.bool_]:",
+     "def overlapping_pairs(boxes: ArrayLike, /, min_overlap: float = 0.1) -> "
+     "NDArray[np.bool_]:", _SIG),
+    ("def failure_frame(error: ArrayLike, threshold: float, *, persist: int = 10) -> int:",
+     "def failure_frame(error: ArrayLike, threshold: float, /, persist: int = 10) -> int:",
+     _SIG),
+    ("def tracked_fraction(error: ArrayLike, threshold: float, *, persist: int = 10) -> "
+     "float:",
+     "def tracked_fraction(error: ArrayLike, threshold: float, /, persist: int = 10) -> "
+     "float:", _SIG),
+    ("effective_dynamics: ArrayLike, *, components: bool = False",
+     "effective_dynamics: ArrayLike, /, components: bool = False", _SIG),
+    ("*,", "/,", _SIG + " (the keyword-only markers of otb_curves and depth_order_accuracy)"),
+    ("def mean_over_tracked(values: ArrayLike, state: ArrayLike | None = None) -> float:",
+     "def mean_over_tracked(values: ArrayLike, state: ArrayLike & None = None) -> float:",
+     "an annotation: never evaluated (from __future__ import annotations)"),
 ]
 EQUIVALENT["particle"] += [  # noqa: F821
     ("np.exp(logpi - logpi.max()), np.exp(log_g - log_g.max()), sizes,",

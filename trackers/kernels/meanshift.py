@@ -183,9 +183,11 @@ def _clear(hist, touched, n_touched):
 def _shift(bin_img, cx, cy, w, h, q, hist, total, touched, n_touched, weight):
     """New centre by eq. 26 with a constant shadow; returns (x, y, sum of weights).
 
-    Visits the pixels ``_window`` visited (same box range, same ellipse test) and skips
-    those that carried no weight there. ``weight`` (B,) is scratch space for the per-bin
-    weights of eq. 25, so the pixel loop takes no square root.
+    Visits the pixels ``_window`` weighted (same box range, same ellipse test r^2 < 1).
+    Each of them carried a positive weight there (1 - r^2, or 1 - sqrt(r^2) with
+    sqrt(r^2) < 1 for every double r^2 < 1), so its bin is among the touched ones and
+    ``weight`` holds its eq. 25 weight. ``weight`` (B,) is scratch space for the per-bin
+    weights, so the pixel loop takes no square root.
     """
     for t in range(n_touched):
         b = touched[t]
@@ -219,10 +221,7 @@ def _shift(bin_img, cx, cy, w, h, q, hist, total, touched, n_touched, weight):
             dx = (px - ex) * inv_hw
             if dx * dx + dy2 >= 1.0:
                 continue
-            b = bin_img[r, c]
-            if hist[b] <= 0.0:
-                continue
-            wi = weight[b]
+            wi = weight[bin_img[r, c]]
             row_x += wi * (px - cx)
             row_w += wi
         sx += row_x
