@@ -233,9 +233,10 @@ def test_a_window_without_the_models_colours_stays_put(kernel):
 
 @pytest.mark.parametrize("kernel", KERNELS)
 def test_a_window_that_is_its_model_has_distance_zero_and_does_not_move(kernel):
-    # One colour under the window and a model of that colour alone: rho rounds to 1
-    # exactly (p = total * (1 / total) is within an ulp of 1, and so is its square root),
-    # so the distance is 0 and, with min_distance 0, no shift is attempted.
+    # One colour under the window and a model of that colour alone: p = total * (1 /
+    # total) is exactly 1 for these windows (it can be 1 - 2^-53 for others, whose
+    # distance is then 1e-8), so rho is 1, the distance exactly 0 and, with min_distance
+    # 0, no shift is attempted.
     bins = np.ones((30, 40), dtype=np.int32)
     q = np.array([[0.0, 1.0]])
     start = np.array([[20.0, 15.0], [13.7, 11.2], [25.5, 14.5]])
