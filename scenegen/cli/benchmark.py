@@ -20,7 +20,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("dataset", type=Path, help="dataset folder DIR")
     p.add_argument("--tracker", action="append", required=True, metavar="NAME",
-                   help="tracker name (repeatable; see trackers in the README)")  # fmt: skip
+                   help="tracker name, or a user's factory MODULE:FACTORY or "
+                   "path/to/file.py:FACTORY (repeatable; see trackers in the README)")  # fmt: skip
     p.add_argument(
         "--param", action="append", default=[], metavar="KEY=VALUE",
         help="tracker parameter given to every tracker that takes it (e.g. n_particles=100); "

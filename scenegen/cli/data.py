@@ -36,14 +36,14 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=cmd_inspect)
 
     p = sub.add_parser(
-        "validate", help="check a scenegen file, dataset, experiment or report folder; exit 1 "
-        "on any problem",
+        "validate", help="check a scenegen file, dataset, experiment, report or benchmark "
+        "folder; exit 1 on any problem",
     )  # fmt: skip
     p.add_argument("file", type=Path)
     p.add_argument(
         "--deep", action="store_true",
         help="also re-render each sequence from its config and seed and compare (an "
-        "experiment folder: run every run again and compare with its record)",
+        "experiment or benchmark folder: run every run again and compare with its record)",
     )  # fmt: skip
     p.set_defaults(func=cmd_validate)
 
@@ -229,6 +229,19 @@ def cmd_validate(args: argparse.Namespace) -> int:
     import sys
 
     folder = args.file
+    if folder.is_dir():
+        from scenegen.lab.benchmark_outputs import check_benchmark, is_benchmark_folder
+
+        if is_benchmark_folder(folder):  # its sealed records, results.json and pages
+            skipped: list[str] = []
+            problems = check_benchmark(folder, deep=args.deep, skipped=skipped)
+            for line in problems:
+                print(line, file=sys.stderr)
+            if not problems:
+                note = (f" ({len(skipped)} runs of trackers that are not deterministic not "
+                        "run again)" if skipped else "")  # fmt: skip
+                print(f"{folder}: valid benchmark folder{note}")
+            return 1 if problems else 0
     if folder.is_dir() and not (folder / "manifest.json").exists() and (
         (folder / "results.json").exists() or (folder / "runs").is_dir()
         or (folder / "experiments").is_dir()

@@ -4,14 +4,18 @@ Every (tracker, sequence) pair is one task. The worker reads the sequence lazily
 shard, runs the tracker through :func:`scenegen.lab.run.run` (the one bridge, compiled
 kernels on one thread) with a seed derived from (tracker, parameters, sequence seed), and
 scores it with :func:`scenegen.evaluation.evaluate`. Scores are rounded to fixed decimals
-and stored as one JSON file per pair under ``OUT/runs/TRACKER/NNNNN.json`` (atomically),
-so a rerun skips finished pairs, and the results are the same whichever executor ran
-them.
+and stored as one sealed JSON file per pair under ``OUT/runs/TRACKER/NNNNN.json``
+(atomically), so a rerun skips finished pairs, and the results are the same whichever
+executor ran them.
 
 ``OUT`` then holds ``scores.csv`` (one row per tracker and sequence, with the sequence's
-parameters), ``results.json`` (leaderboard, per-axis curves and every score),
-``leaderboard.md``, one PNG per metric and difficulty axis (``curve-METRIC-AXIS.png``:
-the metric's mean per axis value, one line per tracker) and ``index.html``.
+parameters), ``results.json`` (sealed: leaderboard, per-axis curves, every score and the
+listing of the run files it was computed from), ``leaderboard.md``, one PNG per metric
+and difficulty axis (``curve-METRIC-NN-AXIS.png``: the metric's mean per axis value, one
+line per tracker) and ``index.html``. Everything but the PNGs is a function of the run
+records and the dataset's description (:func:`results_document`, :func:`texts`), which is
+how ``scenegen validate OUT`` checks the folder
+(:func:`scenegen.lab.benchmark_outputs.check_benchmark`).
 
 Metrics (per sequence, from :func:`scenegen.evaluation.evaluate`): OTB ``auc`` and
 ``precision_20`` (the mean over the sequence's targets), ``success`` and ``recovery`` (% of
@@ -36,15 +40,23 @@ from typing import Any
 import numpy as np
 
 from scenegen.errors import ConfigError
-from scenegen.lab.experiments.runner import _round, derive_seed, write_json_atomic
+from scenegen.io.sealed import SEAL, seal, write_sealed_json
+from scenegen.lab.experiments.runner import _round, derive_seed
 
 __all__ = [
     "METRICS",
     "BenchTask",
+    "curves",
+    "dataset_meta",
+    "figure_list",
     "leaderboard",
     "plan_benchmark",
+    "results_document",
     "run_benchmark",
+    "run_file",
     "run_pair",
+    "texts",
+    "write_outputs",
 ]
 
 METRICS: dict[str, str] = {
@@ -88,6 +100,9 @@ class BenchTask:
     tracker : str
     params : tuple of (str, value)
         Tracker parameters (without ``rng``), sorted.
+    sequence_params : str
+        The sequence's parameters in the manifest (its axis values), as sorted JSON. Not
+        part of the key: the record carries them so that the results need only the records.
     """
 
     root: str
@@ -98,19 +113,28 @@ class BenchTask:
     frames_digest: str
     tracker: str
     params: tuple[tuple[str, Any], ...]
+    sequence_params: str = "{}"
 
     def tracker_seed(self) -> int:
         return derive_seed("benchmark", self.tracker, json.dumps(dict(self.params),
                            sort_keys=True), self.seed)  # fmt: skip
 
     def filename(self) -> str:
-        return f"runs/{_slug(self.tracker)}/{self.index:05d}.json"
+        return run_file(self.tracker, self.index)
 
     def key(self) -> dict[str, Any]:
         d = asdict(self)
-        del d["root"]
+        del d["root"], d["sequence_params"]
         d["params"] = dict(self.params)
         return _round(d)
+
+
+def run_file(tracker: str, index: int) -> str:
+    """The record file of ``tracker`` on sequence ``index``, relative to the output folder
+    (a ``path/to/file.py:make`` factory by its file name: ``runs/file.py_make/``)."""
+    from scenegen.lab.run import tracker_label
+
+    return f"runs/{_slug(tracker_label(tracker))}/{index:05d}.json"
 
 
 def _slug(name: str) -> str:
@@ -157,31 +181,50 @@ def run_pair(task: BenchTask) -> dict[str, Any]:
             "targets": len(targets),
             "n_frames": int(rep["n_frames"]),
             "scores": scores,
+            "sequence_params": json.loads(task.sequence_params),
+            # False for a tracker that says its runs are not reproducible (OpenCV's MIL):
+            # ``validate --deep`` does not run it again.
+            "deterministic": bool(getattr(done.tracker, "deterministic", True)),
         }
     )
 
 
-def _load(path: Path, task: BenchTask) -> dict[str, Any] | None:
+def _accepted(tracker: str, params: dict[str, Any]) -> set[str]:
+    """The keys of ``params`` that ``tracker`` (one of ours, or a user's ``MODULE:FACTORY``
+    or ``path/file.py:FACTORY``) takes as keyword parameters (``rng`` aside).
+
+    Raises
+    ------
+    ConfigError
+        An unknown tracker name, or a factory that cannot be imported.
+    """
+    import inspect
+
+    from scenegen.lab.run import resolve_factory
+    from trackers.registry import parameters
+
+    if ":" not in tracker:
+        try:
+            return set(parameters(tracker)) - {"rng"}
+        except ValueError as err:
+            raise ConfigError(str(err)) from None
+    factory = resolve_factory(tracker)
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return None
-    if not isinstance(data, dict) or data.get("key") != task.key():
-        return None
-    return data
+        sig = inspect.signature(factory)
+    except (TypeError, ValueError):  # no signature to read: it gets every parameter
+        return set(params)
+    kinds = (inspect.Parameter.POSITIONAL_OR_KEYWORD, inspect.Parameter.KEYWORD_ONLY)
+    if any(p.kind is inspect.Parameter.VAR_KEYWORD for p in sig.parameters.values()):
+        return set(params)
+    return {p.name for p in sig.parameters.values() if p.kind in kinds} - {"rng"}
 
 
 def _check_params(trackers: list[str], params: dict[str, Any]) -> dict[str, dict[str, Any]]:
     """Per tracker, the ``params`` it accepts; each key must be accepted by one at least."""
-    from trackers.registry import parameters
-
     out: dict[str, dict[str, Any]] = {}
     used: set[str] = set()
     for t in trackers:
-        try:
-            valid = set(parameters(t)) - {"rng"}
-        except ValueError as err:
-            raise ConfigError(str(err)) from None
+        valid = _accepted(t, params)
         out[t] = {k: v for k, v in params.items() if k in valid}
         used |= set(out[t])
     unused = sorted(set(params) - used)
@@ -200,7 +243,8 @@ def plan_benchmark(
     Raises
     ------
     ConfigError
-        No tracker, a duplicate or unknown tracker, or a parameter no tracker takes.
+        No tracker, a duplicate or unknown tracker, two trackers whose run folders would
+        be the same, or a parameter no tracker takes.
     DataError
         If ``root`` is not a dataset folder.
     """
@@ -210,6 +254,12 @@ def plan_benchmark(
         raise ConfigError("give at least one --tracker")
     if len(set(trackers)) != len(trackers):
         raise ConfigError(f"a tracker is listed twice: {', '.join(trackers)}")
+    folders: dict[str, str] = {}
+    for t in trackers:
+        other = folders.setdefault(run_file(t, 0).split("/")[1], t)
+        if other != t:
+            raise ConfigError(f"trackers {other!r} and {t!r} would share the run folder "
+                              f"runs/{run_file(t, 0).split('/')[1]}: rename one")  # fmt: skip
     per = _check_params(trackers, dict(params or {}))
     man = read_manifest(root)
     if not man.get("complete"):
@@ -219,9 +269,10 @@ def plan_benchmark(
         p = tuple(sorted(per[t].items()))
         for e in sorted(man["sequences"], key=lambda e: e["index"]):
             fd = str((e.get("digests") or {}).get("frames", ""))
+            sp = json.dumps(e.get("params", {}), sort_keys=True)
             tasks.append(
                 BenchTask(str(root), int(e["index"]), e["name"], e["file"], int(e["seed"]),
-                          fd, t, p)
+                          fd, t, p, sp)
             )  # fmt: skip
     return man, tasks
 
@@ -297,11 +348,12 @@ def _axes(man: dict[str, Any]) -> list[str]:
 
 
 def curves(
-    rows: list[dict[str, Any]], man: dict[str, Any], trackers: list[str]
+    rows: list[dict[str, Any]], axes: list[str], trackers: list[str]
 ) -> list[dict[str, Any]]:
-    """Per difficulty axis and metric: the metric's mean per axis level, per tracker."""
+    """Per difficulty axis (names, :func:`dataset_meta`) and metric: the metric's mean per
+    axis level, per tracker."""
     out = []
-    for axis in _axes(man):
+    for axis in axes:
         mine = [r for r in rows if axis in r["params"]]
         if not mine:
             continue
@@ -373,7 +425,7 @@ def _markdown(board: list[dict[str, Any]]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _html(man: dict[str, Any], board: list[dict[str, Any]], figures: list[tuple[str, str]],
+def _html(meta: dict[str, Any], board: list[dict[str, Any]], figures: list[tuple[str, str]],
           params: dict[str, dict[str, Any]]) -> str:  # fmt: skip
     e = html.escape
     cols = _columns(board)
@@ -388,7 +440,7 @@ def _html(man: dict[str, Any], board: list[dict[str, Any]], figures: list[tuple[
         for f, cap in figures
     )
     tp = "".join(f"<li>{e(t)}: {e(json.dumps(p, sort_keys=True))}</li>" for t, p in params.items())
-    axes = ", ".join(e(a) for a in _axes(man)) or "none"
+    axes = ", ".join(e(a) for a in meta["axes"]) or "none"
     multi = [m for m in MULTI_TARGET if m in cols]
     note = (
         f"<p>{', '.join(METRICS[m] for m in multi)}: means over the sequences with several "
@@ -396,13 +448,13 @@ def _html(man: dict[str, Any], board: list[dict[str, Any]], figures: list[tuple[
         "<p>No multi-target metric: every sequence has one target (or none was computed).</p>"
     )  # fmt: skip
     return f"""<!doctype html>
-<html><head><meta charset="utf-8"><title>Benchmark: {e(str(man.get("family")))}</title>
+<html><head><meta charset="utf-8"><title>Benchmark: {e(str(meta["family"]))}</title>
 <style>body{{font-family:sans-serif;max-width:1100px;margin:2em auto}}
 table{{border-collapse:collapse}}td,th{{border:1px solid #ccc;padding:4px 8px;text-align:right}}
 td:nth-child(2){{text-align:left}}figure{{display:inline-block;margin:8px}}
 img{{max-width:520px}}</style></head><body>
-<h1>Benchmark on dataset {e(str(man.get("family")))}</h1>
-<p>{e(str(man.get("description", "")))} — {man.get("count")} sequences, seed {man.get("seed")},
+<h1>Benchmark on dataset {e(str(meta["family"]))}</h1>
+<p>{e(str(meta["description"]))} — {meta["count"]} sequences, seed {meta["seed"]},
 difficulty axes: {axes}.</p>
 <h2>Leaderboard</h2>
 <table><tr><th>rank</th><th>tracker</th><th>sequences</th>{head}</tr>
@@ -448,15 +500,20 @@ def run_benchmark(
     on_done : callable, optional
         Called with each task whose record was just stored.
 
+    A stored run is kept when it is sound and of the same key (dataset sequence, tracker,
+    parameters). One that is damaged, edited, malformed, written before records were
+    sealed, or sealed but not the one the folder's ``results.json`` lists for that key, is
+    run again with one warning line (:func:`scenegen.lab.benchmark_outputs.load_record`).
+
     Returns
     -------
     dict
-        What ``results.json`` holds: ``dataset``, ``trackers``, ``params``,
-        ``leaderboard``, ``curves``, ``scores``.
+        What ``results.json`` holds (:func:`results_document`).
     """
     from tqdm import tqdm
 
     from scenegen.datasets.executor import check_executor, probe, run_tasks
+    from scenegen.lab.benchmark_outputs import listed_digests, load_record
 
     check_executor(jobs, scheduler)
     root = Path(dataset)
@@ -465,10 +522,12 @@ def run_benchmark(
         probe(scheduler)  # fail before writing anything
     outp = Path(out)
     outp.mkdir(parents=True, exist_ok=True)
+    meta = dataset_meta(man, root)
+    listed = listed_digests(outp, meta)
     records: dict[tuple[str, int], dict[str, Any]] = {}
     todo = []
     for t in tasks:
-        rec = _load(outp / t.filename(), t)
+        rec = load_record(outp / t.filename(), t, listed.get(t.filename()))
         if rec is None:
             todo.append(t)
         else:
@@ -477,8 +536,8 @@ def run_benchmark(
                desc="benchmark", leave=False)  # fmt: skip
 
     def store(t: BenchTask, rec: dict[str, Any]) -> None:
-        write_json_atomic(outp / t.filename(), rec)
-        records[(t.tracker, t.index)] = json.loads(json.dumps(rec, sort_keys=True))
+        write_sealed_json(outp / t.filename(), rec, parents=True)
+        records[(t.tracker, t.index)] = _content(rec)
         bar.update(1)
         if on_done is not None:
             on_done(t)
@@ -488,48 +547,88 @@ def run_benchmark(
                   key=lambda t: f"{_slug(t.tracker)}-{t.index}", name="scenegen-benchmark")
     finally:  # fmt: skip
         bar.close()
-    return write_report(man, tasks, records, outp, list(trackers))
+    ordered = [records[(t.tracker, t.index)] for t in tasks]
+    return write_outputs(outp, meta, list(trackers), ordered)
 
 
-def write_report(
-    man: dict[str, Any],
-    tasks: list[BenchTask],
-    records: dict[tuple[str, int], dict[str, Any]],
-    out: Path,
-    trackers: list[str],
+def _content(rec: dict[str, Any]) -> dict[str, Any]:
+    """``rec`` as a reader of its sealed file sees it (through canonical JSON, no digest)."""
+    return {k: v for k, v in seal(rec).items() if k != SEAL}
+
+
+def dataset_meta(man: dict[str, Any], root: str | Path) -> dict[str, Any]:
+    """What the results keep of the dataset: its folder (absolute), family, family digest,
+    seed, count and description, its sequence parameters (``scores.csv``'s columns) and its
+    difficulty axes (the swept axes with more than one value, then the drawn paths)."""
+    return {
+        "path": str(Path(root).resolve()),
+        "family": man.get("family"),
+        "family_digest": man.get("family_digest"),
+        "seed": man.get("seed"),
+        "count": man.get("count"),
+        "description": str(man.get("description", "")),
+        "sequence_params": list(man.get("params", [])),
+        "axes": _axes(man),
+    }
+
+
+def results_document(
+    meta: dict[str, Any], trackers: list[str], records: list[dict[str, Any]]
 ) -> dict[str, Any]:
-    """Write scores.csv, results.json, leaderboard.md, the figures and index.html."""
-    from scenegen.io import atomic_path
+    """What ``results.json`` holds, from the dataset's description and the run records.
 
-    entries = {int(e["index"]): e for e in man["sequences"]}
+    Parameters
+    ----------
+    meta : dict
+        :func:`dataset_meta`.
+    trackers : list of str
+        In the order given on the command line.
+    records : list of dict
+        Every run record (as read back, without digest), trackers x sequences in task order.
+
+    Returns
+    -------
+    dict
+        ``dataset`` (``meta``), ``trackers``, ``params`` (per tracker), ``leaderboard``,
+        ``curves``, ``scores`` (one row per record) and ``records`` (``"runs/TRACKER/NNNNN.json
+        SHA256"`` per record, in order).
+    """
+    from scenegen.lab.benchmark_outputs import listing
+
     rows = []
-    for t in tasks:
-        rec = records[(t.tracker, t.index)]
-        e = entries[t.index]
-        rows.append({"tracker": t.tracker, "index": t.index, "name": t.name,
-                     "targets": rec["targets"], "params": e.get("params", {}),
+    for rec in records:
+        k = rec["key"]
+        rows.append({"tracker": k["tracker"], "index": k["index"], "name": k["name"],
+                     "targets": rec["targets"], "params": rec.get("sequence_params", {}),
                      **rec["scores"]})  # fmt: skip
-    board = leaderboard(rows, trackers)
-    cur = curves(rows, man, trackers)
-    figures = []
-    for i, c in enumerate(cur):
-        name = f"curve-{c['metric']}-{i:02d}-{_slug(c['axis'])[:40]}.png"
-        _figure(c, out / name)
-        figures.append((name, f"{METRICS.get(c['metric'], c['metric'])} vs {c['axis']}"))
-    per_tracker = {t.tracker: dict(t.params) for t in tasks}
-    results = _round({
-        "dataset": {"family": man.get("family"),
-                    "family_digest": man.get("family_digest"), "seed": man.get("seed"),
-                    "count": man.get("count")},
-        "trackers": trackers,
+    per_tracker = {t: {} for t in trackers}
+    for rec in records:
+        per_tracker[rec["key"]["tracker"]] = dict(rec["key"]["params"])
+    return _round({
+        "dataset": meta,
+        "trackers": list(trackers),
         "params": per_tracker,
-        "leaderboard": board,
-        "curves": cur,
+        "leaderboard": leaderboard(rows, list(trackers)),
+        "curves": curves(rows, list(meta["axes"]), list(trackers)),
         "scores": rows,
+        "records": listing(records),
     })  # fmt: skip
-    write_json_atomic(out / "results.json", results, indent=1)
+
+
+def figure_list(results: dict[str, Any]) -> list[tuple[str, str, dict[str, Any]]]:
+    """(file name, caption, curve) of every figure of ``results``' curves."""
+    out = []
+    for i, c in enumerate(results["curves"]):
+        name = f"curve-{c['metric']}-{i:02d}-{_slug(c['axis'])[:40]}.png"
+        out.append((name, f"{METRICS.get(c['metric'], c['metric'])} vs {c['axis']}", c))
+    return out
+
+
+def texts(results: dict[str, Any]) -> dict[str, str]:
+    """``scores.csv``, ``leaderboard.md`` and ``index.html`` of ``results``, by file name."""
+    meta, board, rows = results["dataset"], results["leaderboard"], results["scores"]
     metric_cols = [m for m in METRICS if any(m in r for r in rows)]
-    pnames = list(man.get("params", []))
+    pnames = list(meta["sequence_params"])
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
     w.writerow(["tracker", "index", "name", "targets", *pnames, *metric_cols])
@@ -538,8 +637,24 @@ def write_report(
                     *[json.dumps(r["params"].get(p)) if isinstance(r["params"].get(p), list)
                       else r["params"].get(p) for p in pnames],
                     *["" if r.get(m) is None else r[m] for m in metric_cols]])  # fmt: skip
-    for name, text in (("scores.csv", buf.getvalue()), ("leaderboard.md", _markdown(board)),
-                       ("index.html", _html(man, board, figures, per_tracker))):  # fmt: skip
+    figures = [(name, cap) for name, cap, _ in figure_list(results)]
+    return {"scores.csv": buf.getvalue(), "leaderboard.md": _markdown(board),
+            "index.html": _html(meta, board, figures, results["params"])}  # fmt: skip
+
+
+def write_outputs(
+    out: Path, meta: dict[str, Any], trackers: list[str], records: list[dict[str, Any]]
+) -> dict[str, Any]:
+    """Write the figures, ``results.json`` (sealed), ``scores.csv``, ``leaderboard.md`` and
+    ``index.html`` of ``records`` (see :func:`results_document`) into ``out``; return the
+    results."""
+    from scenegen.io import atomic_path
+
+    results = _content(results_document(meta, trackers, records))
+    for name, _, curve in figure_list(results):
+        _figure(curve, out / name)
+    write_sealed_json(out / "results.json", results, indent=1)
+    for name, text in texts(results).items():
         with atomic_path(out / name, Path(name).suffix) as tmp:
             tmp.write_text(text, encoding="utf-8")
     return results

@@ -58,7 +58,9 @@ def test_failure_is_nan():
         ("KCFX", {}, "unknown OpenCV tracker 'KCFX'"),
         ("MIL", {"bogus": 1}, "unknown parameter 'bogus' for cv2.TrackerMIL; valid: "),
         ("MIL", {"samplerSearchWinSize": "x"}, "samplerSearchWinSize='x'"),
-        ("MIL", {"rng": 1.5}, "rng of an OpenCV tracker must be an int"),
+        ("MIL", {"rng": 1.5}, "rng of an OpenCV tracker must be a Generator, an int seed or "
+                              "None, not 1.5"),
+        ("MIL", {"rng": -(2**31) - 1}, "rng of an OpenCV tracker must be >= -2**31"),
     ],
 )
 def test_bad_construction_names_the_problem(name, kw, needle):
@@ -81,3 +83,22 @@ def test_docstring_example_runs():
     module = importlib.import_module("trackers.adapters.opencv")  # the attribute is the function
     result = doctest.testmod(module)
     assert result.attempted > 0 and result.failed == 0
+
+
+def test_any_seed_becomes_a_c_int_seed(monkeypatch):
+    # A derived 63-bit seed (scenegen benchmark, the experiments) or a Generator reaches
+    # cv2.setRNGSeed as a C int; a seed that already is one is passed unchanged.
+    import cv2
+
+    from trackers.adapters import cv2_seed
+
+    seen = []
+    monkeypatch.setattr(cv2, "setRNGSeed", seen.append)
+    for rng in (7, -(2**31), 2**31 - 1, 2**31, 2**63 - 1, np.random.default_rng(5)):
+        t = opencv("MIL", rng=rng)
+        t.init(_scene(1)[0], [[10, 15, 12, 12]])
+    assert seen[:3] == [7, -(2**31), 2**31 - 1]
+    assert all(isinstance(s, int) and 0 <= s < 2**31 for s in seen[3:])
+    assert seen[3] != seen[4] and seen[3] == cv2_seed(2**31) and seen[5] == cv2_seed(
+        np.random.default_rng(5))  # fmt: skip
+    assert cv2_seed(None) is None and opencv("MIL").rng is None

@@ -18,9 +18,9 @@ to the frame, and grown about its centre to at least :data:`MIN_SIDE` pixels a s
 cv2 5.0); a grown box is reported with its initial size, centred where OpenCV puts it.
 When a cv2 tracker reports failure its target's box is NaN for that frame
 (``extras["ok"]`` says which succeeded); it keeps updating and may find the target again.
-OpenCV's trackers draw from OpenCV's global random state: ``rng`` (an int) is passed to
-``cv2.setRNGSeed`` at ``init``, but MIL is not reproducible across runs even so, hence
-``deterministic = False``.
+OpenCV's trackers draw from OpenCV's global random state: ``rng`` becomes a C ``int``
+seed (:func:`cv2_seed`) passed to ``cv2.setRNGSeed`` at ``init``, but MIL is not
+reproducible across runs even so, hence ``deterministic = False``.
 """
 
 from __future__ import annotations
@@ -32,7 +32,7 @@ from numpy.typing import NDArray
 
 from trackers.base import Estimate, check_boxes, check_frame
 
-__all__ = ["OpenCVTracker", "opencv", "opencv_names"]
+__all__ = ["OpenCVTracker", "cv2_seed", "opencv", "opencv_names"]
 
 # Trackers that construct without model files in opencv-python-headless (checked in the
 # suite: tests/trackers/test_adapters.py).
@@ -76,8 +76,8 @@ class OpenCVTracker:
     ----------
     name : str
         ``cv2.Tracker<name>``, e.g. ``"MIL"``.
-    rng : int or None
-        Seed for ``cv2.setRNGSeed`` at ``init`` (OpenCV's global random state).
+    rng : numpy.random.Generator, int or None
+        Seed of OpenCV's global random state, set at ``init`` (:func:`cv2_seed`).
     **params
         Fields of ``cv2.Tracker<name>_Params``.
 
@@ -91,11 +91,10 @@ class OpenCVTracker:
     deterministic = False
     handles_occlusion = False
 
-    def __init__(self, name: str, *, rng: int | None = None, **params: Any) -> None:
-        if rng is not None and (isinstance(rng, bool) or not isinstance(rng, (int, np.integer))):
-            raise ValueError(f"rng of an OpenCV tracker must be an int seed or None, not {rng!r}")
+    def __init__(self, name: str, *, rng: np.random.Generator | int | None = None,
+                 **params: Any) -> None:  # fmt: skip
         self.name = name
-        self.rng = rng
+        self.rng = cv2_seed(rng)
         self.params = dict(params)
         self._cls, self._params_cls = _lookup(name)
         self._make()  # fail at construction on bad parameters or missing model files
@@ -198,6 +197,39 @@ def _span(start: float, size: float, limit: int) -> tuple[int, int]:
         lo = int(np.clip(np.floor(centre - side / 2), 0, limit - side))
         hi = lo + side
     return lo, hi - lo
+
+
+def cv2_seed(rng: np.random.Generator | int | None) -> int | None:
+    """The C ``int`` seed given to ``cv2.setRNGSeed`` for ``rng``.
+
+    An int that fits a C ``int`` is used as it is (``rng=3`` seeds OpenCV with 3); a larger
+    non-negative int (a derived 63-bit seed, as ``scenegen benchmark`` and the experiments
+    give) is mapped to 31 bits through ``numpy.random.SeedSequence``; a Generator draws
+    one; None leaves OpenCV's state alone.
+
+    Raises
+    ------
+    ValueError
+        For a negative int below -2**31, or anything else than an int, a Generator or None.
+
+    Examples
+    --------
+    >>> cv2_seed(3), cv2_seed(None), 0 <= cv2_seed(2**62 + 5) < 2**31
+    (3, None, True)
+    """
+    if rng is None:
+        return None
+    if isinstance(rng, np.random.Generator):
+        return int(rng.integers(2**31))
+    if isinstance(rng, bool) or not isinstance(rng, (int, np.integer)):
+        raise ValueError(f"rng of an OpenCV tracker must be a Generator, an int seed or None, "
+                         f"not {rng!r}")  # fmt: skip
+    seed = int(rng)
+    if -(2**31) <= seed < 2**31:
+        return seed
+    if seed < 0:
+        raise ValueError(f"rng of an OpenCV tracker must be >= -2**31, got {seed}")
+    return int(np.random.SeedSequence(seed).generate_state(1, np.uint32)[0] >> 1)
 
 
 def opencv(name: str, **kw: Any) -> OpenCVTracker:

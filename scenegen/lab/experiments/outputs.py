@@ -46,6 +46,8 @@ __all__ = [
     "check_report",
     "listed_digest",
     "listing",
+    "parse_listing",
+    "read_checked",
     "read_record",
     "read_results",
     "record_problems",
@@ -162,10 +164,18 @@ def read_record(path: Path) -> dict[str, Any]:
         One line: missing, damaged, edited, written by an older version
         (:class:`scenegen.io.sealed.Unsealed`), or not a run record.
     """
+    return read_checked(path, record_problems, "a run record")
+
+
+def read_checked(path: Path, problems_of: Callable[[Any], list[str]], what: str
+                 ) -> dict[str, Any]:  # fmt: skip
+    """The sealed document at ``path`` (without its digest) when ``problems_of`` finds
+    nothing wrong with its content, else one DataError line: ``PATH: not WHAT (the first
+    problem)``; as :func:`scenegen.io.sealed.read_sealed_json` for a damaged file."""
     data = read_sealed_json(path)
-    problems = record_problems(data)
+    problems = problems_of(data)
     if problems:
-        raise DataError(f"{path}: not a run record ({problems[0]})")
+        raise DataError(f"{path}: not {what} ({problems[0]})")
     return data
 
 
@@ -177,7 +187,12 @@ def listing(records: list[dict[str, Any]]) -> list[str]:
 
 
 def _entries(results: dict[str, Any]) -> list[tuple[str, str]] | None:
-    entries = results.get(RECORDS)
+    return parse_listing(results.get(RECORDS))
+
+
+def parse_listing(entries: Any) -> list[tuple[str, str]] | None:
+    """``[(NAME, SHA256), ...]`` of a :data:`RECORDS` listing, or None when it is not a
+    non-empty list of ``"NAME SHA256"`` strings."""
     if not isinstance(entries, list) or not entries:
         return None
     out = []

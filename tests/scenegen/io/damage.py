@@ -463,18 +463,25 @@ def _file_bytes_variant(kind: str, target: str, rng: np.random.Generator) -> Cal
     return apply
 
 
-def folder_variants(src: Path, n: int, seed: int,
-                    kinds: tuple[str, ...] = FOLDER_KINDS) -> list[Variant]:  # fmt: skip
-    """``n`` seeded damaged variants of the experiment folder ``src``: each damages one
-    file (``results.json``, a run record or ``table.md``); ``apply(dst)`` writes the
-    damaged copy into the folder ``dst`` (which must not exist)."""
+EXPERIMENT_FILES = ("runs/*.json", ("table.md",))
+"""An experiment folder's run records (a glob) and its text files."""
+BENCHMARK_FILES = ("runs/*/*.json", ("scores.csv", "leaderboard.md", "index.html"))
+"""A benchmark folder's run records (a glob) and its text files."""
+
+
+def folder_variants(src: Path, n: int, seed: int, kinds: tuple[str, ...] = FOLDER_KINDS,
+                    layout: tuple[str, tuple[str, ...]] = EXPERIMENT_FILES) -> list[Variant]:
+    """``n`` seeded damaged variants of the experiment (or, with ``layout`` =
+    :data:`BENCHMARK_FILES`, benchmark) folder ``src``: each damages one file
+    (``results.json``, a run record or a text file); ``apply(dst)`` writes the damaged
+    copy into the folder ``dst`` (which must not exist)."""
     rng = np.random.default_rng(seed)
-    runs = sorted(f"runs/{p.name}" for p in (src / "runs").glob("*.json"))
+    runs = sorted(str(p.relative_to(src)) for p in src.glob(layout[0]))
     out = []
     for i in range(n):
         kind = kinds[i % len(kinds)]
         byte_kind = kind in ("truncate", "zero", "flip", "delete_file")
-        files = ["results.json", *runs, *(["table.md"] if byte_kind else [])]
+        files = ["results.json", *runs, *(layout[1] if byte_kind else [])]
         if kind == "replaced":
             files = runs
         target = files[int(rng.integers(len(files)))]
@@ -493,12 +500,14 @@ def folder_variants(src: Path, n: int, seed: int,
     return out
 
 
-def folder_content(folder: str) -> str:
-    """Digest of everything readable in an experiment folder: the parsed content of every
-    JSON file (its raw bytes if it does not parse) and the text of ``table.md``."""
+def folder_content(folder: str,
+                   layout: tuple[str, tuple[str, ...]] = EXPERIMENT_FILES) -> str:  # fmt: skip
+    """Digest of everything readable in an experiment (or benchmark) folder: the parsed
+    content of every JSON file (its raw bytes if it does not parse) and the text files."""
     h = hashlib.sha256()
     root = Path(folder)
-    for p in sorted([root / "results.json", root / "table.md", *(root / "runs").glob("*.json")]):
+    texts = [root / t for t in layout[1]]
+    for p in sorted([root / "results.json", *texts, *root.glob(layout[0])]):
         h.update(str(p.relative_to(root)).encode())
         if not p.exists():
             h.update(b"<missing>")

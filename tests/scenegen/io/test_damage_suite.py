@@ -27,6 +27,8 @@ from collections import Counter
 import numpy as np
 import pytest
 from damage import (
+    BENCHMARK_FILES,
+    EXPERIMENT_FILES,
     FOLDER_KINDS,
     KINDS,
     RESULT_KINDS,
@@ -232,36 +234,64 @@ def _folder_argvs(v, dst, i: int) -> tuple[list[list[str]], bool]:
     return argvs, i % 3 == 2
 
 
-def judge_folder(tally, v, dst, results, original, original_results):
-    """Classify one experiment-folder variant's outcome into ``tally``."""
-    path = str(dst)
-    target = v.name.split(":", 1)[1]
-    (vcode, verr), *others = results
+def print_folder_tally(what: str, n: int, tally: Tally, extra: list[str]) -> None:
+    """The README's figures of a folder damage run: counts by outcome and by kind."""
+    print(f"\n{what}-folder variants tried: {n}; " + "; ".join(
+        f"{k}: {c}" for k, c in sorted(tally.counts.items())))  # fmt: skip
+    for k in FOLDER_KINDS:
+        tried = sum(1 for i in range(n) if FOLDER_KINDS[i % len(FOLDER_KINDS)] == k)
+        print(f"  {k}: tried {tried}, reported {tally.by_kind[k]}, harmless "
+              f"{tally.by_kind[k + ' (harmless)']}")
+    for line in [*extra, *tally.failures][:20]:
+        print("  " + line)
+
+
+def judge_validate(tally, v, path: str, result, original, layout) -> bool:
+    """Classify ``validate DIR``'s (code, stderr) on a damaged folder: reported, harmless
+    (nothing readable changed) or a wrong "valid"; False for a traceback or garbled
+    output (then nothing else of the variant is judged)."""
+    vcode, verr = result
     if vcode not in (0, 1) or "Traceback" in verr or (vcode and not verr.strip()) or any(
             not ln.startswith(path) for ln in verr.splitlines()):  # fmt: skip
-        tally.fail("traceback or garbled output", f"{v.name}: {results}")
-        return
+        tally.fail("traceback or garbled output", f"{v.name}: {result}")
+        return False
     if vcode == 1:
         tally.counts["reported by validate"] += 1
         tally.by_kind[v.kind] += 1
-    elif folder_content(path) == original:
+    elif folder_content(path, layout) == original:
         tally.counts["harmless (no readable change)"] += 1
         tally.by_kind[f"{v.kind} (harmless)"] += 1
     else:
         tally.fail("WRONG VALID", f"{v.name}: {verr.strip()}")
+    return True
+
+
+def judge_resume(tally, v, dst, vcode, result, lines, wrong, original_results) -> None:
+    """A resumed run into a damaged folder: it must end with the original
+    ``results.json`` (and not be ``wrong``), and say in a warning line that a damaged run
+    record validate reported is computed again (a deleted one is simply not done yet)."""
+    target = v.name.split(":", 1)[1]
+    if wrong or (dst / "results.json").read_bytes() != original_results:
+        tally.fail("RESUME WRONG", f"{v.name}: {result[0]} {result[1]!r}")
+    elif target.startswith("runs/") and vcode == 1 and v.kind != "delete_file" and not any(
+            ln.startswith(f"scenegen: warning: {dst / target}") for ln in lines):
+        tally.fail("RESUME SILENT", f"{v.name}: {result[1]!r}")  # fmt: skip
+    else:
+        tally.counts["resumed: damaged runs recomputed, same results.json"] += 1
+
+
+def judge_folder(tally, v, dst, results, original, original_results):
+    """Classify one experiment-folder variant's outcome into ``tally``."""
+    target = v.name.split(":", 1)[1]
+    (vcode, _), *others = results
+    if not judge_validate(tally, v, str(dst), results[0], original, EXPERIMENT_FILES):
+        return
     for code, err in others:
         lines = err.splitlines()
         if code in (99, 2) or "Traceback" in err or len(lines) > 2:
             tally.fail("traceback or garbled output", f"{v.name}: {code} {err!r}")
         elif err.startswith("scenegen: warning:") or err.startswith(f"{EXP}:"):  # resumed
-            if code != 0 or (dst / "results.json").read_bytes() != original_results:
-                tally.fail("RESUME WRONG", f"{v.name}: {code} {err!r}")
-            elif target.startswith("runs/") and vcode == 1 and v.kind != "delete_file" and not any(
-                    ln.startswith(f"scenegen: warning: {dst / target}") for ln in lines):
-                # a missing run is simply not done yet; any other damage is said
-                tally.fail("RESUME SILENT", f"{v.name}: {err!r}")  # fmt: skip
-            else:
-                tally.counts["resumed: damaged runs recomputed, same results.json"] += 1
+            judge_resume(tally, v, dst, vcode, (code, err), lines, code != 0, original_results)
         elif code == 1:  # the report
             if not err.startswith(str(dst / "results.json")):
                 tally.fail("REPORT GARBLED", f"{v.name}: {err!r}")
@@ -314,12 +344,90 @@ def test_slow_damaged_experiment_outputs(experiment, tmp_path, capsys):
         else:
             judge_folder(tally, v, dst, results, original, original_results)
     with capsys.disabled():
-        print(f"\nexperiment-folder variants tried: {n}; " + "; ".join(
-            f"{k}: {c}" for k, c in sorted(tally.counts.items())))  # fmt: skip
-        for k in FOLDER_KINDS:
-            tried = sum(1 for i in range(n) if FOLDER_KINDS[i % len(FOLDER_KINDS)] == k)
-            print(f"  {k}: tried {tried}, reported {tally.by_kind[k]}, harmless "
-                  f"{tally.by_kind[k + ' (harmless)']}")
-        for line in tally.failures[:20]:
-            print("  " + line)
+        print_folder_tally("experiment", n, tally, [])
     assert tally.failures == []
+
+
+# ---------------------------------------------------------------------------------------
+# Benchmark outputs: sealed records under runs/TRACKER/, results.json, scores.csv,
+# leaderboard.md and index.html
+
+BENCH_FAMILY = {"name": "small", "base": SCENE, "sweep": {"clutter[0].count": [0, 4]},
+                "count": 2}  # fmt: skip
+BENCH_TRACKERS = ["--tracker", "meanshift", "--tracker", "sok", "--jobs", "1"]
+
+
+@pytest.fixture(scope="module")
+def benchmark(tmp_path_factory):
+    """A small benchmark folder (4 sealed runs, results.json, three pages), its dataset
+    and its content."""
+    from scenegen.cli import main
+    from scenegen.datasets import build_dataset
+
+    base = tmp_path_factory.mktemp("benchmark")
+    build_dataset(BENCH_FAMILY, base / "data", jobs=1)
+    d = base / "bench"
+    assert main(["benchmark", str(base / "data"), *BENCH_TRACKERS, "-o", str(d)]) == 0
+    assert main(["validate", str(d)]) == 0
+    return (base / "data", d, folder_content(str(d), BENCHMARK_FILES),
+            (d / "results.json").read_bytes())  # fmt: skip
+
+
+def judge_benchmark(tally, v, dst, results, original, original_results):
+    """Classify one benchmark-folder variant's outcome into ``tally``: validate reports it
+    (or it changed nothing readable); a resumed benchmark exits 0, warns in one line for a
+    damaged run record and ends with the original ``results.json``."""
+    (vcode, _), *others = results
+    if not judge_validate(tally, v, str(dst), results[0], original, BENCHMARK_FILES):
+        return
+    for code, err in others:
+        lines = [ln for ln in err.splitlines() if not ln.startswith("benchmark: ")]
+        wrong = code != 0 or "Traceback" in err or len(lines) > 1
+        judge_resume(tally, v, dst, vcode, (code, err), lines, wrong, original_results)
+
+
+def _bench_variants(benchmark, tmp_path, n: int, seed: int, run) -> Tally:
+    data, src, original, original_results = benchmark
+    tally = Tally()
+    for i, v in enumerate(folder_variants(src, n, seed=seed, layout=BENCHMARK_FILES)):
+        dst = tmp_path / f"b{i}"
+        shutil.rmtree(dst, ignore_errors=True)
+        v.apply(dst)
+        argvs = [["validate", str(dst)]]
+        if i % 2 == 1:
+            argvs.append(["benchmark", str(data), *BENCH_TRACKERS, "-o", str(dst)])
+        results = run(argvs, v, dst)
+        if results is not None:
+            judge_benchmark(tally, v, dst, results, original, original_results)
+    return tally
+
+
+def test_fast_damaged_benchmark_outputs(benchmark, tmp_path):
+    """26 variants of a benchmark folder, every kind, in this process."""
+    tally = _bench_variants(benchmark, tmp_path, 26, 12, lambda a, v, d: run_case(a, 3.0))
+    assert tally.failures == []
+    assert sum(tally.counts[k] for k in ("reported by validate", "harmless (no readable "
+                                         "change)")) == 26  # fmt: skip
+    assert tally.counts["reported by validate"] >= 22
+    assert tally.counts["resumed: damaged runs recomputed, same results.json"] == 13
+
+
+@pytest.mark.slow
+def test_slow_damaged_benchmark_outputs(benchmark, tmp_path, capsys):
+    """260 variants of a benchmark folder (13 kinds x 20), each in a guarded child with a
+    120 s deadline: validate reports each, a resumed benchmark repairs it; no hang, no
+    traceback, no wrong "valid"."""
+    n = int(os.environ.get("SCENEGEN_FOLDER_DAMAGE", "260"))
+    hung: list[str] = []
+
+    def run(argvs, v, dst):
+        try:
+            return guard.call(run_case, argvs, 3.0, label=str(dst), seconds=120)
+        except guard.Unreadable as err:
+            hung.append(f"HANG: {v.name}: {err}")
+            return None
+
+    tally = _bench_variants(benchmark, tmp_path, n, 2027, run)
+    with capsys.disabled():
+        print_folder_tally("benchmark", n, tally, hung)
+    assert hung == [] and tally.failures == []

@@ -1,6 +1,7 @@
 """Benchmarking trackers over a dataset: same results on any executor, resume, the report."""
 
 import json
+import shutil
 from pathlib import Path
 
 import pytest
@@ -103,3 +104,163 @@ def test_same_results_on_a_dask_cluster(dataset, reference, tmp_path):
         run_benchmark(dataset, TRACKERS, tmp_path / "b", params=PARAMS,
                       scheduler=cluster.scheduler_address)  # fmt: skip
     assert files(tmp_path / "b") == files(reference)
+
+
+def test_validate_and_deep_find_what_each_can(dataset, reference, tmp_path, capsys):
+    from scenegen.cli import main
+    from scenegen.io.sealed import read_sealed_json, write_sealed_json
+    from scenegen.lab.benchmark import write_outputs
+    from scenegen.lab.benchmark_outputs import check_benchmark, read_record
+
+    assert main(["validate", str(reference)]) == 0
+    assert capsys.readouterr().out.strip() == f"{reference}: valid benchmark folder"
+    res = read_sealed_json(reference / "results.json")
+    assert res["dataset"]["path"] == str(dataset.resolve())
+    assert res["dataset"]["axes"] == ["clutter[0].count", "entities[a].position_noise"]
+    assert len(res["records"]) == 8 and res["records"][0].startswith("runs/sok/00000.json ")
+
+    # A score edited, the record resealed and every output rewritten from it: only the
+    # runs computed again (--deep, from the dataset results.json names) can tell.
+    out = tmp_path / "b"
+    shutil.copytree(reference, out)
+    names = [e.split(" ")[0] for e in res["records"]]
+    recs = [read_record(out / n) for n in names]
+    recs[3]["scores"]["auc"] = round(recs[3]["scores"]["auc"] / 2, 6)
+    write_sealed_json(out / names[3], recs[3])
+    write_outputs(out, res["dataset"], res["trackers"], recs)
+    assert check_benchmark(out) == []
+    assert check_benchmark(out, deep=True) == [f"{out / names[3]}: differs from the run "
+                                               "computed again"]  # fmt: skip
+    # Without the dataset, --deep says so in one line; the folder itself stays valid.
+    moved = tmp_path / "moved"
+    shutil.copytree(reference, moved)
+    doc = read_sealed_json(moved / "results.json")
+    doc["dataset"]["path"] = str(tmp_path / "nowhere")
+    write_outputs(moved, doc["dataset"], doc["trackers"],
+                  [read_record(moved / n) for n in names])  # fmt: skip
+    assert check_benchmark(moved) == []
+    (line,) = check_benchmark(moved, deep=True)
+    assert line.startswith(f"{moved / 'results.json'}: --deep needs the dataset it was "
+                           f"computed on, at {tmp_path / 'nowhere'}")  # fmt: skip
+
+
+def test_damaged_or_old_outputs_are_named_and_run_again(dataset, reference, tmp_path, capsys):
+    from scenegen.io.sealed import read_sealed_json, seal
+    from scenegen.lab.benchmark_outputs import check_benchmark, is_benchmark_folder
+
+    out = tmp_path / "b"
+    shutil.copytree(reference, out)
+    run = out / "runs" / "annealed" / "00002.json"
+    doc = read_sealed_json(run)
+    doc["scores"]["success"] = 0.0
+    run.write_text(json.dumps(seal(doc)))  # edited and correctly resealed
+    (out / "leaderboard.md").write_text("| rank |\n")
+    problems = check_benchmark(out)
+    assert problems == [f"{run}: is not the run results.json was computed from (edited or "
+                        "replaced since)"]  # fmt: skip
+    ran = []
+    run_benchmark(dataset, TRACKERS, out, params=PARAMS, jobs=1, on_done=ran.append)
+    assert [(t.tracker, t.index) for t in ran] == [("annealed", 2)]
+    assert capsys.readouterr().err.strip() == (
+        f"scenegen: warning: {run}: is not the run results.json lists (edited or replaced "
+        "since); running it again")  # fmt: skip
+    assert files(out) == files(reference) and check_benchmark(out) == []
+    # A folder written before outputs were sealed: named, with the command that redoes it.
+    old = tmp_path / "old"
+    shutil.copytree(reference, old)
+    body = read_sealed_json(old / "results.json")
+    (old / "results.json").write_text(json.dumps(body))
+    assert is_benchmark_folder(old) and not is_benchmark_folder(dataset)
+    assert check_benchmark(old) == [
+        f"{old / 'results.json'}: no sha256 digest (written by an older version of scenegen, "
+        "or edited): run the same `scenegen benchmark` command again into this folder to "
+        "recompute it"]  # fmt: skip
+    for p in (old / "runs").rglob("*.json"):
+        p.write_text(json.dumps(read_sealed_json(p)))
+    run_benchmark(dataset, TRACKERS, old, params=PARAMS, jobs=1)
+    warned = capsys.readouterr().err.splitlines()
+    assert len(warned) == 8 and all("no sha256 digest" in w for w in warned)
+    assert files(old) == files(reference)
+
+
+@pytest.mark.parametrize("page", ["scores.csv", "leaderboard.md", "index.html"])
+def test_each_page_and_figure_is_checked_against_results(reference, tmp_path, page):
+    from scenegen.lab.benchmark_outputs import check_benchmark
+
+    out = tmp_path / "b"
+    shutil.copytree(reference, out)
+    text = (out / page).read_text()
+    (out / page).write_text(text.replace("0.", "1.", 1))  # one digit
+    assert check_benchmark(out) == [f"{out / page}: is not the {page} of results.json (damaged "
+                                    "or edited: run the same `scenegen benchmark` command "
+                                    "again into this folder to recompute it)"]  # fmt: skip
+    (out / page).write_text(text)
+    figure = sorted(out.glob("curve-*.png"))[1]
+    figure.write_bytes(figure.read_bytes()[1:])
+    assert check_benchmark(out) == [f"{figure}: not a PNG file (damaged)"]
+    figure.unlink()
+    assert check_benchmark(out)[0].startswith(f"{figure}: missing (run the same")
+
+
+USER_TRACKER = '''
+from types import SimpleNamespace
+
+import numpy as np
+
+
+class Jitter:
+    """Keeps the initial boxes, moved each frame by a seeded jitter of ``jitter`` px."""
+
+    def __init__(self, jitter, rng):
+        self.sigma, self.rng = float(jitter), np.random.default_rng(rng)
+
+    def init(self, frame, boxes):
+        self.boxes = np.asarray(boxes, dtype=float).copy()
+
+    def step(self, frame):
+        b = self.boxes.copy()
+        b[:, :2] += self.rng.normal(0.0, self.sigma, (len(b), 2))
+        return SimpleNamespace(boxes=b)
+
+
+def make(jitter=1.0, rng=None):
+    return Jitter(jitter, rng)
+'''
+
+
+def test_a_users_factory_and_opencv_go_through_the_benchmark(dataset, tmp_path, capsys):
+    from scenegen.cli import main
+    from scenegen.errors import ConfigError
+    from scenegen.io.sealed import read_sealed_json
+    from scenegen.lab.benchmark_outputs import check_benchmark
+
+    mod = tmp_path / "mine.py"
+    mod.write_text(USER_TRACKER)
+    spec = f"{mod}:make"
+    one, two = tmp_path / "one", tmp_path / "two"
+    run_benchmark(dataset, [spec, "annealed"], one, params={"jitter": 2.0, **PARAMS}, jobs=1)
+    run_benchmark(dataset, [spec, "annealed"], two, params={"jitter": 2.0, **PARAMS}, jobs=2)
+    res = read_sealed_json(one / "results.json")
+    assert res["params"] == {spec: {"jitter": 2.0}, "annealed": PARAMS}
+    assert {r["tracker"] for r in res["scores"]} == {spec, "annealed"}
+    assert sorted(p.name for p in (one / "runs").iterdir()) == ["annealed", "mine.py_make"]
+    assert files(one).keys() == files(two).keys()
+    assert all(files(one)[k] == files(two)[k] for k in files(one) if k.startswith("runs/"))
+    skipped: list[str] = []
+    assert check_benchmark(one, deep=True, skipped=skipped) == [] and skipped == []
+    with pytest.raises(ConfigError, match=r"--param window: no tracker of .*mine.py:make"):
+        run_benchmark(dataset, [spec], tmp_path / "x", params={"window": 3})
+    with pytest.raises(ConfigError, match="mine.py has no attribute 'nope'"):
+        run_benchmark(dataset, [f"{mod}:nope"], tmp_path / "x")
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "sub" / "mine.py").write_text(USER_TRACKER)
+    with pytest.raises(ConfigError, match=r"would share the run folder runs/mine.py_make"):
+        run_benchmark(dataset, [spec, f"{tmp_path / 'sub' / 'mine.py'}:make"], tmp_path / "x")
+    # OpenCV's MIL through the adapter: its derived 63-bit seeds reach cv2 as C ints; it is
+    # not deterministic, so --deep does not run it again (and says how many it skipped).
+    cv = tmp_path / "cv"
+    run_benchmark(dataset, ["trackers.adapters:opencv"], cv, params={"name": "MIL"}, jobs=1)
+    assert main(["validate", str(cv), "--deep"]) == 0
+    assert capsys.readouterr().out.strip() == (
+        f"{cv}: valid benchmark folder (4 runs of trackers that are not deterministic not "
+        "run again)")  # fmt: skip

@@ -1,0 +1,325 @@
+"""The files a benchmark writes and reads back, sealed, and the check of its folder.
+
+A benchmark folder ``OUT`` (``scenegen benchmark DIR ... -o OUT``) holds one run record
+per (tracker, sequence) under ``OUT/runs/TRACKER/NNNNN.json``, ``results.json``,
+``scores.csv``, ``leaderboard.md``, ``index.html`` and PNG figures. Records and
+``results.json`` are sealed JSON documents (:mod:`scenegen.io.sealed`: a ``sha256`` key
+over the canonical content, written atomically); ``results.json`` lists under ``records``
+every run file it was computed from with that file's digest, as an experiment's does
+(:mod:`scenegen.lab.experiments.outputs`).
+
+- A resumed benchmark (:func:`load_record`) runs again, with one warning line, a record
+  that is damaged, edited, malformed or written before records were sealed, and a sealed
+  record of the same key that ``results.json`` lists with another digest (edited and
+  resealed after the results were computed).
+- :func:`check_benchmark` (``scenegen validate OUT``) checks everything but the pixels of
+  the figures: each listed record reads, matches its digest, its listed digest and its
+  file name, and has a record's fields; ``results.json`` equals the results recomputed
+  from those records and its own dataset description; ``scores.csv``, ``leaderboard.md``
+  and ``index.html`` are the texts of ``results.json``; every figure it names is a PNG
+  file. With ``deep``, every run is computed again from the dataset (found at the path
+  ``results.json`` names) and compared with its record.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+from typing import Any
+
+from scenegen.errors import DataError
+from scenegen.io.sealed import Unsealed, content_digest, read_sealed_json
+from scenegen.lab.experiments.outputs import _more, parse_listing, read_checked, warn
+
+__all__ = [
+    "RESULTS",
+    "check_benchmark",
+    "is_benchmark_folder",
+    "listed_digests",
+    "listing",
+    "load_record",
+    "read_record",
+    "read_results",
+    "record_problems",
+]
+
+RESULTS = "results.json"
+"""The benchmark's results file in its output folder."""
+_RERUN = "run the same `scenegen benchmark` command again into this folder to recompute it"
+_KEY = {"index": int, "name": str, "file": str, "seed": int, "frames_digest": str,
+        "tracker": str, "params": dict}  # fmt: skip
+_META = ("path", "family", "family_digest", "seed", "count", "description",
+         "sequence_params", "axes")  # fmt: skip
+_TOP = ("dataset", "trackers", "params", "leaderboard", "curves", "scores", "records")
+_RUN_FILE = re.compile(r"runs/[A-Za-z0-9._-]+/[0-9]{5,}\.json")
+
+
+def _is(value: Any, kind: type) -> bool:
+    return isinstance(value, kind) and not isinstance(value, bool)
+
+
+def record_problems(data: Any) -> list[str]:
+    """What is wrong with the fields of a benchmark run record (empty when none is)."""
+    from scenegen.lab.benchmark import METRICS
+
+    if not isinstance(data, dict):
+        return ["not a run record (a JSON object is expected)"]
+    out = []
+    key = data.get("key")
+    if not (isinstance(key, dict) and set(key) == set(_KEY)
+            and all(_is(key[k], kind) for k, kind in _KEY.items())):  # fmt: skip
+        out.append("key is not a benchmark run key")
+    for name in ("tracker_seed", "targets", "n_frames"):
+        if not _is(data.get(name), int):
+            out.append(f"{name} is missing or not an int")
+    scores = data.get("scores")
+    if not (isinstance(scores, dict) and set(scores) <= set(METRICS) and all(
+            v is None or _is(v, int) or _is(v, float) for v in scores.values())):  # fmt: skip
+        out.append("scores is not a dict of metrics (numbers or null)")
+    if not isinstance(data.get("sequence_params"), dict):
+        out.append("sequence_params is missing or not a dict")
+    if not isinstance(data.get("deterministic"), bool):
+        out.append("deterministic is missing or not a bool")
+    return out
+
+
+def read_record(path: Path) -> dict[str, Any]:
+    """The benchmark run record at ``path`` (without its digest).
+
+    Raises
+    ------
+    DataError
+        One line: missing, damaged, edited, written before records were sealed
+        (:class:`scenegen.io.sealed.Unsealed`), or not a run record.
+    """
+    return read_checked(path, record_problems, "a benchmark run record")
+
+
+def _run_file(key: dict[str, Any]) -> str:
+    from scenegen.lab.benchmark import run_file
+
+    return run_file(key["tracker"], key["index"])
+
+
+def listing(records: list[dict[str, Any]]) -> list[str]:
+    """The ``records`` entry of ``results.json``: ``"runs/TRACKER/NNNNN.json SHA256"`` per
+    record (as read back, without digest), in order."""
+    return [f"{_run_file(r['key'])} {content_digest(r)}" for r in records]
+
+
+def _results_problem(data: dict[str, Any]) -> str | None:
+    missing = [k for k in _TOP if k not in data]
+    if missing:
+        return f"no {missing[0]!r}"
+    meta = data["dataset"]
+    if not isinstance(meta, dict) or any(k not in meta for k in _META):
+        return "'dataset' is not a dataset description"
+    if not (isinstance(data["trackers"], list) and data["trackers"]
+            and all(isinstance(t, str) for t in data["trackers"])):  # fmt: skip
+        return "'trackers' is not a list of tracker names"
+    if parse_listing(data["records"]) is None:
+        return "'records' is not a listing of run files"
+    return None
+
+
+def read_results(path: Path) -> dict[str, Any]:
+    """The content of a benchmark's ``results.json`` (without its digest).
+
+    Raises
+    ------
+    DataError
+        One line naming the file: missing, damaged, edited, written before results were
+        sealed (with the command that recomputes it), or not a benchmark's results.
+    """
+    try:
+        data = read_sealed_json(path)
+    except Unsealed as err:
+        raise DataError(f"{err}: {_RERUN}") from None
+    problem = _results_problem(data)
+    if problem:
+        raise DataError(f"{path}: not a benchmark's results ({problem})")
+    return data
+
+
+def listed_digests(out: Path, meta: dict[str, Any]) -> dict[str, tuple[str, dict[str, Any]]]:
+    """Per run file that ``OUT/results.json`` lists: (its digest, the parameters of its
+    tracker then). Empty when there is no sound ``results.json``, or when it was computed
+    on another dataset than ``meta`` (:func:`scenegen.lab.benchmark.dataset_meta`)
+    describes (another family digest, seed or count)."""
+    try:
+        res = read_results(Path(out) / RESULTS)
+    except DataError:
+        return {}
+    if any(res["dataset"].get(k) != meta.get(k) for k in ("family_digest", "seed", "count")):
+        return {}
+    entries = parse_listing(res["records"]) or []
+    params = res["params"] if isinstance(res["params"], dict) else {}
+    out_map: dict[str, tuple[str, dict[str, Any]]] = {}
+    for (name, digest), row in zip(entries, res["scores"], strict=False):
+        tracker = row.get("tracker") if isinstance(row, dict) else None
+        out_map[name] = (digest, params.get(tracker, {}) if isinstance(tracker, str) else {})
+    return out_map
+
+
+def load_record(path: Path, task: Any, listed: tuple[str, dict[str, Any]] | None = None
+                ) -> dict[str, Any] | None:  # fmt: skip
+    """The stored record of ``task`` (a :class:`scenegen.lab.benchmark.BenchTask`) at
+    ``path``, or None when the run must be computed (again).
+
+    Damaged, edited, malformed, unsealed or another file's run; or sound, yet listed by
+    ``results.json`` (``listed``: :func:`listed_digests`' entry for the file, computed on
+    this dataset) with another digest while that listing was computed with the same
+    tracker parameters: None, with one warning line. Missing, or stored for another key
+    of the same file (other tracker parameters, another dataset): None, silently.
+    """
+    if not path.exists():
+        return None
+    try:
+        data = read_record(path)
+    except DataError as err:
+        warn(f"{err}; running it again")
+        return None
+    if _run_file(data["key"]) != task.filename():
+        warn(f"{path}: holds the run {_run_file(data['key'])!r}; running it again")
+        return None
+    if listed is not None and listed[1] == dict(task.params) and (
+            content_digest(data) != listed[0]):  # fmt: skip
+        warn(f"{path}: is not the run {RESULTS} lists (edited or replaced since); "
+             "running it again")  # fmt: skip
+        return None
+    if data["key"] != task.key():
+        return None
+    return data
+
+
+def is_benchmark_folder(folder: str | Path) -> bool:
+    """True for a folder that ``scenegen benchmark`` wrote (even a damaged one): it has
+    ``scores.csv`` or ``leaderboard.md``, or run folders under ``runs/``."""
+    root = Path(folder)
+    if not root.is_dir() or (root / "manifest.json").exists():
+        return False
+    if (root / "scores.csv").is_file() or (root / "leaderboard.md").is_file():
+        return True
+    runs = root / "runs"
+    return runs.is_dir() and any(p.is_dir() for p in runs.iterdir())
+
+
+def check_benchmark(folder: str | Path, *, deep: bool = False,
+                    skipped: list[str] | None = None) -> list[str]:  # fmt: skip
+    """Check a benchmark folder; one line per problem, empty when it is sound.
+
+    Parameters
+    ----------
+    folder : str or Path
+        A folder written by ``scenegen benchmark DIR ... -o OUT``.
+    deep : bool
+        Also run every listed run again on the dataset at the path ``results.json`` names
+        (same seeds) and compare it with its record: finds a record edited with every
+        digest recomputed. Runs of a tracker that is not deterministic (its record says
+        so) are not run again.
+    skipped : list, optional
+        With ``deep``, receives the file of every run not run again for that reason.
+
+    Returns
+    -------
+    list of str
+        Each line names the file at fault (at most a few per kind, then a count).
+    """
+    from scenegen.lab.benchmark import figure_list, results_document, texts
+
+    root = Path(folder)
+    res_path = root / RESULTS
+    try:
+        results = read_results(res_path)
+    except DataError as err:
+        return [str(err)]
+    problems: list[str] = []
+    records: list[dict[str, Any]] = []
+    for name, digest in parse_listing(results["records"]) or []:
+        path = root / name
+        if not _RUN_FILE.fullmatch(name):
+            problems.append(f"{res_path}: records names {name!r}, not a run file")
+            continue
+        try:
+            rec = read_record(path)
+        except DataError as err:
+            problems.append(str(err))
+            continue
+        if _run_file(rec["key"]) != name:
+            problems.append(f"{path}: holds the run {_run_file(rec['key'])!r}")
+        elif content_digest(rec) != digest:
+            problems.append(f"{path}: is not the run {RESULTS} was computed from (edited or "
+                            "replaced since)")  # fmt: skip
+        records.append(rec)
+    if problems:
+        return _more(problems)
+    try:
+        fresh = results_document(results["dataset"], results["trackers"], records)
+        fresh = json.loads(json.dumps(fresh, sort_keys=True))
+    except Exception as err:  # noqa: BLE001 - sound digests, yet contents no summary expects
+        return [f"{res_path}: its runs cannot be summarised ({type(err).__name__}: "
+                f"{str(err)[:80]})"]  # fmt: skip
+    changed = sorted(k for k in set(fresh) | set(results) if fresh.get(k) != results.get(k))
+    if changed:
+        verb = "differs" if len(changed) == 1 else "differ"
+        return [f"{res_path}: {', '.join(changed)} {verb} from the results of its runs "
+                f"(edited, or written by another version of scenegen: {_RERUN})"]  # fmt: skip
+    for name, text in texts(results).items():
+        path = root / name
+        try:
+            stored = path.read_text(encoding="utf-8")
+        except FileNotFoundError:
+            problems.append(f"{path}: missing ({_RERUN})")
+        except (OSError, UnicodeDecodeError) as err:
+            problems.append(f"{path}: unreadable ({type(err).__name__})")
+        else:
+            if stored != text:
+                problems.append(f"{path}: is not the {name} of {RESULTS} (damaged or edited: "
+                                f"{_RERUN})")  # fmt: skip
+    for name, _, _ in figure_list(results):
+        path = root / name
+        try:
+            with path.open("rb") as fh:
+                head = fh.read(8)
+        except OSError:
+            problems.append(f"{path}: missing ({_RERUN})")
+            continue
+        if head != b"\x89PNG\r\n\x1a\n":
+            problems.append(f"{path}: not a PNG file (damaged)")
+    if deep and not problems:
+        problems += _check_deep(root, results, records, skipped if skipped is not None else [])
+    return _more(problems)
+
+
+def _check_deep(root: Path, results: dict[str, Any], records: list[dict[str, Any]],
+                skipped: list[str]) -> list[str]:  # fmt: skip
+    """Every record against its run computed again on the dataset ``results`` names."""
+    from scenegen.datasets import read_manifest
+    from scenegen.lab.benchmark import BenchTask, run_pair
+
+    meta = results["dataset"]
+    data = Path(str(meta["path"]))
+    try:
+        man = read_manifest(data)
+    except Exception as err:  # noqa: BLE001 - any failure to read it is one line
+        return [f"{root / RESULTS}: --deep needs the dataset it was computed on, at {data} "
+                f"({str(err)[:120]})"]  # fmt: skip
+    if man.get("family_digest") != meta["family_digest"] or man.get("seed") != meta["seed"]:
+        return [f"{data}: is not the dataset {root / RESULTS} was computed on (another "
+                "family or seed)"]  # fmt: skip
+    problems = []
+    for rec in records:
+        if not rec["deterministic"]:
+            skipped.append(_run_file(rec["key"]))
+            continue
+        key = dict(rec["key"])
+        params = tuple(sorted(key.pop("params").items()))
+        task = BenchTask(str(data), params=params,
+                         sequence_params=json.dumps(rec["sequence_params"], sort_keys=True),
+                         **key)  # fmt: skip
+        again = json.loads(json.dumps(run_pair(task), sort_keys=True))
+        if again != rec:
+            problems.append(f"{root / _run_file(rec['key'])}: differs from the run computed "
+                            "again")  # fmt: skip
+    return problems
