@@ -261,6 +261,11 @@ def plan_benchmark(
             raise ConfigError(f"trackers {other!r} and {t!r} would share the run folder "
                               f"runs/{run_file(t, 0).split('/')[1]}: rename one")  # fmt: skip
     per = _check_params(trackers, dict(params or {}))
+    for t in trackers:
+        if ":" in t:  # a user's factory: built once here, so bad parameters fail first
+            from scenegen.lab.run import make_tracker
+
+            make_tracker(t, per[t], 0)
     man = read_manifest(root)
     if not man.get("complete"):
         raise ConfigError(f"{root}: the dataset is incomplete; finish it with scenegen dataset")
@@ -455,7 +460,8 @@ td:nth-child(2){{text-align:left}}figure{{display:inline-block;margin:8px}}
 img{{max-width:520px}}</style></head><body>
 <h1>Benchmark on dataset {e(str(meta["family"]))}</h1>
 <p>{e(str(meta["description"]))} — {meta["count"]} sequences, seed {meta["seed"]},
-difficulty axes: {axes}.</p>
+difficulty axes: {axes}. Dataset folder {e(str(meta["path"]))}, family digest
+{e(str(meta["family_digest"]))}.</p>
 <h2>Leaderboard</h2>
 <table><tr><th>rank</th><th>tracker</th><th>sequences</th>{head}</tr>
 {body}</table>

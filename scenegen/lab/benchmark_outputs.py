@@ -49,8 +49,9 @@ RESULTS = "results.json"
 _RERUN = "run the same `scenegen benchmark` command again into this folder to recompute it"
 _KEY = {"index": int, "name": str, "file": str, "seed": int, "frames_digest": str,
         "tracker": str, "params": dict}  # fmt: skip
-_META = ("path", "family", "family_digest", "seed", "count", "description",
-         "sequence_params", "axes")  # fmt: skip
+_META = {"path": (str,), "family": (str, type(None)), "family_digest": (str, type(None)),
+         "seed": (int,), "count": (int,), "description": (str,), "sequence_params": (list,),
+         "axes": (list,)}  # fmt: skip
 _TOP = ("dataset", "trackers", "params", "leaderboard", "curves", "scores", "records")
 _RUN_FILE = re.compile(r"runs/[A-Za-z0-9._-]+/[0-9]{5,}\.json")
 
@@ -113,8 +114,11 @@ def _results_problem(data: dict[str, Any]) -> str | None:
     if missing:
         return f"no {missing[0]!r}"
     meta = data["dataset"]
-    if not isinstance(meta, dict) or any(k not in meta for k in _META):
-        return "'dataset' is not a dataset description"
+    if not (isinstance(meta, dict) and set(meta) == set(_META) and all(
+            isinstance(meta[k], kinds) and not isinstance(meta[k], bool)
+            for k, kinds in _META.items())
+            and all(isinstance(a, str) for a in [*meta["sequence_params"], *meta["axes"]])):
+        return "'dataset' is not a dataset description"  # fmt: skip
     if not (isinstance(data["trackers"], list) and data["trackers"]
             and all(isinstance(t, str) for t in data["trackers"])):  # fmt: skip
         return "'trackers' is not a list of tracker names"

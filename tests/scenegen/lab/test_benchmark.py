@@ -259,8 +259,81 @@ def test_a_users_factory_and_opencv_go_through_the_benchmark(dataset, tmp_path, 
     # OpenCV's MIL through the adapter: its derived 63-bit seeds reach cv2 as C ints; it is
     # not deterministic, so --deep does not run it again (and says how many it skipped).
     cv = tmp_path / "cv"
+    with pytest.raises(ConfigError, match="opencv': unknown parameter 'n_(particles|layers)' "
+                       "for cv2.TrackerMIL"):
+        run_benchmark(dataset, ["trackers.adapters:opencv", "annealed"], cv,
+                      params={"name": "MIL", **PARAMS})  # fmt: skip
+    assert not (cv / "runs").exists()
     run_benchmark(dataset, ["trackers.adapters:opencv"], cv, params={"name": "MIL"}, jobs=1)
     assert main(["validate", str(cv), "--deep"]) == 0
     assert capsys.readouterr().out.strip() == (
         f"{cv}: valid benchmark folder (4 runs of trackers that are not deterministic not "
         "run again)")  # fmt: skip
+
+
+def _paths(x, prefix=()):
+    out = [prefix] if prefix else []
+    items = x.items() if isinstance(x, dict) else enumerate(x) if isinstance(x, list) else ()
+    for k, v in items:
+        out += _paths(v, (*prefix, k))
+    return out
+
+
+def _get(x, path):
+    for k in path:
+        x = x[k]
+    return x
+
+
+def _retyped(v):
+    """A value of another JSON type than ``v``."""
+    if isinstance(v, dict):
+        return [v]
+    if isinstance(v, list):
+        return {"0": v}
+    if isinstance(v, str):
+        return [v]
+    if v is None or isinstance(v, bool):
+        return {"x": v}
+    return str(v)
+
+
+def _changed(v):
+    """Another value of the same JSON type as the leaf ``v``."""
+    if isinstance(v, bool):
+        return not v
+    if isinstance(v, str):
+        return v + "x"
+    if isinstance(v, (int, float)):
+        return v + 1
+    return 0  # None
+
+
+@pytest.mark.parametrize("how", ["retyped", "changed"])
+@pytest.mark.parametrize("target", ["results.json", "runs/sok/00001.json"])
+def test_every_value_edited_and_resealed_is_one_line(reference, tmp_path, target, how):
+    # Each value of the file (any container or leaf) replaced by one of another JSON type,
+    # or each leaf by another value of its type, and the file correctly resealed: validate
+    # names the folder's file at fault in a line or two, and never raises.
+    from scenegen.io.sealed import read_sealed_json, seal
+    from scenegen.lab.benchmark_outputs import check_benchmark
+
+    body = read_sealed_json(reference / target)
+    paths = [p for p in _paths(body) if p[0] != "sha256"]
+    edit = _retyped
+    if how == "changed":
+        edit = _changed
+        paths = [p for p in paths if not isinstance(_get(body, p), (dict, list))]
+    assert len(paths) > 20
+    out = tmp_path / "b"
+    shutil.copytree(reference, out)
+    for p in paths:
+        doc = json.loads(json.dumps(body))
+        parent = doc
+        for k in p[:-1]:
+            parent = parent[k]
+        parent[p[-1]] = edit(parent[p[-1]])
+        (out / target).write_text(json.dumps(seal(doc)))
+        problems = check_benchmark(out)
+        assert 1 <= len(problems) <= 2 and all(ln.startswith(str(out)) for ln in problems), (
+            p, problems)
