@@ -170,8 +170,10 @@ def read_mot_tracker(
     Raises
     ------
     DataError
-        Naming the file and line of a malformed row, a frame out of range, or a track id
-        that appears twice in a frame.
+        Naming the file and line of a malformed row (fewer than 6 columns, a frame or id
+        that is not an integer, a box value that is not a finite number, a width or height
+        that is not positive), a frame out of range, or a track id that appears twice in a
+        frame.
     """
     p = Path(path)
     try:
@@ -192,6 +194,10 @@ def read_mot_tracker(
             if frame != int(frame) or ident != int(ident):
                 raise ValueError("frame and id must be integers")
             vals = [float(c) for c in cells[2:6]]
+            if not all(np.isfinite(vals)):
+                raise ValueError("a box value is not a finite number")
+            if vals[2] <= 0 or vals[3] <= 0:
+                raise ValueError("width and height must be positive")
         except ValueError as err:
             raise DataError(f"{p}:{n}: not a MOTChallenge row ({err}): {line[:80]!r}") from None
         if not 1 <= frame <= n_frames:

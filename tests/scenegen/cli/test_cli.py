@@ -114,3 +114,16 @@ def test_bad_files_exit_1(tmp_path, capsys, verb):
     assert code == 1 and "schema is 'other/9'" in err and "Traceback" not in err
     code, _, err = run(capsys, verb, tmp_path / "missing.h5")
     assert code == 1 and "no such file" in err
+
+
+def test_a_closed_pipe_ends_quietly_with_141():
+    # `scenegen presets | head -1`: the reader is gone before we write. No "internal
+    # error", no "Exception ignored" at exit; 141 as a shell reports SIGPIPE.
+    import subprocess
+    import sys
+
+    proc = subprocess.Popen([sys.executable, "-m", "scenegen.cli", "presets"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)  # fmt: skip
+    proc.stdout.close()  # the child holds only the write end: its first write fails
+    err = proc.stderr.read()
+    assert proc.wait(timeout=120) == 141 and err == b""

@@ -67,6 +67,16 @@ def test_bad_tracker_files_name_file_and_line(tmp_path, capsys):
     bad.write_text("99,1,2,3,4,5\n")
     code, _, err = run(capsys, "evaluate", seq_file, bad)
     assert code == 1 and "frame 99 is outside 1..14" in err
+    # A box value that is not a finite number, or a size that is not positive, is not a
+    # box (it was read as one: a NaN row as "lost", a negative width as a box).
+    for row, why in (("2,1,nan,3,4,5", "a box value is not a finite number"),
+                     ("2,1,2,inf,4,5", "a box value is not a finite number"),
+                     ("2,1,2,3,-4,5", "width and height must be positive"),
+                     ("2,1,2,3,4,0", "width and height must be positive")):  # fmt: skip
+        bad.write_text(f"1,1,2,3,4,5\n{row}\n")
+        code, _, err = run(capsys, "evaluate", seq_file, bad)
+        assert code == 1 and err.strip() == (f"scenegen: error: {bad}:2: not a MOTChallenge "
+                                             f"row ({why}): {row!r}")  # fmt: skip
     code, _, err = run(capsys, "evaluate", seq_file, bad, "--gt-mode", "visible",
                        "--visibility-threshold", "1.5")  # fmt: skip
     assert code == 2
