@@ -257,6 +257,10 @@ def cmd_validate(args: argparse.Namespace) -> int:
         if not problems:
             print(f"{folder}: valid {'report' if report else 'experiment'} folder")
         return 1 if problems else 0
+    if folder.is_dir() and not (folder / "manifest.json").exists():
+        print(f"{folder}: not a scenegen folder (no manifest.json of a dataset, results.json "
+              "of an experiment, report or benchmark, or runs/)", file=sys.stderr)  # fmt: skip
+        return 1
     if folder.is_dir():  # a dataset folder (scenegen dataset): every shard and digest
         from scenegen.cli.dataset import cmd_validate_dataset
 

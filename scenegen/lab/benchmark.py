@@ -515,6 +515,14 @@ def run_benchmark(
     -------
     dict
         What ``results.json`` holds (:func:`results_document`).
+
+    Raises
+    ------
+    ConfigError
+        As :func:`plan_benchmark`; a bad ``jobs`` or an unreachable scheduler; ``out``
+        holding a dataset (its ``manifest.json``).
+    DataError
+        ``dataset`` is not a dataset folder, or a shard is damaged.
     """
     from tqdm import tqdm
 
@@ -527,6 +535,10 @@ def run_benchmark(
     if scheduler is not None:
         probe(scheduler)  # fail before writing anything
     outp = Path(out)
+    if (outp / "manifest.json").exists():
+        what = "the dataset folder" if outp.resolve() == root.resolve() else "a dataset folder"
+        raise ConfigError(f"-o {outp}: is {what} (manifest.json); write the benchmark into "
+                          "another folder")  # fmt: skip
     outp.mkdir(parents=True, exist_ok=True)
     meta = dataset_meta(man, root)
     listed = listed_digests(outp, meta)

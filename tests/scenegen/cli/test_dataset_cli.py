@@ -80,3 +80,11 @@ def test_unreachable_scheduler_exits_2_and_writes_nothing(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "cannot reach the Dask scheduler at 'tcp://127.0.0.1:9'" in err and err.count("\n") == 1
     assert not out.exists()
+
+
+def test_validate_an_unknown_folder_says_what_it_looked_for(tmp_path, capsys):
+    (tmp_path / "notes.txt").write_text("x")
+    assert main(["validate", str(tmp_path)]) == 1
+    assert capsys.readouterr().err.strip() == (
+        f"{tmp_path}: not a scenegen folder (no manifest.json of a dataset, results.json of "
+        "an experiment, report or benchmark, or runs/)")  # fmt: skip

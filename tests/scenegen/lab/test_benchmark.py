@@ -250,6 +250,8 @@ def test_a_users_factory_and_opencv_go_through_the_benchmark(dataset, tmp_path, 
     assert check_benchmark(one, deep=True, skipped=skipped) == [] and skipped == []
     with pytest.raises(ConfigError, match=r"--param window: no tracker of .*mine.py:make"):
         run_benchmark(dataset, [spec], tmp_path / "x", params={"window": 3})
+    with pytest.raises(ConfigError, match=r"is the dataset folder \(manifest.json\); write"):
+        run_benchmark(dataset, [spec], dataset)
     with pytest.raises(ConfigError, match="mine.py has no attribute 'nope'"):
         run_benchmark(dataset, [f"{mod}:nope"], tmp_path / "x")
     (tmp_path / "sub").mkdir()
