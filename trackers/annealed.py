@@ -27,7 +27,13 @@ from trackers.meanshift import (
     window_boxes,
 )
 from trackers.models.observation import FrameObservation
-from trackers.params import check_choice, check_integer, check_number
+from trackers.params import (
+    TrackerParams,
+    check_choice,
+    check_integer,
+    check_number,
+    check_particle_count,
+)
 
 __all__ = [
     "ESTIMATES",
@@ -129,14 +135,18 @@ def resample_targets(particles: NDArray[np.float64], weights: NDArray[np.float64
     return particles.reshape(k * n, -1)[idx].reshape(particles.shape)
 
 
-def check_particles(n_particles: int, lam: float, resampler: str) -> None:
-    """Raise ``ValueError`` for a particle count below 1, λ <= 0 or an unknown resampler."""
-    if int(n_particles) != n_particles or n_particles < 1:
-        raise ValueError(f"n_particles must be an integer >= 1, got {n_particles!r}")
-    if not (np.isfinite(lam) and lam > 0.0):
-        raise ValueError(f"lam must be a finite number > 0, got {lam!r}")
-    if resampler not in RESAMPLERS:
-        raise ValueError(f"unknown resampler {resampler!r}; valid: {', '.join(RESAMPLERS)}")
+def check_particles(params: TrackerParams) -> None:
+    """Check and store ``n_particles`` (:func:`trackers.params.check_particle_count`),
+    ``lam`` (finite, > 0) and ``resampler`` (one of ``RESAMPLERS``) of ``params``.
+
+    Raises
+    ------
+    ValueError
+        One line naming the parameter and its value.
+    """
+    check_particle_count(params)
+    check_number(params, "lam", low=0.0, low_open=True)
+    check_choice(params, "resampler", RESAMPLERS)
 
 
 @dataclass(frozen=True)
@@ -159,9 +169,7 @@ class AnnealedParams(ColourParams):
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        check_particles(self.n_particles, self.lam, self.resampler)
-        self._set("n_particles", int(self.n_particles))
-        self._set("lam", float(self.lam))
+        check_particles(self)
         check_integer(self, "n_layers", low=1)
         check_choice(self, "schedule", SCHEDULES)
         check_choice(self, "estimate", ESTIMATES)

@@ -36,9 +36,7 @@ class HybridParams(MeanShiftParams):
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        check_particles(self.n_particles, self.lam, self.resampler)
-        self._set("n_particles", int(self.n_particles))
-        self._set("lam", float(self.lam))
+        check_particles(self)
         check_number(self, "sigma", low=0.0)
 
 

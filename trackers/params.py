@@ -13,7 +13,7 @@ written once, in the dataclass::
     >>> DPSParams(n_particles=0)
     Traceback (most recent call last):
     ...
-    ValueError: n_particles must be an integer >= 1, got 0
+    ValueError: n_particles must be an integer in [1, 1000000], got 0
 
 Each dataclass checks each of its fields once, in ``__post_init__``; an error is one line
 that names the parameter and the bad value. Integer fields given as integral floats
@@ -30,7 +30,18 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["TrackerParams", "check_choice", "check_integer", "check_number"]
+__all__ = [
+    "MAX_PARTICLES",
+    "TrackerParams",
+    "check_choice",
+    "check_integer",
+    "check_number",
+    "check_particle_count",
+]
+
+MAX_PARTICLES = 1_000_000
+"""Largest ``n_particles`` of any tracker. The papers use 40 to 600; the bound makes a
+mistyped count fail at once (``n_particles=1e9`` took 24 GB of memory before it failed)."""
 
 
 @dataclass(frozen=True)
@@ -87,6 +98,17 @@ def check_integer(params: TrackerParams, name: str, *, low: int | None = None,
         none = " or None" if optional else ""
         raise ValueError(f"{name} must be {what}{none}, got {value!r}")
     params._set(name, int(value))
+
+
+def check_particle_count(params: TrackerParams) -> None:
+    """Check ``n_particles``: an integer in [1, :data:`MAX_PARTICLES`], stored as ``int``.
+
+    Raises
+    ------
+    ValueError
+        ``"n_particles must be an integer in [1, 1000000], got <value>"``.
+    """
+    check_integer(params, "n_particles", low=1, high=MAX_PARTICLES)
 
 
 def check_number(params: TrackerParams, name: str, *, low: float | None = None,

@@ -85,7 +85,13 @@ from trackers.models.observation import (
     FrameLikelihood,
     ObservationModel,
 )
-from trackers.params import TrackerParams, check_choice, check_integer, check_number
+from trackers.params import (
+    TrackerParams,
+    check_choice,
+    check_integer,
+    check_number,
+    check_particle_count,
+)
 
 __all__ = [
     "ASSIGNMENTS",
@@ -169,7 +175,7 @@ class ParticleParams(TrackerParams):
     observation: ObservationModel | None = None
 
     def __post_init__(self) -> None:
-        check_integer(self, "n_particles", low=1)
+        check_particle_count(self)
         check_number(self, "lam", low=0.0, low_open=True)
         check_choice(self, "model", MODELS, what="observation model")
         check_integer(self, "bins", low=1, high=256)

@@ -21,10 +21,13 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def cmd_bench(args: argparse.Namespace) -> int:
     from scenegen.errors import ConfigError
-    from scenegen.lab.bench import format_table, run_all
+    from scenegen.lab.bench import MODULES, format_table, run_all
 
     if args.repeats < 1:
         raise ConfigError(f"--repeats must be >= 1, got {args.repeats}")
+    if args.only is not None and not any(args.only in name for name in MODULES):
+        short = ", ".join(name.rsplit(".", 1)[-1] for name in MODULES)
+        raise ConfigError(f"--only {args.only!r} matches no bench module; modules: {short}")
     rows = run_all(args.repeats, only=args.only, log=lambda m: print(m, file=sys.stderr))
     if args.figure is not None and any(r.params.get("axis") for r in rows):
         from scenegen.lab.bench.scaling import write_figure

@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from scenegen import presets
+from scenegen.cli.options import seed_arg
 from scenegen.cli.progress import bar
 from scenegen.errors import ConfigError, DataError
 
@@ -24,7 +25,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--preset", help="preset name (see `scenegen presets`)")
     src.add_argument("--config", type=Path, help="scenario config, .yaml or .json")
-    p.add_argument("--seed", type=int, default=None, help="random seed (default: fresh)")
+    p.add_argument("--seed", type=seed_arg, default=None, help="random seed (default: fresh)")
     p.add_argument("-o", "--output", type=Path, required=True, help="output .h5 file")
     p.add_argument("--frames", type=int, default=None, help="override the frame count")
     p.add_argument("--compression", default="gzip", help="gzip | lzf | none (default gzip)")
@@ -124,8 +125,6 @@ def cmd_generate(args: argparse.Namespace) -> int:
         raise ConfigError(
             f"--compression must be one of {', '.join(COMPRESSIONS)}; got {args.compression!r}"
         )
-    if args.seed is not None and args.seed < 0:
-        raise ConfigError(f"--seed must be >= 0, got {args.seed}")
     cfg, preset = load_source(args.preset, args.config)
     if args.frames is not None:
         if args.frames < 1:

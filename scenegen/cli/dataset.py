@@ -6,6 +6,8 @@ import argparse
 import sys
 from pathlib import Path
 
+from scenegen.cli.options import seed_arg
+
 __all__ = ["cmd_dataset", "cmd_validate_dataset", "register"]
 
 
@@ -23,7 +25,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("family", help="family file, built-in family or preset")
     p.add_argument("-o", "--output", type=Path, required=True, help="dataset folder DIR")
     p.add_argument("--count", type=int, default=None, help="sequences (default: the family's)")
-    p.add_argument("--seed", type=int, default=None, help="base seed (default: the family's)")
+    p.add_argument("--seed", type=seed_arg, default=None, help="base seed (default: the family's)")
     p.add_argument("--frames", type=int, default=None,
                    help="override every sequence's frame count")  # fmt: skip
     where = p.add_mutually_exclusive_group()

@@ -9,6 +9,8 @@ import sys
 import time
 from pathlib import Path
 
+from scenegen.cli.options import seed_arg
+
 __all__ = ["register"]
 
 
@@ -16,7 +18,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("demo", help="generate every preset, run the experiments, write a report")
     p.add_argument("-o", "--output", type=Path, default=Path("report"), help="report folder")
     p.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="worker processes")
-    p.add_argument("--seed", type=int, default=0, help="seed of the preset sequences")
+    p.add_argument("--seed", type=seed_arg, default=0, help="seed of the preset sequences")
     p.set_defaults(func=cmd_demo)
 
 

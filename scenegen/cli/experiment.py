@@ -7,6 +7,8 @@ import argparse
 import sys
 from pathlib import Path
 
+from scenegen.cli.options import seed_arg
+
 __all__ = ["cmd_experiment", "parse_overrides", "register"]
 
 
@@ -29,7 +31,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     where.add_argument("--jobs", type=int, default=None, help="local processes (default: all)")
     where.add_argument("--scheduler", default=None, metavar="ADDRESS",
                        help="dask.distributed scheduler address, e.g. tcp://host:8786")
-    p.add_argument("--seed", type=int, default=0, help="base seed (default 0)")
+    p.add_argument("--seed", type=seed_arg, default=0, help="base seed (default 0)")
     p.add_argument("--method", action="append", default=None, metavar="NAME",
                    help="run only this method (repeatable; not with `all`)")
     p.add_argument("--param", action="append", default=None, metavar="KEY=VALUE",

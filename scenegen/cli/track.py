@@ -8,6 +8,7 @@ import os
 from pathlib import Path
 from typing import Any
 
+from scenegen.cli.options import seed_arg
 from scenegen.cli.progress import bar
 from scenegen.errors import ConfigError
 
@@ -35,7 +36,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--tracker", required=True, metavar="NAME|MODULE:FACTORY",
         help=f"one of: {names}; or a user's factory MODULE:FACTORY",
     )  # fmt: skip
-    p.add_argument("--seed", type=int, default=0, help="tracker random seed (default 0)")
+    p.add_argument("--seed", type=seed_arg, default=0, help="tracker random seed (default 0)")
     p.add_argument(
         "--param", action="append", default=[], metavar="KEY=VALUE",
         help="tracker parameter; VALUE is read as JSON when it parses, else as a string",
@@ -77,8 +78,6 @@ def cmd_track(args: argparse.Namespace) -> int:
     from scenegen.io.validate import require_valid
     from scenegen.lab.run import run_tracker, tracker_label
 
-    if args.seed < 0:
-        raise ConfigError(f"--seed must be >= 0, got {args.seed}")
     params = parse_params(args.param)
     require_valid(args.file)  # no computing on a damaged or inconsistent file
     check_writable(args.output)

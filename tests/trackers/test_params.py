@@ -65,7 +65,13 @@ def test_unknown_keyword_is_a_type_error_naming_it():
 @pytest.mark.parametrize(
     "name, params, message",
     [
-        ("dps", {"n_particles": 0}, "n_particles must be an integer >= 1, got 0"),
+        ("dps", {"n_particles": 0}, r"n_particles must be an integer in \[1, 1000000\], got 0"),
+        ("dps", {"n_particles": 10**9}, r"must be an integer in \[1, 1000000\], got 1000000000"),
+        ("annealed", {"n_particles": "abc"}, r"n_particles must be an integer in \[1, 1000000\], "
+                                             "got 'abc'"),
+        ("hybrid", {"n_particles": 1e9}, r"n_particles must be an integer in \[1, 1000000\]"),
+        ("kams", {"lam": "x"}, "lam must be finite and > 0, got 'x'"),
+        ("hybrid", {"resampler": "best"}, "unknown resampler 'best'; valid: multinomial"),
         ("dps", {"n_groups": 301}, r"n_groups must be an integer in \[1, 300\] or None"),
         ("ps", {"ordering": -1}, "ordering must be a circular shift >= 0"),
         ("condensation", {"lam": -1.0}, "lam must be finite and > 0"),

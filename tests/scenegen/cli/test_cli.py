@@ -127,3 +127,32 @@ def test_a_closed_pipe_ends_quietly_with_141():
     proc.stdout.close()  # the child holds only the write end: its first write fails
     err = proc.stderr.read()
     assert proc.wait(timeout=120) == 141 and err == b""
+
+
+@pytest.mark.parametrize("verb", [["generate", "--preset", "kams-a", "-o", "x.h5"],
+                                  ["track", "x.h5", "--tracker", "kams", "-o", "r.h5"],
+                                  ["dataset", "kams", "-o", "d"], ["demo", "-o", "d"],
+                                  ["experiment", "shm-depth", "-o", "e"]])  # fmt: skip
+@pytest.mark.parametrize("value", ["-1", "9223372036854775808", "3.5", "x"])
+def test_every_seed_option_takes_0_to_2_63_minus_1(verb, value, capsys):
+    # Larger seeds ended in an internal error when written (a 64-bit attribute); every
+    # verb's --seed is the same argument type, and a bad one is a usage error.
+    assert main([*verb, "--seed", value]) == 2
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert err.endswith(f"error: argument --seed: must be an integer in [0, 2**63 - 1], got "
+                        f"{value!r}")  # fmt: skip
+
+
+def test_the_largest_seed_is_written_and_read_back(tmp_path):
+    out = tmp_path / "g.h5"
+    assert main(["generate", "--preset", "kams-a", "--frames", "2", "--seed",
+                 str(2**63 - 1), "-o", str(out)]) == 0  # fmt: skip
+    assert read(out).seed == 2**63 - 1
+
+
+def test_bench_only_that_matches_nothing_is_a_usage_error(capsys):
+    # It printed an empty table and exited 0.
+    assert main(["bench", "--only", "nothing", "--repeats", "1"]) == 2
+    assert capsys.readouterr().err.strip() == (
+        "scenegen: error: --only 'nothing' matches no bench module; modules: generation, "
+        "particle, stepshare, meanshift, shm, reliability, scaling, datasets")  # fmt: skip
