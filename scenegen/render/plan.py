@@ -50,12 +50,23 @@ def entity_rng(seed: int, name: str, *extra: int) -> np.random.Generator:
     return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(_key(name), *extra)))
 
 
+MAX_SEED = 2**64 - 1
+"""Largest scene seed: a file stores it as a 64-bit unsigned integer."""
+
+
 def resolve_seed(seed: int | np.integer | None) -> int:
-    """A non-negative int seed; ``None`` draws a fresh one from the OS."""
+    """An int seed in [0, :data:`MAX_SEED`]; ``None`` draws a fresh one from the OS.
+
+    Raises
+    ------
+    ConfigError
+        ``"seed must be an integer in [0, 2**64 - 1], got <seed>"``.
+    """
     if seed is None:
         return int(np.random.SeedSequence().generate_state(1, dtype=np.uint64)[0] >> 1)
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise ConfigError(f"seed must be a non-negative integer, got {_short(seed)}")
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not (
+            0 <= seed <= MAX_SEED):  # fmt: skip
+        raise ConfigError(f"seed must be an integer in [0, 2**64 - 1], got {_short(seed)}")
     return int(seed)
 
 
