@@ -1,12 +1,13 @@
 """Errors a user can cause. Each carries one line that names the field or value at fault.
 
-The CLI maps :class:`ConfigError` (bad usage, bad config, bad parameter) to exit code 2 and
-:class:`DataError` (an invalid or mismatched data file, a failed check) to exit code 1.
+The CLI maps :class:`ConfigError` (bad usage, bad config, bad parameter) to exit code 2,
+:class:`DataError` (an invalid or mismatched data file, a failed check) and
+:class:`TrackerError` (a user's tracker raised) to exit code 1.
 """
 
 from __future__ import annotations
 
-__all__ = ["ConfigError", "DataError"]
+__all__ = ["ConfigError", "DataError", "TrackerError"]
 
 
 class ConfigError(ValueError):
@@ -15,3 +16,9 @@ class ConfigError(ValueError):
 
 class DataError(ValueError):
     """An invalid, damaged or mismatched data file; the message names the file and problem."""
+
+
+class TrackerError(RuntimeError):
+    """A user's tracker (a factory, not one of ours) raised while it ran; the message names
+    the tracker, the sequence, how far it got and its exception (the original is the
+    ``__cause__``)."""

@@ -11,7 +11,7 @@ import argparse
 import sys
 from collections.abc import Sequence
 
-from scenegen.errors import ConfigError, DataError
+from scenegen.errors import ConfigError, DataError, TrackerError
 
 __all__ = ["main"]
 
@@ -76,7 +76,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             raise
         print(f"scenegen: error: {err}", file=sys.stderr)
         return 2
-    except DataError as err:
+    except (DataError, TrackerError) as err:
         if debug:
             raise
         print(f"scenegen: error: {err}", file=sys.stderr)

@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from scenegen.errors import ConfigError, DataError
+from scenegen.errors import ConfigError, DataError, TrackerError
 from scenegen.io import TrackerResult
 
 __all__ = ["Run", "make_tracker", "resolve_factory", "run", "run_tracker", "tracker_label"]
@@ -198,6 +198,9 @@ def run(
         If no target is present at frame 0, or the file is damaged.
     ConfigError
         If the tracker rejects its parameters or the scene (a ``ValueError``).
+    TrackerError
+        If a user's tracker (a factory or spec, not one of ours) raises anything else
+        while it runs.
     """
     import numba
 
@@ -211,13 +214,30 @@ def run(
     previous = numba.get_num_threads()
     if single_thread:
         numba.set_num_threads(1)
+    done = [0]  # steps completed, for the message of a user's tracker that raises
+
+    def step_done(t: int) -> None:
+        done[0] = t
+        if progress is not None:
+            progress(t)
+
+    tracker = None
     try:
         tracker = make_tracker(name, params, seed)
-        out = trackers.track(tracker, seq.frames, init, progress=progress)
+        out = trackers.track(tracker, seq.frames, init, progress=step_done)
     except DataError:
         raise  # a damaged file (DataError is a ValueError): exit 1, not 2
     except ValueError as err:
         raise ConfigError(str(err)) from None
+    except Exception as err:
+        if tracker is None or (isinstance(name, str) and ":" not in name):
+            raise  # ours: a bug to report, with its traceback
+        first = str(err).strip().splitlines()[0] if str(err).strip() else ""
+        raise TrackerError(
+            f"tracker {tracker_label(name)!r} failed on sequence {seq.name!r} after "
+            f"{done[0]} of {len(seq.frames) - 1} steps: {type(err).__name__}: {first[:200]}"
+            " (rerun with --debug for its traceback)"
+        ) from err
     finally:
         numba.set_num_threads(previous)
     orderings = getattr(tracker, "orderings", None)

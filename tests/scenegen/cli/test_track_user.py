@@ -39,6 +39,16 @@ USER_MODULE = textwrap.dedent(
 
     def broken():
         return object()
+
+    class Fails(Still):
+        def step(self, frame):
+            self.n = getattr(self, "n", 0) + 1
+            if self.n == 3:
+                raise RuntimeError("lost my way")
+            return super().step(frame)
+
+    def fails():
+        return Fails()
     """
 )
 
@@ -107,3 +117,18 @@ def test_track_help_lists_the_tracker_names(capsys):
     import trackers
 
     assert all(name in out for name in trackers.names()) and "MODULE:FACTORY" in out
+
+
+def test_a_users_tracker_that_raises_is_one_line_naming_it(user_dir, monkeypatch, capsys):
+    # It was "internal error: RuntimeError: ..." as if scenegen had failed.
+    from scenegen.errors import TrackerError
+
+    monkeypatch.chdir(user_dir)
+    assert main(["track", "seq.h5", "--tracker", "usertrk:fails", "-o", "r2.h5"]) == 1
+    assert capsys.readouterr().err.strip() == (
+        "scenegen: error: tracker 'usertrk:fails' failed on sequence 'kams-a' after 2 of 3 "
+        "steps: RuntimeError: lost my way (rerun with --debug for its traceback)")  # fmt: skip
+    assert not (user_dir / "r2.h5").exists()
+    with pytest.raises(TrackerError) as info:
+        main(["--debug", "track", "seq.h5", "--tracker", "usertrk:fails", "-o", "r2.h5"])
+    assert isinstance(info.value.__cause__, RuntimeError)
