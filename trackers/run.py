@@ -71,6 +71,13 @@ def estimate_boxes(tracker: Any, estimate: Any, n_targets: int, frame: int) -> N
             f"{_label(tracker)}.step() at frame {frame}: .boxes holds inf "
             "(the protocol: finite, or NaN for a lost target)"
         )
+    mixed = np.isnan(boxes).any(axis=1) & ~np.isnan(boxes).all(axis=1)
+    if mixed.any():
+        j = int(np.flatnonzero(mixed)[0])
+        raise ValueError(
+            f"{_label(tracker)}.step() at frame {frame}: box {j} is {boxes[j].tolist()} "
+            "(the protocol: a row is finite, or all NaN for a lost target)"
+        )
     return boxes
 
 
@@ -150,7 +157,12 @@ def track(
         est = tracker.step(frames[t])
         boxes[t] = estimate_boxes(tracker, est, k, t)
         extras = getattr(est, "extras", None)
-        per_frame.append(dict(extras) if isinstance(extras, dict) else {})
+        # Copied now: a tracker may hand back the same buffer every frame.
+        per_frame.append(
+            {k: np.array(v, copy=True) for k, v in extras.items()}
+            if isinstance(extras, dict)
+            else {}
+        )
         if progress is not None:
             progress(t)
     return TrackResult(boxes=boxes, extras=_stack_extras(tracker, per_frame, n))

@@ -59,6 +59,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run the CLI; returns the exit code (also used as the console script)."""
     args_list = list(sys.argv[1:] if argv is None else argv)
     debug = "--debug" in args_list
+    # --debug is taken anywhere (the error lines say "rerun with --debug"), not only
+    # before the verb.
+    args_list = [a for a in args_list if a != "--debug"]
     parser = _parser()
     try:
         args = parser.parse_args(args_list)

@@ -61,6 +61,36 @@ class TrackerResult:
     orderings: NDArray[np.int16] | None = None
     order_prob: NDArray[np.float32] | None = None
 
+    def problems(self) -> list[str]:
+        """What keeps this result from being written: shapes that disagree (``boxes``
+        (T, M, 4) with M ``target_ids``; ``orderings`` (L, M) of positions 0..M-1 and
+        ``order_prob`` (T, L), both or neither) and box rows neither finite nor all NaN.
+        Empty if none."""
+        out: list[str] = []
+        ids, boxes = np.asarray(self.target_ids), np.asarray(self.boxes)
+        if ids.ndim != 1:
+            return [f"target_ids has shape {ids.shape}, expected (M,)"]
+        m = ids.shape[0]
+        if boxes.ndim != 3 or boxes.shape[1:] != (m, 4):
+            return [f"boxes has shape {boxes.shape}, expected (T, {m}, 4)"]
+        if (~(np.isfinite(boxes).all(axis=-1) | np.isnan(boxes).all(axis=-1))).any():
+            out.append("boxes has rows that are neither finite nor all NaN (a lost target)")
+        if (self.orderings is None) != (self.order_prob is None):
+            return ["orderings and order_prob must come together"]
+        if self.orderings is None:
+            return out
+        orderings, prob = np.asarray(self.orderings), np.asarray(self.order_prob)
+        if orderings.ndim != 2 or orderings.shape[1] != m:
+            return [f"orderings has shape {orderings.shape}, expected (L, {m})"]
+        if orderings.size and (orderings.min() < 0 or orderings.max() >= m):
+            out.append(f"orderings name positions outside 0..{m - 1}")
+        if prob.shape != (boxes.shape[0], orderings.shape[0]):
+            out.append(
+                f"order_prob has shape {prob.shape}, expected "
+                f"({boxes.shape[0]}, {orderings.shape[0]}) (T frames, L orderings)"
+            )
+        return out
+
 
 def write_result(path: str | Path, *results: TrackerResult) -> None:
     """Write tracker results to a result file (atomically), one group per tracker.
@@ -74,10 +104,14 @@ def write_result(path: str | Path, *results: TrackerResult) -> None:
     Raises
     ------
     ConfigError
-        No result, two results of one tracker, or a missing folder.
+        No result, two results of one tracker, a result whose shapes disagree
+        (:meth:`TrackerResult.problems`), or a missing folder.
     """
     if not results:
         raise ConfigError("write_result needs at least one result")
+    for r in results:
+        if bad := r.problems():
+            raise ConfigError(f"result of tracker {r.tracker!r}: {bad[0]}")
     with atomic_path(path) as tmp, h5py.File(tmp, "w", **_WRITE_OPTIONS) as f:
         _write_header(f)
         root = f.create_group("results")

@@ -482,6 +482,15 @@ def _check_results(p: Path, root: h5py.Group) -> list[str]:
                 problems.append(f"{where}: {key} has dtype {ds.dtype}, expected {np.dtype(dtype)}")
         data, unreadable = _read_small(where, g, list(expect))
         problems += unreadable
+        boxes = data.get("boxes")
+        if boxes is not None and boxes.ndim == 3 and boxes.shape[-1] == 4:
+            # The protocol: a row is a box (finite) or a lost target (all NaN).
+            mixed = ~(np.isfinite(boxes).all(axis=-1) | np.isnan(boxes).all(axis=-1))
+            if mixed.any():
+                problems.append(
+                    f"{where}: boxes has rows that are neither finite nor all NaN at frames "
+                    f"{_frames(np.flatnonzero(mixed.any(axis=1)).tolist())}"
+                )
         orderings = data.get("orderings")
         if (
             orderings is not None

@@ -76,6 +76,9 @@ def resolve_factory(spec: str) -> Callable[..., Any]:
             if not path.is_file():
                 raise ConfigError(f"tracker {spec!r}: no such file {module_name}")
             name = f"scenegen_user_tracker_{path.stem}"
+            folder = str(path.resolve().parent)  # its sibling modules import, as with python FILE
+            if folder not in sys.path:
+                sys.path.insert(0, folder)
             loader_spec = importlib.util.spec_from_file_location(name, path)
             assert loader_spec is not None and loader_spec.loader is not None
             module = importlib.util.module_from_spec(loader_spec)
@@ -96,7 +99,11 @@ def resolve_factory(spec: str) -> Callable[..., Any]:
     obj: Any = module
     for part in attr.split("."):
         if not hasattr(obj, part):
-            raise ConfigError(f"tracker {spec!r}: {module_name} has no attribute {attr!r}")
+            where = getattr(module, "__file__", None)
+            raise ConfigError(
+                f"tracker {spec!r}: {module_name} has no attribute {attr!r}"
+                + (f" (imported from {where})" if where else "")
+            )
         obj = getattr(obj, part)
     if not callable(obj):
         raise ConfigError(f"tracker {spec!r}: {attr} is not callable ({type(obj).__name__})")
@@ -137,11 +144,17 @@ def make_tracker(tracker: TrackerSpec, params: dict[str, Any], seed: int) -> Any
     Raises
     ------
     ConfigError
-        For an unknown name or parameter, a factory that fails, or an object that is not
-        a tracker (naming what it lacks).
+        For an unknown name or parameter (a ``TypeError`` or ``ValueError`` of the
+        factory), or an object that is not a tracker (naming what it lacks).
+    TrackerError
+        If a user's factory raises anything else.
     """
     import trackers
 
+    if "rng" in params:
+        raise ConfigError(
+            "parameter 'rng': the tracker's seed is given by the seed (--seed), not as a parameter"
+        )
     if isinstance(tracker, str) and ":" not in tracker:
         try:
             return trackers.make(tracker, rng=seed, **params)
@@ -156,6 +169,11 @@ def make_tracker(tracker: TrackerSpec, params: dict[str, Any], seed: int) -> Any
         obj = factory(**kwargs)
     except (TypeError, ValueError) as err:
         raise ConfigError(f"tracker {label!r}: {err}") from None
+    except Exception as err:  # the user's factory failed for its own reasons
+        raise TrackerError(
+            f"tracker {label!r} failed while being built: {type(err).__name__}: "
+            f"{_first_line(err)} (rerun with --debug for its traceback)"
+        ) from err
     if not isinstance(obj, trackers.Tracker):
         missing = [m for m in ("init", "step") if not callable(getattr(obj, m, None))]
         raise ConfigError(
@@ -221,42 +239,83 @@ def run(
         if progress is not None:
             progress(t)
 
-    tracker = None
+    ours = isinstance(name, str) and ":" not in name
     try:
         tracker = make_tracker(name, params, seed)
         out = trackers.track(tracker, seq.frames, init, progress=step_done)
-    except DataError:
-        raise  # a damaged file (DataError is a ValueError): exit 1, not 2
+    except (DataError, ConfigError, TrackerError):
+        raise  # a damaged file (exit 1), bad parameters (2), a user's factory failed (1)
     except ValueError as err:
-        raise ConfigError(str(err)) from None
+        if ours:
+            raise ConfigError(str(err)) from None  # ours rejects its parameters or the scene
+        raise _failed(name, seq, done[0], err) from err
     except Exception as err:
-        if tracker is None or (isinstance(name, str) and ":" not in name):
+        if ours:
             raise  # ours: a bug to report, with its traceback
-        first = str(err).strip().splitlines()[0] if str(err).strip() else ""
-        raise TrackerError(
-            f"tracker {tracker_label(name)!r} failed on sequence {seq.name!r} after "
-            f"{done[0]} of {len(seq.frames) - 1} steps: {type(err).__name__}: {first[:200]}"
-            " (rerun with --debug for its traceback)"
-        ) from err
+        raise _failed(name, seq, done[0], err) from err
     finally:
         numba.set_num_threads(previous)
+    result = _result(seq, name, params, seed, tracker, out)
+    return Run(result=result, targets=targets, extras=out.extras, tracker=tracker)
+
+
+def _first_line(err: BaseException) -> str:
+    text = str(err).strip()
+    return text.splitlines()[0][:200] if text else ""
+
+
+def _failed(name: TrackerSpec, seq: Any, done: int, err: BaseException) -> TrackerError:
+    """The one line for a user's tracker that raised (or broke the protocol) while it ran."""
+    return TrackerError(
+        f"tracker {tracker_label(name)!r} failed on sequence {seq.name!r} after "
+        f"{done} of {len(seq.frames) - 1} steps: {type(err).__name__}: {_first_line(err)}"
+        " (rerun with --debug for its traceback)"
+    )
+
+
+def _result(
+    seq: Any, name: TrackerSpec, params: dict[str, Any], seed: int, tracker: Any, out: Any
+) -> TrackerResult:
+    """The :class:`TrackerResult` of a run, its depth-order outputs checked.
+
+    Raises
+    ------
+    TrackerError
+        If a tracker's ``orderings`` or ``order_prob`` are not what a result file holds.
+    """
+    targets = seq.initial_targets(0)
+    label = tracker_label(name)
     orderings = getattr(tracker, "orderings", None)
     order_prob = out.extras.get("order_prob")
-    if order_prob is not None:
-        order_prob = order_prob.copy()
-        # Frame 0 is the initialisation: every ordering equally likely.
-        order_prob[0] = 1.0 / order_prob.shape[1]
+    if orderings is None or order_prob is None:
+        # Stored together or not at all (a one-frame sequence has no step, no order_prob).
+        orderings = order_prob = None
+    try:
+        if orderings is not None:
+            orderings = np.asarray(orderings, dtype=np.int16)
+        if order_prob is not None:
+            order_prob = np.array(order_prob, dtype=np.float32)
+            if order_prob.ndim == 2:
+                # Frame 0 is the initialisation: every ordering equally likely.
+                order_prob[0] = 1.0 / order_prob.shape[1]
+    except (TypeError, ValueError) as err:
+        raise TrackerError(
+            f"tracker {label!r}: orderings and order_prob must be numeric arrays: "
+            f"{_first_line(err)}"
+        ) from None
     result = TrackerResult(
-        tracker=tracker_label(name),
+        tracker=label,
         params=params,
         seed=seed,
         sequence=seq.name,
         target_ids=seq.entities.id[targets],
         boxes=out.boxes.astype(np.float32),
-        orderings=None if orderings is None else np.asarray(orderings, dtype=np.int16),
-        order_prob=None if order_prob is None else order_prob.astype(np.float32),
+        orderings=orderings,
+        order_prob=order_prob,
     )
-    return Run(result=result, targets=targets, extras=out.extras, tracker=tracker)
+    if bad := result.problems():
+        raise TrackerError(f"tracker {label!r}: its depth-order output cannot be stored: {bad[0]}")
+    return result
 
 
 def run_tracker(

@@ -12,7 +12,21 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["difference"]
+__all__ = ["difference", "load_expected"]
+
+
+def load_expected(path: Any) -> NDArray[Any] | None:
+    """The array stored at ``path`` (``.npy``), or None if the file is not a readable one.
+
+    An empty, truncated or foreign file (text, a pickle) is None rather than numpy's own
+    error, so callers can name the file (or, when regenerating, rewrite it).
+    """
+    try:
+        with open(path, "rb") as f:
+            arr = np.load(f, allow_pickle=False)
+    except (OSError, ValueError, EOFError):
+        return None
+    return arr if isinstance(arr, np.ndarray) else None
 
 
 def _nan_mask(arr: NDArray[Any]) -> NDArray[np.bool_]:

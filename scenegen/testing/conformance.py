@@ -14,8 +14,8 @@ runs the named checks of :data:`CHECKS` on small generated scenes:
     started from the ground-truth boxes of the targets present at frame 0. Frames are
     passed read-only, so a tracker writing into its input fails here.
 ``boxes``
-    On those runs every estimate's ``boxes`` has shape (K, 4) and each row is either
-    finite or all NaN (a lost target).
+    On those runs, and on a scene of two targets (K = 2), every estimate's ``boxes`` has
+    shape (K, 4) and each row is either finite or all NaN (a lost target).
 ``deterministic``
     Two trackers made with the same seed give identical boxes (only if the tracker claims
     it: ``deterministic`` attribute, default True, or the ``deterministic`` option).
@@ -60,6 +60,7 @@ from scenegen.testing.checks import (
     EDGE_FIXTURES,
     NotApplicable,
     Options,
+    SceneError,
     first_line,
     label,
 )
@@ -130,6 +131,8 @@ class ConformanceReport:
 def _run_check(name: str, factory: Callable[..., Any], opts: Options) -> CheckResult:
     try:
         return CheckResult(name, "passed", CHECKS[name](factory, opts))
+    except SceneError:
+        raise  # the environment's fault, not the tracker's
     except NotApplicable as why:
         return CheckResult(name, "skipped", str(why))
     except AssertionError as err:
@@ -166,18 +169,12 @@ def check_tracker(
         Unless ``report``: naming every failed check and why.
     ValueError
         For an unknown option or check name, or a bad option value.
+    SceneError
+        If a conformance scene cannot be built (the environment's fault, say an
+        unwritable fixture cache).
     """
-    valid = list(Options.__dataclass_fields__)
-    for key in options:
-        if key not in valid:
-            raise ValueError(f"unknown option {key!r}; valid: {', '.join(valid)}")
-    if isinstance(options.get("checks"), str):
-        options["checks"] = (options["checks"],)
-    elif options.get("checks") is not None:
-        options["checks"] = tuple(options["checks"])
-    opts = Options(**options)
-    names = list(CHECKS) if opts.checks is None else list(opts.checks)
-    results = [_run_check(n, factory, opts) for n in names]
+    opts = make_options(options)
+    results = [_run_check(n, factory, opts) for n in _names(opts)]
     if results and results[0].name == "protocol" and results[0].status == "failed":
         results = [results[0]] + [
             CheckResult(r.name, "skipped", "not a tracker (see protocol)") for r in results[1:]
@@ -192,14 +189,41 @@ def check_tracker(
     return out
 
 
-def _entries(factories: Iterable[Any]) -> list[tuple[Callable[..., Any], dict[str, Any]]]:
+def make_options(options: dict[str, Any]) -> Options:
+    """:class:`Options` from keyword options (``checks`` may be one name or a list).
+
+    Raises
+    ------
+    ValueError
+        For an unknown option or check name, or a bad option value.
+    """
+    valid = list(Options.__dataclass_fields__)
+    for key in options:
+        if key not in valid:
+            raise ValueError(f"unknown option {key!r}; valid: {', '.join(valid)}")
+    options = dict(options)
+    if isinstance(options.get("checks"), str):
+        options["checks"] = (options["checks"],)
+    elif options.get("checks") is not None:
+        options["checks"] = tuple(options["checks"])
+    return Options(**options)
+
+
+def _names(opts: Options) -> list[str]:
+    return list(CHECKS) if opts.checks is None else list(opts.checks)
+
+
+def _entries(factories: Iterable[Any]) -> list[tuple[Callable[..., Any], Options]]:
     out = []
     for entry in factories:
         if isinstance(entry, tuple):
             factory, options = entry
-            out.append((factory, dict(options)))
+            try:
+                out.append((factory, make_options(dict(options))))
+            except ValueError as err:
+                raise ValueError(f"options of {label(factory)}: {err}") from None
         else:
-            out.append((entry, {}))
+            out.append((entry, Options()))
     return out
 
 
@@ -209,7 +233,9 @@ def parametrize_with_checks(factories: Iterable[Any]) -> Any:
     Parameters
     ----------
     factories : iterable
-        Factories, or ``(factory, options)`` pairs with :func:`check_tracker`'s options.
+        Factories, or ``(factory, options)`` pairs with :func:`check_tracker`'s options
+        (``checks`` chooses the tests made for that factory; a bad option is a
+        ``ValueError`` when the tests are collected).
 
     Example
     -------
@@ -227,10 +253,10 @@ def parametrize_with_checks(factories: Iterable[Any]) -> Any:
     import pytest
 
     params = []
-    for factory, options in _entries(factories):
+    for factory, opts in _entries(factories):
         row = label(factory)
-        for name in CHECKS:
-            params.append(pytest.param(factory, _Check(name, options), id=f"{row}-{name}"))
+        for name in _names(opts):
+            params.append(pytest.param(factory, _Check(name, opts), id=f"{row}-{name}"))
     return pytest.mark.parametrize(("factory", "check"), params)
 
 
@@ -239,13 +265,12 @@ class _Check:
     """One named check with its options; called with the factory inside a test."""
 
     name: str
-    options: dict[str, Any] = field(default_factory=dict)
+    options: Options = field(default_factory=Options)
 
     def __call__(self, factory: Callable[..., Any]) -> None:
         import pytest
 
-        opts = Options(**{k: v for k, v in self.options.items() if k != "checks"})
-        result = _run_check(self.name, factory, opts)
+        result = _run_check(self.name, factory, self.options)
         if result.status == "skipped":
             pytest.skip(f"{self.name}: {result.message}")
         if result.status == "failed":

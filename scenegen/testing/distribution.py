@@ -95,6 +95,7 @@ def assert_distribution_matches(
         Fewer than 2 runs, or bad ``z``/``atol``.
     """
     from scenegen.io.atomic import write_npy
+    from scenegen.testing.compare import load_expected
 
     arr = _runs(samples, "samples")
     if regen:
@@ -102,7 +103,12 @@ def assert_distribution_matches(
         return True
     if not path.exists():
         raise AssertionError(f"no stored distribution {path}; run pytest with --scenegen-regen")
-    what = distribution_difference(arr, np.load(path), z=z, atol=atol)
+    stored = load_expected(path)
+    if stored is None:
+        raise AssertionError(
+            f"{path}: not a readable .npy file; run pytest with --scenegen-regen to rewrite it"
+        )
+    what = distribution_difference(arr, stored, z=z, atol=atol)
     if what is not None:
         raise AssertionError(f"{path}: {what}")
     return False

@@ -310,9 +310,18 @@ def scenegen_fixture(request: pytest.FixtureRequest) -> Callable[[str], Any]:
 def _check_digests(registry: Path, name: str, seq: Any) -> None:
     from scenegen.testing.fixtures import digests
 
-    entry = json.loads(registry.read_text(encoding="utf-8")).get("fixtures", {}).get(name)
+    try:
+        doc = json.loads(registry.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as err:
+        raise AssertionError(f"{registry}: not a readable JSON registry: {err}") from None
+    fixtures = doc.get("fixtures", {}) if isinstance(doc, dict) else None
+    if not isinstance(fixtures, dict):
+        raise AssertionError(f"{registry}: not a registry (no 'fixtures' mapping)")
+    entry = fixtures.get(name)
     if entry is None:
         return
+    if not isinstance(entry, dict) or not isinstance(entry.get("digests", {}), dict):
+        raise AssertionError(f"{registry}: the entry of fixture {name!r} is malformed")
     stored, actual = entry.get("digests", {}), digests(seq)
     bad = sorted(k for k in set(stored) | set(actual) if stored.get(k) != actual.get(k))
     if bad:
@@ -343,23 +352,27 @@ def assert_close_to_expected(
         differing element and the tolerances.
     """
     from scenegen.io.atomic import write_npy
-    from scenegen.testing.compare import difference
+    from scenegen.testing.compare import difference, load_expected
 
     if atol < 0 or rtol < 0:
         raise ValueError(f"tolerances must be >= 0, got atol={atol}, rtol={rtol}")
     arr = np.asarray(actual)
     if regen:
-        if path.exists():
-            old = np.load(path)
-            if old.dtype == arr.dtype and np.array_equal(
-                old, arr, equal_nan=arr.dtype.kind in "fc"
-            ):
-                return False
+        old = load_expected(path) if path.exists() else None  # a damaged file is rewritten
+        if old is not None and old.dtype == arr.dtype and np.array_equal(
+            old, arr, equal_nan=arr.dtype.kind in "fc"
+        ):
+            return False
         write_npy(path, arr, parents=True)
         return True
     if not path.exists():
         raise AssertionError(f"no stored expectation {path}; run pytest with --scenegen-regen")
-    what = difference(arr, np.load(path), atol=atol, rtol=rtol)
+    expected = load_expected(path)
+    if expected is None:
+        raise AssertionError(
+            f"{path}: not a readable .npy file; run pytest with --scenegen-regen to rewrite it"
+        )
+    what = difference(arr, expected, atol=atol, rtol=rtol)
     if what is not None:
         raise AssertionError(f"{path}: {what}")
     return False

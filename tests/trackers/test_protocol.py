@@ -45,6 +45,7 @@ def test_track_runs_a_tracker_with_only_init_and_step():
         (np.zeros((1, 4)), "which has no .boxes"),
         (SimpleNamespace(boxes=np.zeros((2, 4))), "shape (2, 4), expected (1, 4)"),
         (SimpleNamespace(boxes=np.full((1, 4), np.inf)), "holds inf"),
+        (SimpleNamespace(boxes=np.array([[1, 2, np.nan, 4]])), "box 0 is [1.0, 2.0, nan, 4.0]"),
     ],
 )
 def test_track_names_the_protocol_breach(estimate, needle):

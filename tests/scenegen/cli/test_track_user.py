@@ -49,6 +49,45 @@ USER_MODULE = textwrap.dedent(
 
     def fails():
         return Fails()
+
+    class Singular(Still):
+        def step(self, frame):
+            self.n = getattr(self, "n", 0) + 1
+            if self.n == 2:
+                np.linalg.inv(np.zeros((2, 2)))  # a ValueError subclass
+            return super().step(frame)
+
+    def singular():
+        return Singular()
+
+    class TwoBoxes(Still):
+        def step(self, frame):
+            return Box(np.vstack([self.b, self.b]))
+
+    def wrong_bug():
+        raise RuntimeError("model file not found: weights.bin")
+
+    class BadOrderings(Still):
+        orderings = [[0], [5]]
+
+        def step(self, frame):
+            out = super().step(frame)
+            out.extras = {"order_prob": np.array([0.3, 0.3, 0.4])}
+            return out
+
+    class Reuse(Still):
+        orderings = [[0], [0]]
+
+        def init(self, frame, boxes):
+            super().init(frame, boxes)
+            self.p, self.t = np.zeros(2), 0
+
+        def step(self, frame):
+            self.t += 1
+            self.p[:] = (1.0, 0.0) if self.t % 2 else (0.0, 1.0)
+            out = super().step(frame)
+            out.extras = {"order_prob": self.p}
+            return out
     """
 )
 
@@ -57,6 +96,9 @@ USER_MODULE = textwrap.dedent(
 def user_dir(tmp_path_factory):
     folder = tmp_path_factory.mktemp("user")
     (folder / "usertrk.py").write_text(USER_MODULE)
+    (folder / "sub").mkdir()
+    (folder / "sub" / "usersib.py").write_text(USER_MODULE)
+    (folder / "sub" / "userfile.py").write_text("from usersib import make\n")
     scenegen.write(folder / "seq.h5", scenegen.generate("kams-a", seed=1, frames=4))
     return folder
 
@@ -132,3 +174,62 @@ def test_a_users_tracker_that_raises_is_one_line_naming_it(user_dir, monkeypatch
     with pytest.raises(TrackerError) as info:
         main(["--debug", "track", "seq.h5", "--tracker", "usertrk:fails", "-o", "r2.h5"])
     assert isinstance(info.value.__cause__, RuntimeError)
+
+
+@pytest.mark.parametrize(
+    ("spec", "needle"),
+    [
+        # A ValueError of the user's step was "error: Singular matrix", exit 2.
+        ("usertrk:singular", "after 1 of 3 steps: LinAlgError: Singular matrix"),
+        # A protocol breach of the user's tracker is its failure, exit 1.
+        ("usertrk:TwoBoxes", "after 0 of 3 steps: ValueError: TwoBoxes.step() at frame 1: "
+                             ".boxes has shape (2, 4), expected (1, 4)"),
+        # A factory failing for its own reasons was "internal error: RuntimeError".
+        ("usertrk:wrong_bug", "failed while being built: RuntimeError: model file not found"),
+        # Depth-order outputs a result file cannot hold were written, then called invalid.
+        ("usertrk:BadOrderings", "its depth-order output cannot be stored: orderings name "
+                                 "positions outside 0..0"),
+    ],
+)
+def test_a_users_tracker_failing_is_exit_1_naming_it(user_dir, monkeypatch, capsys, spec, needle):
+    monkeypatch.chdir(user_dir)
+    code = main(["track", "seq.h5", "--tracker", spec, "-o", "f.h5"])
+    err = capsys.readouterr().err
+    assert code == 1 and len(err.strip().splitlines()) == 1, err
+    assert err.startswith(f"scenegen: error: tracker '{spec}'") and needle in err, err
+    assert not (user_dir / "f.h5").exists()
+
+
+def test_per_frame_extras_are_copied_when_a_tracker_reuses_its_buffer(user_dir, monkeypatch):
+    # Every frame held the last frame's order_prob (the list kept references).
+    monkeypatch.chdir(user_dir)
+    assert main(["track", "seq.h5", "--tracker", "usertrk:Reuse", "-o", "e.h5"]) == 0
+    prob = read_result(user_dir / "e.h5").order_prob
+    np.testing.assert_array_equal(prob[1:], [[1, 0], [0, 1], [1, 0]])
+
+
+def test_a_file_spec_imports_its_sibling_modules(user_dir, monkeypatch, capsys):
+    monkeypatch.chdir(user_dir)
+    monkeypatch.setattr("sys.path", list(__import__("sys").path))
+    code = main(["track", "seq.h5", "--tracker", "sub/userfile.py:make", "-o", "g.h5"])
+    assert code == 0, capsys.readouterr().err
+
+
+def test_seed_is_not_a_parameter_and_debug_goes_anywhere(user_dir, monkeypatch, capsys):
+    monkeypatch.chdir(user_dir)
+    args = ["--tracker", "usertrk:seeded", "--param", "rng=5", "-o", "h.h5"]
+    code = main(["track", "seq.h5", *args])
+    err = capsys.readouterr().err
+    assert code == 2 and "parameter 'rng'" in err and "--seed" in err, err
+    # "rerun with --debug" works with --debug after the verb too.
+    from scenegen.errors import TrackerError
+
+    with pytest.raises(TrackerError):
+        main(["track", "seq.h5", "--tracker", "usertrk:fails", "-o", "r3.h5", "--debug"])
+
+
+def test_a_module_already_imported_names_where_it_came_from(user_dir, monkeypatch, capsys):
+    monkeypatch.chdir(user_dir)
+    code = main(["track", "seq.h5", "--tracker", "trackers:make_mine", "-o", "i.h5"])
+    err = capsys.readouterr().err
+    assert code == 2 and "trackers has no attribute 'make_mine' (imported from " in err, err

@@ -8,6 +8,7 @@ metadata becomes a problem line too (``validate`` checks in a child process).
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 import shlex
@@ -19,7 +20,7 @@ import pytest
 
 from scenegen.cli import main
 from scenegen.config import from_dict
-from scenegen.errors import DataError
+from scenegen.errors import ConfigError, DataError
 from scenegen.io import TrackerResult, integrity, read, validate, write_result, write_scenario
 from scenegen.io.validate import check_file
 from scenegen.render.plan import plan
@@ -340,6 +341,17 @@ def test_result_files(tmp_path):
     with h5py.File(p, "r+") as f:
         del f["results/kalman/boxes"]
     assert check_file(p) == [f"{p}: result 'kalman': missing dataset boxes"]
+    # A row that is neither a box nor a lost target (all NaN) was valid.
+    half = np.zeros((8, 1, 4), np.float32)
+    half[5, 0, 2] = np.nan
+    with h5py.File(p, "r+") as f:
+        f["results/kalman/boxes"] = half
+    assert check_file(p)[0] == (
+        f"{p}: result 'kalman': boxes has rows that are neither finite nor all NaN at frames 5"
+    )
+    with pytest.raises(ConfigError, match="result of tracker 'kalman': boxes has rows"):
+        write_result(tmp_path / "r2.h5", dataclasses.replace(res, boxes=half))
+    assert not (tmp_path / "r2.h5").exists()
 
 
 def test_cli_prints_one_line_per_problem_and_exits_1(copy, capsys):

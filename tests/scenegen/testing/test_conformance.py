@@ -183,6 +183,11 @@ def test_occlusion_check_runs_where_claimed():
         ({"repeats": 0}, "repeats must be an integer >= 1"),
         ({"min_pass_rate": 0}, "min_pass_rate must be in (0, 1]"),
         ({"checks": ["nope"]}, "unknown check 'nope'; valid: protocol"),
+        # Were TypeErrors ("'<' not supported ...") or silently taken as True.
+        ({"min_pass_rate": "0.5"}, "min_pass_rate must be a number, got '0.5'"),
+        ({"iou_threshold": None}, "iou_threshold must be a number, got None"),
+        ({"equivariance_tol": "1"}, "equivariance_tol must be a number"),
+        ({"deterministic": "false"}, "deterministic must be True, False or None, got 'false'"),
     ],
 )
 def test_bad_options_are_named(kw, needle):
@@ -208,3 +213,89 @@ def test_docstring_example_runs():
 
     result = doctest.testmod(conformance)
     assert result.attempted > 0 and result.failed == 0
+
+
+class OnlyFirst(Follower):
+    """Follows the first box and drops the others: (1, 4) whatever K is."""
+
+    def step(self, frame):
+        return SimpleNamespace(boxes=super().step(frame).boxes[:1])
+
+
+def test_boxes_runs_a_scene_of_two_targets():
+    # Every scene had K = 1, so a tracker of the first box only passed every check.
+    report = check_tracker(OnlyFirst, report=True, checks=["boxes"])
+    assert report.results[0].status == "failed"
+    assert "pair: frame 1: .boxes has shape (1, 4), expected (2, 4)" in report.results[0].message
+    ok = check_tracker(Still, report=True, checks=["boxes"]).results[0]
+    assert ok.status == "passed" and "K up to 2" in ok.message
+
+
+def test_boxes_is_skipped_when_no_estimate_was_examined():
+    # It passed on the one-frame fixture, where step is never called.
+    class Raiser(Still):
+        def step(self, frame):
+            raise RuntimeError("boom")
+
+    result = check_tracker(Raiser, report=True, checks=["boxes"]).results[0]
+    assert result.status == "skipped" and "no estimate to check" in result.message
+
+
+def test_determinism_failure_names_the_first_frame_that_differs():
+    # NaN in both runs is no difference (it was reported as inf from the first lost frame).
+    class LostThenNoisy(Still):
+        def __init__(self, rng=None):
+            self.t, self.jitter = 0, np.random.default_rng()  # ignores the seed on purpose
+
+        def step(self, frame):
+            self.t += 1
+            if self.t == 1:
+                return SimpleNamespace(boxes=np.full_like(self.boxes, np.nan))
+            extra = self.jitter.uniform(0.1, 0.5) if self.t >= 5 else 0.0
+            return SimpleNamespace(boxes=self.boxes + extra)
+
+    msg = check_tracker(LostThenNoisy, report=True, checks=["deterministic"]).results[0].message
+    assert "differ from frame 5 (largest difference 0." in msg, msg
+
+
+def _window(window=3, rng=None):
+    return Still()
+
+
+def test_labels_are_stable_across_processes():
+    import functools
+
+    from scenegen.testing.checks import label
+
+    # A partial's repr holds a memory address: test ids changed every run.
+    assert label(functools.partial(_window, window=3)) == "_window(window=3)"
+    assert label(functools.partial(_window, object())) == "_window(object)"
+    assert label(Still) == "Still"
+
+
+@parametrize_with_checks([(Follower, {"checks": ["protocol", "boxes"]})])
+def test_parametrize_with_checks_honours_checks(factory, check):
+    # `checks` was ignored: every check made a test.
+    assert check.name in ("protocol", "boxes")
+    check(factory)
+
+
+def test_parametrize_with_checks_refuses_bad_options_when_collected():
+    with pytest.raises(ValueError, match="options of Follower: unknown option 'bogus'"):
+        parametrize_with_checks([(Follower, {"bogus": 1})])
+
+
+def test_a_scene_that_cannot_be_built_is_raised_not_blamed_on_the_tracker(monkeypatch):
+    from scenegen.testing import checks
+
+    def broken(name):
+        raise NotADirectoryError("cache: not a directory")
+
+    checks._scene.cache_clear()
+    monkeypatch.setattr(checks, "_make_scene", broken)
+    try:
+        with pytest.raises(checks.SceneError, match="cannot build the conformance scene"):
+            check_tracker(Still, report=True, checks=["boxes"])
+    finally:
+        monkeypatch.undo()
+        checks._scene.cache_clear()

@@ -75,3 +75,14 @@ def test_plugin_pins_an_unseeded_tracker_across_sessions(pytester):
     changed = pytester.runpytest("-q")
     changed.assert_outcomes(failed=1)
     changed.stdout.fnmatch_lines(["*mean-iou.npy: 1 of 1 elements out of band*"])
+
+
+def test_a_damaged_stored_distribution_names_its_file(tmp_path):
+    from scenegen.testing.distribution import assert_distribution_matches
+
+    path = tmp_path / "d.npy"
+    path.write_bytes(b"")  # was numpy's EOFError, naming no file
+    with pytest.raises(AssertionError, match=r"d\.npy: not a readable \.npy file"):
+        assert_distribution_matches(path, np.ones((3, 2)))
+    assert assert_distribution_matches(path, np.ones((3, 2)), regen=True)
+    assert not assert_distribution_matches(path, np.ones((3, 2)))

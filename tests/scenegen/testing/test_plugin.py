@@ -227,6 +227,32 @@ def test_compare_helper_semantics(tmp_path):
         assert_close_to_expected(path, expected, atol=-1)
 
 
+@pytest.mark.parametrize("content", [b"", b"not an array", b"\x93NUMPY\x01\x00v\x00{'descr"])
+def test_a_damaged_expectation_names_its_file_and_regen_rewrites_it(tmp_path, content):
+    # Was numpy's EOFError / ValueError (naming no file); regen could not repair it.
+    path = tmp_path / "e.npy"
+    path.write_bytes(content)
+    with pytest.raises(AssertionError, match=r"e\.npy: not a readable \.npy file; run pytest "
+                                             r"with --scenegen-regen"):
+        assert_close_to_expected(path, [1.0])
+    assert assert_close_to_expected(path, [1.0], regen=True)
+    assert not assert_close_to_expected(path, [1.0])
+
+
+@pytest.mark.parametrize(
+    ("text", "needle"),
+    [("{", "not a readable JSON registry"), ("[]", "not a registry (no 'fixtures' mapping)"),
+     ('{"fixtures": {"small": 3}}', "the entry of fixture 'small' is malformed")],
+)
+def test_a_damaged_registry_is_named(tmp_path, text, needle):
+    from scenegen.testing.pytest_plugin import _check_digests
+
+    (tmp_path / "registry.json").write_text(text)
+    with pytest.raises(AssertionError, match="registry.json: ") as info:
+        _check_digests(tmp_path / "registry.json", "small", None)
+    assert needle in str(info.value)
+
+
 def test_cache_key_changes_with_every_input():
     from scenegen.config import from_dict
 
