@@ -71,12 +71,13 @@ def estimate_boxes(tracker: Any, estimate: Any, n_targets: int, frame: int) -> N
             f"{_label(tracker)}.step() at frame {frame}: .boxes holds inf "
             "(the protocol: finite, or NaN for a lost target)"
         )
-    mixed = np.isnan(boxes).any(axis=1) & ~np.isnan(boxes).all(axis=1)
-    if mixed.any():
-        j = int(np.flatnonzero(mixed)[0])
+    nan = np.isnan(boxes)
+    bad = (nan.any(axis=1) & ~nan.all(axis=1)) | (boxes[:, 2:] < 0).any(axis=1)
+    if bad.any():
+        j = int(np.flatnonzero(bad)[0])
         raise ValueError(
             f"{_label(tracker)}.step() at frame {frame}: box {j} is {boxes[j].tolist()} "
-            "(the protocol: a row is finite, or all NaN for a lost target)"
+            "(the protocol: a row is finite with w, h >= 0, or all NaN for a lost target)"
         )
     return boxes
 

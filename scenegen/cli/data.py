@@ -315,9 +315,20 @@ def _is_result_file(path: Path, output: Path) -> bool:
     return has_results and (not has_sequences or output.suffix == ".txt")
 
 
+def _refuse_replacing_input(source: Path, output: Path) -> None:
+    """An export replaces its output: refuse one that is, or holds, the file it reads."""
+    src, out = source.resolve(), output.resolve()
+    if src == out or out in src.parents:
+        raise ConfigError(
+            f"-o {output}: would replace {'' if src == out else 'the folder of '}the input "
+            f"{source}; choose another output"
+        )
+
+
 def cmd_export(args: argparse.Namespace) -> int:
     from scenegen.io.mot import write_mot_tracker
 
+    _refuse_replacing_input(Path(args.file), Path(args.output))
     if _is_result_file(args.file, args.output):
         from scenegen.io import read_result
 

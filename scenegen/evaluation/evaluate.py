@@ -47,6 +47,7 @@ from scenegen.evaluation.report import (
     TargetScores,
     format_table,
 )
+from scenegen.io.mot import visible_enough
 
 __all__ = [
     "DEFAULT_RECOVER_FRAMES",
@@ -363,7 +364,7 @@ def _report(
     present = np.asarray(sequence.gt.present, dtype=bool)
     keep = present.copy()
     if gt_mode == "visible":
-        keep &= np.asarray(sequence.gt.visibility, dtype=np.float64) > visibility_threshold
+        keep &= visible_enough(sequence.gt.visibility, visibility_threshold)
     gt_all = np.where(keep[..., None], gt_box, np.nan)
     roles = np.asarray(sequence.entities.role).astype(str)
     entity_ids = np.asarray(sequence.entities.id).astype(np.int64)
@@ -423,16 +424,24 @@ def _report(
                 mot=MotSummary.from_scores(mot),
             )
         )
+    # The single-target means are over the targets present at frame 0, those a tracker is
+    # started on, whichever the tracks came from (a result file has rows for only those;
+    # a tracker file for every target): the two give the same overall row.
+    initial = present[0, rows] if rows else np.zeros(0, dtype=bool)
     if otb_average == "frames":
-        pooled = metrics.otb_curves(rows_est, rows_gt)
+        pooled = metrics.otb_curves(rows_est[:, initial], rows_gt[:, initial])
         auc, p20 = _finite(pooled.auc), _finite(pooled.precision_20)
     else:
-        aucs = [t.auc for t in targets if t.auc is not None]
-        p20s = [t.precision_20 for t in targets if t.precision_20 is not None]
+        aucs = [t.auc for t, i in zip(targets, initial, strict=True) if i and t.auc is not None]
+        p20s = [
+            t.precision_20
+            for t, i in zip(targets, initial, strict=True)
+            if i and t.precision_20 is not None
+        ]
         auc = float(np.mean(aucs)) if aucs else None
         p20 = float(np.mean(p20s)) if p20s else None
     overall = OverallScores(
-        mean_iou=_mean(np.nan_to_num(fm["iou"][has_gt])),
+        mean_iou=_mean(np.nan_to_num(fm["iou"][has_gt & initial[None, :]])),
         auc=auc,
         precision_20=p20,
         otb_average=otb_average,

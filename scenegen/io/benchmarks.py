@@ -32,7 +32,6 @@ VOT (Kristan et al., the ``vot`` toolkit; short-term rectangle format)
 
 from __future__ import annotations
 
-import math
 import os
 import re
 from collections.abc import Callable
@@ -50,15 +49,19 @@ BENCHMARKS = ("otb", "got10k", "vot")
 _DEFAULT_IMAGE = {"otb": "jpg", "got10k": "jpg", "vot": "png"}
 
 
+#: Lower edges of GOT-10k's cover levels 2..7 (level 1 is (0, 15 %), 8 is fully visible),
+#: in float32 like the visibility they are compared with (exactly 90 % is level 7).
+_COVER_EDGES = np.array([0.15, 0.30, 0.45, 0.60, 0.75, 0.90], dtype=np.float32)
+
+
 def cover_level(visibility: float, present: bool) -> int:
     """GOT-10k's cover level 0–8 of a visible fraction (0 when absent or fully occluded)."""
-    if not present or visibility <= 0.0:
+    v = np.float32(visibility)
+    if not present or v <= 0.0:
         return 0
-    if visibility >= 1.0:
+    if v >= 1.0:
         return 8
-    if visibility >= 0.9:
-        return 7
-    return 1 + int(math.floor(visibility / 0.15 + 1e-9))
+    return 1 + int(np.count_nonzero(v >= _COVER_EDGES))
 
 
 def _num(v: float) -> str:
@@ -123,6 +126,17 @@ def _folder_name(seq: Sequence, k: int) -> str:
     return re.sub(r"[^A-Za-z0-9._-]+", "-", raw)
 
 
+def _folder_names(seq: Sequence, idx: list[int]) -> list[str]:
+    """One folder per target; targets whose names map to one folder ("box a", "box-a")
+    each get their entity id appended (``..._box-a-id3``)."""
+    names = [_folder_name(seq, k) for k in idx]
+    clash = {n for n in names if names.count(n) > 1}
+    return [
+        f"{n}-id{int(seq.entities.id[k])}" if n in clash else n
+        for n, k in zip(names, idx, strict=True)
+    ]
+
+
 def export_benchmark(
     seq: Sequence,
     out_dir: str | Path,
@@ -166,7 +180,7 @@ def export_benchmark(
     encode_frame(np.zeros((1, 1, 3), np.uint8), ext, out)
     idx = np.asarray(seq.target_indices())
     idx = [int(k) for k in idx if np.asarray(seq.gt.present[:, k]).any()]
-    names = [_folder_name(seq, k) for k in idx]
+    names = _folder_names(seq, idx)
 
     def fill(tmp: Path) -> None:
         for k, name in zip(idx, names, strict=True):

@@ -52,6 +52,8 @@ MOT_CLASS = {"target": 1, "distractor": 8, "occluder": 9}
 """MOT17 classes: pedestrian, distractor, occluder."""
 
 MAX_TRACKER_FILE_BYTES = 512 * 1024 * 1024
+#: Track ids of a tracker file are integers of magnitude below this (they are stored as int64).
+MAX_TRACK_ID = 2**63
 
 
 def _num(v: float) -> str:
@@ -67,6 +69,12 @@ def check_gt_mode(gt_mode: str, visibility_threshold: float) -> None:
         raise ConfigError(f"visibility threshold must be in [0, 1), got {visibility_threshold}")
 
 
+def visible_enough(visibility: ArrayLike, threshold: float) -> NDArray[np.bool_]:
+    """Where a visible fraction exceeds ``threshold``, compared in float32, the precision
+    visibility is stored in (so an 80 % visible target is not above a threshold of 0.8)."""
+    return np.asarray(visibility, dtype=np.float32) > np.float32(threshold)
+
+
 def gt_keep(
     seq: Sequence, gt_mode: str = "amodal", visibility_threshold: float = 0.0
 ) -> NDArray[np.bool_]:
@@ -75,7 +83,7 @@ def gt_keep(
     present = np.asarray(seq.gt.present, dtype=bool)
     if gt_mode == "amodal":
         return present
-    return present & (np.asarray(seq.gt.visibility, dtype=np.float64) > visibility_threshold)
+    return present & visible_enough(seq.gt.visibility, visibility_threshold)
 
 
 def gt_rows(
@@ -97,7 +105,10 @@ def gt_rows(
             continue
         x, y, w, h = (float(v) for v in gt.box[t, k])
         vis = float(gt.visibility[t, k])
-        conf = int(role == "target" and (gt_mode == "amodal" or vis > visibility_threshold))
+        conf = int(
+            role == "target"
+            and (gt_mode == "amodal" or bool(visible_enough(vis, visibility_threshold)))
+        )
         eid = int(seq.entities.id[k])
         rows.append(
             f"{t + 1},{eid},{_num(x + 1)},{_num(y + 1)},{_num(w)},{_num(h)},{conf},"
@@ -171,9 +182,9 @@ def read_mot_tracker(
     ------
     DataError
         Naming the file and line of a malformed row (fewer than 6 columns, a frame or id
-        that is not an integer, a box value that is not a finite number, a width or height
-        that is not positive), a frame out of range, or a track id that appears twice in a
-        frame.
+        that is not an integer, an id beyond ``MAX_TRACK_ID``, a box value that is not a
+        finite number, a negative width or height), a frame out of range, or a track id
+        that appears twice in a frame.
     """
     p = Path(path)
     try:
@@ -182,7 +193,7 @@ def read_mot_tracker(
         text = p.read_text()
     except (OSError, UnicodeDecodeError) as err:
         raise DataError(f"{p}: cannot read as a MOTChallenge tracker file: {err}") from None
-    rows: list[tuple[int, int, float, float, float, float]] = []
+    rows: list[tuple[int, int, int, float, float, float, float]] = []
     for n, line in enumerate(text.splitlines(), 1):
         if not line.strip():
             continue
@@ -191,25 +202,29 @@ def read_mot_tracker(
             if len(cells) < 6:
                 raise ValueError("fewer than 6 columns")
             frame, ident = float(cells[0]), float(cells[1])
+            if not (np.isfinite(frame) and np.isfinite(ident)):
+                raise ValueError("frame and id must be integers")
             if frame != int(frame) or ident != int(ident):
                 raise ValueError("frame and id must be integers")
+            if abs(ident) >= MAX_TRACK_ID:
+                raise ValueError(f"id beyond ±{MAX_TRACK_ID - 1}")
             vals = [float(c) for c in cells[2:6]]
             if not all(np.isfinite(vals)):
                 raise ValueError("a box value is not a finite number")
-            if vals[2] <= 0 or vals[3] <= 0:
-                raise ValueError("width and height must be positive")
+            if vals[2] < 0 or vals[3] < 0:
+                raise ValueError("width and height must not be negative")
         except ValueError as err:
             raise DataError(f"{p}:{n}: not a MOTChallenge row ({err}): {line[:80]!r}") from None
         if not 1 <= frame <= n_frames:
             raise DataError(f"{p}:{n}: frame {int(frame)} is outside 1..{n_frames}")
-        rows.append((int(frame), int(ident), *vals))  # type: ignore[arg-type]
-    ids = np.array(sorted({r[1] for r in rows}), dtype=np.int64)
+        rows.append((n, int(frame), int(ident), *vals))  # type: ignore[arg-type]
+    ids = np.array(sorted({r[2] for r in rows}), dtype=np.int64)
     col = {int(i): c for c, i in enumerate(ids)}
     boxes = np.full((n_frames, ids.shape[0], 4), np.nan)
-    for frame, ident, x, y, w, h in rows:
+    for n, frame, ident, x, y, w, h in rows:
         t, c = frame - 1, col[ident]
         if not np.isnan(boxes[t, c, 0]):
-            raise DataError(f"{p}: track id {ident} appears twice in frame {frame}")
+            raise DataError(f"{p}:{n}: track id {ident} appears twice in frame {frame}")
         boxes[t, c] = (x - 1.0, y - 1.0, w, h)
     return ids, boxes
 

@@ -34,6 +34,14 @@ from scenegen.io.schema import field
 __all__ = ["TrackerResult", "read_result", "write_result"]
 
 
+def bad_box_rows(boxes: NDArray[Any]) -> NDArray[np.bool_]:
+    """Rows of ``boxes`` (..., 4) that break the protocol, shape (...): a row is a box,
+    finite with w, h >= 0, or a lost target, all NaN."""
+    b = np.asarray(boxes, dtype=np.float64)
+    finite = np.isfinite(b).all(axis=-1)
+    return ~(finite | np.isnan(b).all(axis=-1)) | (finite & (b[..., 2:] < 0).any(axis=-1))
+
+
 @dataclass
 class TrackerResult:
     """One tracker's result in a result file.
@@ -64,7 +72,8 @@ class TrackerResult:
     def problems(self) -> list[str]:
         """What keeps this result from being written: shapes that disagree (``boxes``
         (T, M, 4) with M ``target_ids``; ``orderings`` (L, M) of positions 0..M-1 and
-        ``order_prob`` (T, L), both or neither) and box rows neither finite nor all NaN.
+        ``order_prob`` (T, L), both or neither) and box rows that are neither finite with
+        w, h >= 0 nor all NaN.
         Empty if none."""
         out: list[str] = []
         ids, boxes = np.asarray(self.target_ids), np.asarray(self.boxes)
@@ -73,8 +82,11 @@ class TrackerResult:
         m = ids.shape[0]
         if boxes.ndim != 3 or boxes.shape[1:] != (m, 4):
             return [f"boxes has shape {boxes.shape}, expected (T, {m}, 4)"]
-        if (~(np.isfinite(boxes).all(axis=-1) | np.isnan(boxes).all(axis=-1))).any():
-            out.append("boxes has rows that are neither finite nor all NaN (a lost target)")
+        if bad_box_rows(boxes).any():
+            out.append(
+                "boxes has rows that are neither finite with w, h >= 0 nor all NaN "
+                "(a lost target)"
+            )
         if (self.orderings is None) != (self.order_prob is None):
             return ["orderings and order_prob must come together"]
         if self.orderings is None:

@@ -34,6 +34,7 @@ from scenegen.io import describe_open_error, describe_read_error, describe_temp_
 from scenegen.io.guard import beat, call
 from scenegen.io.guard import timeout as guard_timeout
 from scenegen.io.integrity import ATTRS_DIGEST, DIGEST, INTEGRITY, Hasher, as_text, attrs_digest
+from scenegen.io.results import bad_box_rows
 from scenegen.io.schema import GT_FIELDS, RESULT_FIELDS, ROLES, SCHEMA, SEQUENCE_FIELDS
 
 __all__ = ["check_file", "require_valid"]
@@ -484,12 +485,12 @@ def _check_results(p: Path, root: h5py.Group) -> list[str]:
         problems += unreadable
         boxes = data.get("boxes")
         if boxes is not None and boxes.ndim == 3 and boxes.shape[-1] == 4:
-            # The protocol: a row is a box (finite) or a lost target (all NaN).
-            mixed = ~(np.isfinite(boxes).all(axis=-1) | np.isnan(boxes).all(axis=-1))
-            if mixed.any():
+            # The protocol: a row is a box (finite, w, h >= 0) or a lost target (all NaN).
+            bad = bad_box_rows(boxes)
+            if bad.any():
                 problems.append(
-                    f"{where}: boxes has rows that are neither finite nor all NaN at frames "
-                    f"{_frames(np.flatnonzero(mixed.any(axis=1)).tolist())}"
+                    f"{where}: boxes has rows that are neither finite with w, h >= 0 nor "
+                    f"all NaN at frames {_frames(np.flatnonzero(bad.any(axis=1)).tolist())}"
                 )
         orderings = data.get("orderings")
         if (

@@ -185,10 +185,12 @@ def _run(tracker: Any, frames: NDArray[np.uint8], init: NDArray[np.float64]) -> 
             continue
         finite = np.isfinite(arr)
         mixed = ~(finite.all(axis=1) | np.isnan(arr).all(axis=1))
+        mixed |= finite.all(axis=1) & (arr[:, 2:] < 0).any(axis=1)
         if mixed.any():
             j = int(np.flatnonzero(mixed)[0])
             run.problems.append(
-                f"frame {t}: box {j} is {arr[j].tolist()} (a row must be finite, or all NaN)"
+                f"frame {t}: box {j} is {arr[j].tolist()} (a row must be finite with "
+                "w, h >= 0, or all NaN)"
             )
         out[t] = arr
     run.boxes = out

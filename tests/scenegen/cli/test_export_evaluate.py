@@ -67,16 +67,22 @@ def test_bad_tracker_files_name_file_and_line(tmp_path, capsys):
     bad.write_text("99,1,2,3,4,5\n")
     code, _, err = run(capsys, "evaluate", seq_file, bad)
     assert code == 1 and "frame 99 is outside 1..14" in err
-    # A box value that is not a finite number, or a size that is not positive, is not a
-    # box (it was read as one: a NaN row as "lost", a negative width as a box).
+    # A box value that is not a finite number, or a negative size, is not a box (it was
+    # read as one: a NaN row as "lost", a negative width as a box). An inf or huge frame
+    # or id was an internal error (OverflowError).
     for row, why in (("2,1,nan,3,4,5", "a box value is not a finite number"),
                      ("2,1,2,inf,4,5", "a box value is not a finite number"),
-                     ("2,1,2,3,-4,5", "width and height must be positive"),
-                     ("2,1,2,3,4,0", "width and height must be positive")):  # fmt: skip
+                     ("2,1,2,3,-4,5", "width and height must not be negative"),
+                     ("inf,1,2,3,4,5", "frame and id must be integers"),
+                     ("2,1e20,2,3,4,5", "id beyond ±9223372036854775807")):  # fmt: skip
         bad.write_text(f"1,1,2,3,4,5\n{row}\n")
         code, _, err = run(capsys, "evaluate", seq_file, bad)
         assert code == 1 and err.strip() == (f"scenegen: error: {bad}:2: not a MOTChallenge "
                                              f"row ({why}): {row!r}")  # fmt: skip
+    # A duplicate names its line too.
+    bad.write_text("1,1,2,3,4,5\n1,1,2,3,4,5\n")
+    code, _, err = run(capsys, "evaluate", seq_file, bad)
+    assert code == 1 and f"{bad}:2: track id 1 appears twice in frame 1" in err
     code, _, err = run(capsys, "evaluate", seq_file, bad, "--gt-mode", "visible",
                        "--visibility-threshold", "1.5")  # fmt: skip
     assert code == 2
@@ -139,6 +145,9 @@ def test_benchmark_layouts(tmp_path, capsys):
 
 
 def test_cover_levels_and_occlusion_tags(tmp_path, occluded):
+    # Exact edges stored in float32 (0.9 -> 0.89999998) fall in the level they open.
+    edges = np.float32([0.15, 0.3, 0.45, 0.6, 0.75, 0.9])
+    assert [cover_level(v, True) for v in edges] == [2, 3, 4, 5, 6, 7]
     assert [cover_level(v, True) for v in (0, 0.1, 0.15, 0.3, 0.5, 0.89, 0.9, 1)] == [
         0, 1, 2, 3, 4, 6, 7, 8]  # fmt: skip
     assert cover_level(1.0, False) == 0
@@ -177,3 +186,82 @@ def test_every_verb_help_has_a_description(capsys):
         code = main([name, "--help"])
         out = capsys.readouterr().out
         assert code == 0 and verb.description.split()[0] in out, name
+
+
+def test_zero_size_boxes_round_trip_through_a_mot_file(tmp_path, capsys, occluded):
+    # export wrote a zero-width box that evaluate then refused.
+    seq = occluded
+    boxes = np.load(FIXTURES / "expected" / "full-occlusion" / "kalman.npy").astype(np.float32)
+    boxes[3, 0, 2] = 0.0
+    ids = seq.entities.id[seq.initial_targets()]
+    res, txt = tmp_path / "r.h5", tmp_path / "r.txt"
+    write_result(res, TrackerResult("kalman", {}, 0, seq.name, ids, boxes))
+    assert run(capsys, "export", res, "--format", "mot", "-o", txt)[0] == 0
+    a = json.loads(run(capsys, "evaluate", FIXTURES / "full-occlusion.h5", res, "--json")[1])
+    b = json.loads(run(capsys, "evaluate", FIXTURES / "full-occlusion.h5", txt, "--json")[1])
+    assert a["overall"] == b["overall"] and a["overall"]["fp"] >= 1
+
+
+def test_a_target_entering_late_gives_the_same_overall_row(tmp_path, capsys):
+    # The tracker file's overall AUC counted the late target, the result file's did not.
+    from scenegen.config import from_dict
+    from scenegen.render.plan import generate
+
+    cfg = {"width": 80, "height": 60, "n_frames": 10, "background": {"kind": "noise"},
+           "entities": [
+               {"name": "ball", "role": "target", "position": [20, 30],
+                "appearance": {"shape": "ellipse", "size": [14, 14]}},
+               {"name": "late", "role": "target", "position": [50, 30], "appear": 3,
+                "depth": 1, "appearance": {"shape": "rect", "size": [10, 12]}}]}  # fmt: skip
+    seq = generate(from_dict(cfg), seed=0)
+    from scenegen.io import write
+
+    write(tmp_path / "late.h5", seq)
+    ids = seq.entities.id[seq.initial_targets()]
+    boxes = seq.gt.box[:, seq.initial_targets()].astype(np.float32)
+    write_result(tmp_path / "r.h5", TrackerResult("gt", {}, 0, seq.name, ids, boxes))
+    code = run(capsys, "export", tmp_path / "r.h5", "--format", "mot", "-o", tmp_path / "r.txt")
+    assert code[0] == 0
+    a = json.loads(run(capsys, "evaluate", tmp_path / "late.h5", tmp_path / "r.h5", "--json")[1])
+    b = json.loads(run(capsys, "evaluate", tmp_path / "late.h5", tmp_path / "r.txt", "--json")[1])
+    assert len(b["targets"]) == 2 and len(a["targets"]) == 1
+    assert a["overall"] == b["overall"] and a["overall"]["auc"] > 0.9
+
+
+def test_visibility_at_the_threshold_does_not_count(tmp_path, capsys):
+    from scenegen.io.mot import visible_enough
+
+    stored = np.float32(192 / 240)  # 80 % visible, as a file stores it: 0.80000001
+    assert not visible_enough(stored, 0.8) and visible_enough(stored, 0.79)
+
+
+def test_targets_whose_names_give_one_folder_each_get_their_own(tmp_path, capsys):
+    # "box a" and "box-a" both became scene_box-a: one target's files overwrote the other's.
+    from scenegen.config import from_dict
+    from scenegen.render.plan import generate
+
+    cfg = {"name": "scene", "width": 80, "height": 60, "n_frames": 3,
+           "background": {"kind": "noise"},
+           "entities": [
+               {"name": "box a", "role": "target", "position": [30, 30], "depth": 1,
+                "appearance": {"shape": "rect", "size": [20, 12]}},
+               {"name": "box-a", "role": "target", "position": [30, 10], "depth": 2,
+                "appearance": {"shape": "rect", "size": [10, 8]}}]}  # fmt: skip
+    seq = generate(from_dict(cfg), seed=0)
+    names = export_benchmark(seq, tmp_path / "got", "got10k")
+    ids = [int(i) for i in seq.entities.id]
+    assert names == [f"scene_box-a-id{ids[0]}", f"scene_box-a-id{ids[1]}"]
+    assert (tmp_path / "got" / "list.txt").read_text().split() == names
+
+
+@pytest.mark.parametrize("where", ["same", "inside"])
+def test_an_export_never_replaces_its_input(tmp_path, capsys, where):
+    # Exporting into the folder holding the input deleted the input.
+    folder = tmp_path / "work"
+    folder.mkdir()
+    src = folder / "x.h5"
+    src.write_bytes((FIXTURES / "full-occlusion.h5").read_bytes())
+    out = src if where == "same" else folder
+    code, _, err = run(capsys, "export", src, "--format", "mot", "-o", out)
+    assert code == 2 and "would replace" in err and f"the input {src}" in err
+    assert src.read_bytes() == (FIXTURES / "full-occlusion.h5").read_bytes()

@@ -347,7 +347,8 @@ def test_result_files(tmp_path):
     with h5py.File(p, "r+") as f:
         f["results/kalman/boxes"] = half
     assert check_file(p)[0] == (
-        f"{p}: result 'kalman': boxes has rows that are neither finite nor all NaN at frames 5"
+        f"{p}: result 'kalman': boxes has rows that are neither finite with w, h >= 0 nor "
+        "all NaN at frames 5"
     )
     with pytest.raises(ConfigError, match="result of tracker 'kalman': boxes has rows"):
         write_result(tmp_path / "r2.h5", dataclasses.replace(res, boxes=half))

@@ -97,7 +97,8 @@ def test_writing_into_the_frames_fails():
     ("boxes", "needle"),
     [
         (lambda b: np.zeros((len(b), 5)), "has shape (1, 5), expected (1, 4)"),
-        (lambda b: np.where(np.arange(4) == 0, np.nan, b), "(a row must be finite, or all NaN)"),
+        (lambda b: np.where(np.arange(4) == 0, np.nan, b), "(a row must be finite with w, h"),
+        (lambda b: b * [1, 1, -1, 1], "(a row must be finite with w, h >= 0, or all NaN)"),
         (lambda b: [["a"] * 4] * len(b), ".boxes is not numeric"),
         (None, "the estimate (ndarray) has no .boxes"),
     ],
