@@ -180,7 +180,17 @@ def _target_folder(target: Path) -> Path:
         raise ConfigError(f"{target}: folder {folder} does not exist")
     if target.is_dir():
         raise ConfigError(f"{target}: is a folder, expected a file name")
+    if target.exists() and not target.is_file():
+        # A rename would put a regular file in place of /dev/null, a FIFO or a socket.
+        raise ConfigError(f"{target}: is not a regular file (a device, FIFO or socket)")
     return folder
+
+
+def _real_target(path: str | Path) -> Path:
+    """``path``, or the file a symbolic link at ``path`` points to (written through, so
+    the link stays a link)."""
+    target = Path(path)
+    return Path(os.path.realpath(target)) if target.is_symlink() else target
 
 
 @contextlib.contextmanager
@@ -203,9 +213,11 @@ def atomic_path(path: str | Path, suffix: str = "") -> Iterator[Path]:
     Raises
     ------
     ConfigError
-        If the folder does not exist or the target is a folder.
+        If the folder does not exist, or the target is a folder or another file that is
+        not a regular one (a device such as ``/dev/null``, a FIFO); a symbolic link is
+        written through.
     """
-    target = Path(path)
+    target = _real_target(path)
     folder = _target_folder(target)
     clean_temp_files(folder, target.name)
     fd, tmp = tempfile.mkstemp(prefix=temp_prefix(target.name), suffix=suffix, dir=folder)

@@ -188,6 +188,28 @@ def _child(
 # The parent side
 
 
+def _forget_inherited_forkserver() -> None:
+    """In a process made by ``fork`` (a worker of a PyTorch DataLoader or of a fork pool),
+    the parent's fork server is inherited in name only: it is not this process's child,
+    and starting a guard through it failed with ``ChildProcessError``. Forget it (closing
+    this copy of its keep-alive pipe, which the parent still holds); this process starts
+    its own fork server when it needs one."""
+    from multiprocessing import forkserver
+
+    server = getattr(forkserver, "_forkserver", None)
+    if server is None or getattr(server, "_forkserver_pid", None) is None:
+        return
+    alive = server._forkserver_alive_fd
+    server._forkserver_pid = server._forkserver_address = server._forkserver_alive_fd = None
+    server._lock = threading.Lock()  # it may have been held by another thread at the fork
+    if alive is not None:
+        with contextlib.suppress(OSError):
+            os.close(alive)
+
+
+os.register_at_fork(after_in_child=_forget_inherited_forkserver)
+
+
 def _context() -> Any:
     methods = multiprocessing.get_all_start_methods()
     if in_child() and "fork" in methods:

@@ -19,6 +19,9 @@ from scenegen.sequence import Sequence
 
 __all__ = ["annotate", "contact_sheet", "write_preview"]
 
+#: Frame sides (px) an MP4 preview can have: what the MPEG-4 Part 2 encoder accepts.
+MP4_SIDES = (2, 8191)
+
 _ROLE_COLORS = {
     "target": (0, 200, 0),
     "distractor": (230, 0, 0),
@@ -115,6 +118,13 @@ def write_preview(
             )
         else:
             h, w = frames[0].shape[:2]
+            # MPEG-4 Part 2 takes sides of 2..8191 px; checked first, since the encoder
+            # would print its own lines before refusing.
+            if not (MP4_SIDES[0] <= w <= MP4_SIDES[1] and MP4_SIDES[0] <= h <= MP4_SIDES[1]):
+                raise ConfigError(
+                    f"{out}: MP4 frames must be {MP4_SIDES[0]}..{MP4_SIDES[1]} px a side, "
+                    f"these are {w}x{h}; write a .gif or .png preview instead"
+                )
             writer = cv2.VideoWriter(str(tmp), cv2.VideoWriter_fourcc(*"mp4v"), 12.5, (w, h))
             if not writer.isOpened():
                 raise ConfigError(f"{out}: this OpenCV build cannot write MP4")

@@ -615,6 +615,8 @@ def _rows_differ(stored: NDArray[Any], fresh: NDArray[Any]) -> NDArray[np.bool_]
     if stored.shape != fresh.shape:
         return np.ones(max(len(stored), 1), dtype=bool)
     n = stored.shape[0] if stored.ndim else 1
+    if stored.size == 0:  # no entity (K = 0): nothing to differ
+        return np.zeros(n, dtype=bool)
     a = np.ascontiguousarray(stored).reshape(n, -1).view(np.uint8)
     b = np.ascontiguousarray(fresh).reshape(n, -1).view(np.uint8)
     return (a != b).any(axis=1)

@@ -599,8 +599,9 @@ def _entity_paths(
 def _delayed(arr: NDArray[np.float64], appear: int) -> NDArray[np.float64]:
     """``arr`` starting at frame ``appear`` (held at its first value before)."""
     out = np.empty_like(arr)
-    out[appear:] = arr[: arr.shape[0] - appear]
-    out[:appear] = arr[0]
+    shift = min(appear, arr.shape[0])  # at or past the end: held at its first value
+    out[shift:] = arr[: arr.shape[0] - shift]
+    out[:shift] = arr[0]
     return out
 
 

@@ -36,8 +36,15 @@ _LFW = re.compile(r"lfw_subset\[(\d+)\]\Z")
 
 
 def _rgb(img: NDArray[np.generic]) -> NDArray[np.uint8]:
+    """uint8 RGB (h, w, 3) of an image: integers scaled from their type's range (16-bit
+    files: 0..65535), floats from [0, 1]."""
     if img.dtype != np.uint8:
-        img = np.clip(np.rint(np.asarray(img, dtype=np.float64) * 255.0), 0, 255).astype(np.uint8)
+        scale = 255.0
+        if img.dtype.kind in "iu":
+            scale = 255.0 / float(np.iinfo(img.dtype).max)
+        elif img.dtype.kind == "b":
+            scale = 255.0
+        img = np.clip(np.rint(np.asarray(img, dtype=np.float64) * scale), 0, 255).astype(np.uint8)
     if img.ndim == 2:
         img = np.repeat(img[..., None], 3, axis=2)
     return np.ascontiguousarray(img[..., :3])
@@ -55,7 +62,10 @@ def _load_cached(source: str) -> NDArray[np.uint8]:
         path = Path(source)
         if not path.is_file():
             raise ConfigError(f"no such image file {source!r}")
-        img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+        try:
+            img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+        except cv2.error:  # OpenCV refuses it (say more pixels than it allows): try skimage
+            img = None
         if img is not None and img.ndim == 3:
             img = cv2.cvtColor(img[..., :3], cv2.COLOR_BGR2RGB)
         if img is None:
@@ -64,7 +74,9 @@ def _load_cached(source: str) -> NDArray[np.uint8]:
 
                 img = skimage.io.imread(str(path))
             except Exception as err:  # any reader failure: one line naming the file
-                raise ConfigError(f"cannot read image file {source!r}: {err}") from None
+                text = str(err).strip().splitlines()
+                why = text[0] if text else type(err).__name__
+                raise ConfigError(f"cannot read image file {source!r}: {why}") from None
         if img.ndim not in (2, 3) or img.size == 0:
             raise ConfigError(f"image file {source!r} is not a 2-D image (shape {img.shape})")
     out = _rgb(img)

@@ -165,3 +165,17 @@ def test_bench_only_that_matches_nothing_is_a_usage_error(capsys):
     assert capsys.readouterr().err.strip() == (
         "scenegen: error: --only 'nothing' matches no bench module; modules: generation, "
         "particle, stepshare, meanshift, shm, reliability, scaling, datasets")  # fmt: skip
+
+
+def test_an_mp4_preview_of_frames_the_encoder_refuses_names_their_size(tmp_path, capsys):
+    # It said "this OpenCV build cannot write MP4" (and the encoder printed its own lines).
+    from scenegen.config import from_dict
+    from scenegen.io import write
+    from scenegen.render.plan import generate
+
+    cfg = from_dict({"width": 1, "height": 30, "n_frames": 2})
+    write(tmp_path / "one.h5", generate(cfg, seed=1))
+    code = main(["preview", str(tmp_path / "one.h5"), "-o", str(tmp_path / "one.mp4")])
+    err = capsys.readouterr().err
+    assert code == 2 and "MP4 frames must be 2..8191 px a side, these are 1x30" in err, err
+    assert not (tmp_path / "one.mp4").exists()

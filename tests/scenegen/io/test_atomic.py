@@ -271,3 +271,23 @@ def test_write_text_json_npy_helpers(tmp_path):
     with pytest.raises(ConfigError, match="does not exist"):
         write_text(tmp_path / "missing" / "a.txt", "x")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.md", "b.json", "c.json", "deep"]
+
+
+def test_a_device_or_fifo_is_never_replaced_and_a_link_is_written_through(tmp_path, capsys):
+    # `generate -o /dev/null` replaced the machine's /dev/null with a regular file.
+    from scenegen.cli import main
+    from scenegen.io.atomic import write_text
+
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    with pytest.raises(ConfigError, match="fifo: is not a regular file"):
+        write_text(fifo, "x")
+    assert fifo.is_fifo()
+    code = main(["generate", "--preset", "kams-a", "--frames", "2", "-o", str(fifo)])
+    assert code == 2 and "is not a regular file" in capsys.readouterr().err and fifo.is_fifo()
+    real = tmp_path / "real.txt"
+    real.write_text("old")
+    link = tmp_path / "link.txt"
+    link.symlink_to(real)
+    write_text(link, "new")
+    assert link.is_symlink() and real.read_text() == "new"

@@ -183,3 +183,20 @@ def test_a_pool_worker_can_start_a_guard():
 
     with multiprocessing.get_context("spawn").Pool(1) as pool:
         assert pool.apply(_guarded_int, ("5",)) == 5
+
+
+def _read_frame_count(path):
+    return int(read(path).frames.shape[0])
+
+
+def test_a_forked_worker_starts_a_guard_after_its_parent_did(tmp_path):
+    """A DataLoader worker is forked after the parent read a file: the fork server it
+    inherits is not its child, and every guarded read there failed (ChildProcessError)."""
+    import multiprocessing
+
+    for name in ("a.h5", "b.h5"):
+        scenegen.write(tmp_path / name, scenegen.generate("kams-a", seed=1, frames=2))
+    guard.clear_cache()  # files we did not write are surveyed in a guarded child
+    assert _read_frame_count(tmp_path / "a.h5") == 2  # the parent's guard starts its server
+    with multiprocessing.get_context("fork").Pool(1) as pool:
+        assert pool.apply(_read_frame_count, (tmp_path / "b.h5",)) == 2

@@ -776,3 +776,13 @@ def test_old_results_json_is_refused_by_the_report_with_a_hint(exp_copy, capsys)
     )
     code = main(["validate", str(root)])
     assert code == 1 and capsys.readouterr().err.splitlines() == [str(err.value)]
+
+
+def test_deep_validation_of_a_scene_without_entities(tmp_path, capsys):
+    # --deep called a fresh zero-entity file "damaged HDF5 metadata" (a reshape of K = 0).
+    from scenegen.io import write
+    from scenegen.render.plan import generate
+
+    p = tmp_path / "z.h5"
+    write(p, generate(from_dict({"width": 20, "height": 20, "n_frames": 2}), seed=1))
+    assert main(["validate", "--deep", str(p)]) == 0, capsys.readouterr().err

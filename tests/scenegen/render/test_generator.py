@@ -368,3 +368,17 @@ def test_dps_dancers_partial_occlusion_and_erratic_sway():
         acc.append(np.nanstd(np.diff(cx, 2, axis=0)))
     assert np.median(mins) < 0.5 and max(mins) > 0.0
     assert min(acc) > 1.5
+
+
+@pytest.mark.parametrize("appear", [6, 7, 11, 12])
+def test_a_mimic_appearing_at_or_past_the_end_is_never_present(appear):
+    # n_frames <= appear < 2 n_frames was an internal error (a negative slice stop).
+    from scenegen.config import from_dict
+    from scenegen.render.plan import generate
+
+    cfg = from_dict({"width": 40, "height": 30, "n_frames": 6, "entities": [
+        {"name": "t", "role": "target", "position": [10, 10]},
+        {"name": "m", "role": "distractor", "mimic": "t", "appear": appear, "depth": 1},
+    ]})  # fmt: skip
+    seq = generate(cfg, seed=1)
+    assert not seq.gt.present[:, 1].any() and seq.gt.present[:, 0].all()

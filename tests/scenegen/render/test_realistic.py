@@ -207,6 +207,31 @@ def test_user_image_file_is_read(tmp_path):
     np.testing.assert_array_equal(seq.frames[0, 0, 11], [0, 0, 0])
 
 
+def test_a_16_bit_image_is_scaled_not_saturated(tmp_path):
+    # Every 16-bit file was taken for floats in [0, 1]: all white.
+    import cv2
+
+    path = tmp_path / "g16.png"
+    cv2.imwrite(str(path), np.full((10, 12), 40000, np.uint16))
+    bg = Background(kind="image", source=str(path), fit="stretch")
+    seq = scenegen.generate(SceneConfig(width=12, height=10, n_frames=1, background=bg), seed=0)
+    assert np.unique(seq.frames[0]).tolist() == [round(40000 * 255 / 65535)]
+
+
+@pytest.mark.parametrize("content", [b"", b"not an image\n"])
+def test_an_unreadable_image_file_is_one_line(tmp_path, content):
+    # skimage's reason was three lines, ending with a pip install command.
+    from scenegen.errors import ConfigError
+
+    path = tmp_path / "text.png"
+    path.write_bytes(content)
+    bg = Background(kind="image", source=str(path))
+    with pytest.raises(ConfigError) as info:
+        scenegen.generate(SceneConfig(width=12, height=10, n_frames=1, background=bg), seed=0)
+    msg = str(info.value)
+    assert "cannot read image file" in msg and "text.png" in msg and "\n" not in msg
+
+
 @pytest.mark.parametrize("name", scenegen.presets.realistic_names())
 def test_realistic_presets_ground_truth_and_round_trip(name):
     cfg = scenegen.presets.get(name)
