@@ -799,8 +799,8 @@ def generate(
     """
     cfg, preset = _resolve(config)
     if frames is not None:
-        if frames < 1:
-            raise ConfigError(f"frames must be >= 1, got {_short(frames)}")
+        if isinstance(frames, bool) or not isinstance(frames, (int, np.integer)) or frames < 1:
+            raise ConfigError(f"frames must be an integer >= 1, got {_short(frames)}")
         cfg = replace(cfg, n_frames=int(frames))
     scn = plan(cfg, seed, preset=preset)
     chunk = scn.render()

@@ -382,3 +382,12 @@ def test_a_mimic_appearing_at_or_past_the_end_is_never_present(appear):
     ]})  # fmt: skip
     seq = generate(cfg, seed=1)
     assert not seq.gt.present[:, 1].any() and seq.gt.present[:, 0].all()
+
+
+@pytest.mark.parametrize("frames", ["3", 2.5, True, 0])
+def test_generate_frames_must_be_a_positive_integer(frames):
+    # "3" was a raw TypeError; 2.5 silently made 2 frames.
+    from scenegen.errors import ConfigError
+
+    with pytest.raises(ConfigError, match="frames must be an integer >= 1"):
+        scenegen.generate("kams-a", seed=1, frames=frames)
