@@ -39,6 +39,7 @@ __all__ = [
     "MAX_FRAME_ENTITIES",
     "MAX_MAGNITUDE",
     "MAX_SIDE",
+    "MAX_TEMPLATE_PIXELS",
     "Appearance",
     "Background",
     "Camera",
@@ -51,6 +52,7 @@ __all__ = [
     "Variation",
     "from_dict",
     "load_config",
+    "load_data",
     "to_dict",
 ]
 
@@ -86,6 +88,12 @@ MAX_BLUR = 256.0
 proportion to it."""
 MAX_MOTION_BLUR = 4.0
 """Largest ``Photometric.motion_blur`` (exposure in frame intervals)."""
+MAX_TEMPLATE_PIXELS = 2**24
+"""Most appearance template pixels of a scene: every entity's ``appearance.size`` (a mimic's
+that of its model) plus, per clutter group, ``count`` x its ``appearance.size``. Planning
+keeps about 75 bytes per template pixel (pattern, mask, colour and alpha layers), so this
+caps it near 1.2 GB; e.g. one 4096x4096 entity, or 65,535 clutter items of 16x16. The
+presets use at most 154,500."""
 
 
 def _fail(path: str, msg: str) -> typing.NoReturn:
@@ -583,6 +591,7 @@ class SceneConfig:
                 f"{self.n_frames} frames x {n_total} entities exceeds {MAX_FRAME_ENTITIES:,} "
                 "(planning would need too much memory)",
             )
+        self._check_template_pixels()
         _check_magnitudes(self, "")
         if self.camera is not None:
             ex, ey = self.camera.extent
@@ -610,6 +619,25 @@ class SceneConfig:
     def _repr_pretty_(self, p: Any, cycle: bool) -> None:
         # Hypothesis (and IPython) pretty-print dataclasses field by field otherwise.
         p.text(repr(self))
+
+    def _check_template_pixels(self) -> None:
+        """At most MAX_TEMPLATE_PIXELS appearance template pixels; names the entity or
+        clutter group that goes beyond."""
+        models = {e.name: e for e in self.entities}
+        total = 0
+        items = [(f"entities[{i}].appearance.size", 1,
+                  (models[e.mimic] if e.mimic is not None else e).appearance.size)
+                 for i, e in enumerate(self.entities)]  # fmt: skip
+        items += [(f"clutter[{j}].appearance.size", c.count, c.appearance.size)
+                  for j, c in enumerate(self.clutter)]  # fmt: skip
+        for where, count, (w, h) in items:
+            total += count * w * h
+            if total > MAX_TEMPLATE_PIXELS:
+                _fail(
+                    where,
+                    f"the appearance templates (entities, and clutter count x size) would "
+                    f"hold {total:,} pixels, more than {MAX_TEMPLATE_PIXELS:,}",
+                )
 
     def _check_depth_ties(self) -> None:
         """No two entities share a depth at any frame: a sweep over the keyframes (a tie
@@ -723,6 +751,20 @@ def _type_name(tp: Any) -> str:
     return getattr(tp, "__name__", str(tp))
 
 
+def _is_integer(value: Any) -> bool:
+    """An int or a numpy integer scalar, not a bool."""
+    import numpy as np
+
+    return isinstance(value, (int, np.integer)) and not isinstance(value, bool)
+
+
+def _is_number(value: Any) -> bool:
+    """An int or float, or a numpy integer or floating scalar; not a bool."""
+    import numpy as np
+
+    return _is_integer(value) or isinstance(value, (float, np.floating))
+
+
 def _convert(value: Any, tp: Any, path: str) -> Any:
     origin = get_origin(tp)
     if origin is typing.Union or origin is types.UnionType:
@@ -759,15 +801,15 @@ def _convert(value: Any, tp: Any, path: str) -> Any:
             _fail(path, f"must be true or false, got {_short(value)}")
         return value
     if tp is int:
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
+        if not _is_number(value):
             _fail(path, f"must be an integer, got {_short(value)}")
-        if isinstance(value, float) and not value.is_integer():
+        if not _is_integer(value) and not float(value).is_integer():
             _fail(path, f"must be an integer, got {_short(value)}")
         return int(value)
     if tp is float:
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
+        if not _is_number(value):
             _fail(path, f"must be a number, got {_short(value)}")
-        if isinstance(value, int) and abs(value) > MAX_MAGNITUDE:
+        if _is_integer(value) and abs(int(value)) > MAX_MAGNITUDE:
             _fail(path, f"must be at most {MAX_MAGNITUDE:g} in magnitude, got {_short(value)}")
         if not math.isfinite(value):
             _fail(path, f"must be finite, got {_short(value)}")
@@ -781,7 +823,7 @@ def _convert(value: Any, tp: Any, path: str) -> Any:
 
 def _normalise_depth(value: Any) -> Any:
     # A single number is shorthand for a constant depth from frame 0.
-    if isinstance(value, (int, float)) and not isinstance(value, bool):
+    if _is_number(value):
         return [[0, value]]
     return value
 
@@ -844,16 +886,18 @@ def to_dict(config: SceneConfig) -> dict[str, Any]:
 
 
 MAX_CONFIG_BYTES = 4 * 2**20
-"""Largest config file read, in bytes."""
+"""Largest config (or family) file read, in bytes."""
 MAX_ALIASES = 1000
 """Most YAML aliases (``*name``) in one config."""
 MAX_NODES = 100_000
-"""Most YAML nodes in a config once its aliases are expanded: a few hundred bytes of
-nested aliases ("billion laughs") would otherwise expand to billions of values."""
+"""Most YAML nodes that aliases may add to a config once expanded: a few hundred bytes of
+nested aliases ("billion laughs") would otherwise expand to billions of values. A document
+without aliases is bounded by :data:`MAX_CONFIG_BYTES` alone, as a JSON one is."""
 
 
 def _load_yaml(text: str) -> Any:
-    """``yaml.safe_load`` with the alias count and the expanded size bounded."""
+    """``yaml.safe_load`` with the alias count and the expansion bounded, and duplicate keys
+    refused."""
     import yaml
 
     class Loader(yaml.SafeLoader):
@@ -865,6 +909,22 @@ def _load_yaml(text: str) -> Any:
                 if Loader.aliases > MAX_ALIASES:
                     raise ConfigError(f"more than {MAX_ALIASES} YAML aliases")
             return super().compose_node(parent, index)
+
+        def construct_mapping(self, node: Any, deep: bool = False) -> Any:
+            if isinstance(node, yaml.MappingNode):
+                seen: set[Any] = set()
+                for key_node, _ in node.value:
+                    if key_node.tag == "tag:yaml.org,2002:merge":
+                        continue  # '<<' merges keys that the mapping's own may override
+                    key = self.construct_object(key_node, deep=True)
+                    try:
+                        if key in seen:
+                            line = key_node.start_mark.line + 1
+                            raise ConfigError(f"duplicate key {_short(key)} (line {line})")
+                        seen.add(key)
+                    except TypeError:  # an unhashable key: the constructor names it
+                        pass
+            return super().construct_mapping(node, deep=deep)
 
     loader = Loader(text)
     try:
@@ -879,7 +939,8 @@ def _load_yaml(text: str) -> Any:
 
 def _expanded_size(root: Any) -> int:
     """Nodes of a composed YAML document with every alias expanded (shared nodes counted
-    once per reference); raises ConfigError beyond MAX_NODES or on a recursive alias."""
+    once per reference); raises ConfigError when the aliases add more than MAX_NODES to
+    the document's own nodes, or on a recursive alias."""
     import yaml
 
     sizes: dict[int, int] = {}
@@ -897,10 +958,10 @@ def _expanded_size(root: Any) -> int:
             else:
                 children = []
             total = 1 + sum(sizes[id(c)] for c in children)
-            if total > MAX_NODES:
-                raise ConfigError(
-                    f"the YAML expands to more than {MAX_NODES:,} values (nested aliases)"
-                )
+            # A node's subtree has at most len(sizes) + 1 distinct nodes so far: what the
+            # aliases added is at least total minus that, and exactly so at the root.
+            if total - (len(sizes) + 1) > MAX_NODES:
+                raise ConfigError(f"the YAML's aliases expand to more than {MAX_NODES:,} values")
             sizes[key] = total
             continue
         if key in sizes:
@@ -916,38 +977,82 @@ def _expanded_size(root: Any) -> int:
     return sizes[id(root)]
 
 
+def _json_object(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    """A JSON object, refusing a key given twice (``json.loads`` would keep the last)."""
+    out: dict[str, Any] = {}
+    for k, v in pairs:
+        if k in out:
+            raise ConfigError(f"duplicate key {_short(k)}")
+        out[k] = v
+    return out
+
+
+def _parser_message(err: Exception) -> str:
+    """One line of a YAML or JSON parser's error: what is wrong, and where."""
+    problem, mark = getattr(err, "problem", None), getattr(err, "problem_mark", None)
+    if isinstance(problem, str) and problem:  # yaml's MarkedYAMLError: several lines
+        where = f" (line {mark.line + 1}, column {mark.column + 1})" if mark is not None else ""
+        return f"{problem}{where}"
+    lines = [line.strip() for line in str(err).splitlines() if line.strip()]
+    return " ".join(lines) or type(err).__name__
+
+
+def load_data(path: str | Path, what: str = "config") -> Any:
+    """The plain data of a YAML (``.yaml``/``.yml``) or JSON (``.json``) file, unvalidated.
+
+    The file must be UTF-8 text of at most :data:`MAX_CONFIG_BYTES`; YAML aliases are
+    bounded (:data:`MAX_ALIASES`, :data:`MAX_NODES`) and a key given twice in one mapping
+    is refused, in YAML and JSON alike. Scenario configs (:func:`load_config`) and family
+    files (:func:`scenegen.datasets.load_family`) are read by it.
+
+    Parameters
+    ----------
+    path : str or Path
+    what : str
+        What the file holds, for messages ("config", "family").
+
+    Raises
+    ------
+    ConfigError
+        One line naming the file: unreadable, too big, not UTF-8, another extension, not
+        valid YAML/JSON (the parser's problem and its line and column), an alias bomb or
+        a duplicate key.
+    """
+    p = Path(path)
+    try:
+        if p.stat().st_size > MAX_CONFIG_BYTES:
+            raise ConfigError(
+                f"{p}: {what} is {p.stat().st_size:,} bytes, more than {MAX_CONFIG_BYTES:,}"
+            )
+        text = p.read_text(encoding="utf-8")
+    except OSError as err:
+        raise ConfigError(f"{p}: cannot read {what}: {err.strerror or err}") from None
+    except UnicodeDecodeError as err:
+        raise ConfigError(f"{p}: {what} is not UTF-8 text ({err.reason})") from None
+    try:
+        if p.suffix.lower() in (".yaml", ".yml"):
+            return _load_yaml(text)
+        if p.suffix.lower() == ".json":
+            return json.loads(text, object_pairs_hook=_json_object)
+        raise ConfigError(f"{p}: {what} must be .yaml, .yml or .json, got {_short(p.suffix)}")
+    except ConfigError as err:
+        raise ConfigError(str(err) if str(err).startswith(f"{p}: ") else f"{p}: {err}") from None
+    except Exception as err:  # parser errors of yaml/json: report as one line
+        msg = _excerpt(_parser_message(err))
+        raise ConfigError(f"{p}: not valid {p.suffix[1:].upper()}: {msg}") from None
+
+
 def load_config(path: str | Path) -> SceneConfig:
     """Read a YAML (``.yaml``/``.yml``) or JSON (``.json``) config file and validate it.
 
     Raises
     ------
     ConfigError
-        If the file cannot be read or parsed, or the config is invalid (message prefixed
-        with the file name).
+        If the file cannot be read or parsed (:func:`load_data`), or the config is
+        invalid (message prefixed with the file name).
     """
     p = Path(path)
-    try:
-        if p.stat().st_size > MAX_CONFIG_BYTES:
-            raise ConfigError(
-                f"{p}: config is {p.stat().st_size:,} bytes, more than {MAX_CONFIG_BYTES:,}"
-            )
-        text = p.read_text(encoding="utf-8")
-    except OSError as err:
-        raise ConfigError(f"{p}: cannot read config: {err.strerror or err}") from None
-    except UnicodeDecodeError as err:
-        raise ConfigError(f"{p}: config is not UTF-8 text ({err.reason})") from None
-    try:
-        if p.suffix.lower() in (".yaml", ".yml"):
-            data = _load_yaml(text)
-        elif p.suffix.lower() == ".json":
-            data = json.loads(text)
-        else:
-            raise ConfigError(f"{p}: config must be .yaml, .yml or .json, got {_short(p.suffix)}")
-    except ConfigError as err:
-        raise ConfigError(str(err) if str(err).startswith(f"{p}: ") else f"{p}: {err}") from None
-    except Exception as err:  # parser errors of yaml/json: report as one line
-        first = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
-        raise ConfigError(f"{p}: not valid {p.suffix[1:].upper()}: {_excerpt(first)}") from None
+    data = load_data(p, "config")
     try:
         return from_dict(data)
     except ConfigError as err:

@@ -64,7 +64,7 @@ def cmd_dataset(args: argparse.Namespace) -> int:
         frames=args.frames,
         jobs=args.jobs,
         scheduler=args.scheduler,
-        shard_size=args.shard_size or DEFAULT_SHARD_SIZE,
+        shard_size=DEFAULT_SHARD_SIZE if args.shard_size is None else args.shard_size,
         compression=args.compression,
         progress=sys.stderr.isatty(),
         on_shard=count_made,

@@ -31,7 +31,7 @@ from typing import Any
 
 from scenegen.datasets.builtin import resolve_family
 from scenegen.datasets.executor import check_executor, probe, run_tasks
-from scenegen.datasets.family import Draw, Family
+from scenegen.datasets.family import Axis, Draw, Family
 from scenegen.errors import ConfigError, DataError
 
 __all__ = [
@@ -40,8 +40,14 @@ __all__ = [
     "SCHEMA",
     "ShardTask",
     "build_dataset",
+    "holds_benchmark_outputs",
+    "make_output_folder",
     "make_shard",
+    "manifest_axes",
+    "manifest_entries",
+    "manifest_family",
     "plan_shards",
+    "read_manifest",
     "shard_name",
     "write_manifest",
 ]
@@ -105,10 +111,17 @@ def _entry(d: Draw, file: str, seq: Any, digests: dict[str, str]) -> dict[str, A
     }
 
 
+def is_drawn(seq: Any, d: Draw) -> bool:
+    """Whether the stored sequence ``seq`` is the one ``d`` describes (seed, preset and
+    config)."""
+    from scenegen.config import to_dict
+
+    return seq.seed == d.seed and seq.preset == d.preset and to_dict(seq.config) == d.config
+
+
 def _verify(task: ShardTask) -> list[dict[str, Any]] | None:
     """Entries of an existing complete shard file that matches the task, else None."""
     import scenegen
-    from scenegen.config import to_dict
     from scenegen.io import sequence_names
     from scenegen.testing.fixtures import digests
 
@@ -121,7 +134,7 @@ def _verify(task: ShardTask) -> list[dict[str, Any]] | None:
         out = []
         for d, want in zip(task.draws, task.expected, strict=True):
             seq = scenegen.read(path, d.name)
-            if seq.seed != d.seed or seq.preset != d.preset or to_dict(seq.config) != d.config:
+            if not is_drawn(seq, d):
                 return None
             got = digests(seq)
             if want is not None and got != want:
@@ -237,6 +250,12 @@ def _header(fam: Family, count: int, seed: int, shard_size: int, compression: st
             for a in fam.axes
         ],
         "vary": [{"path": d.path, "kind": d.kind, "args": list(d.args)} for d in fam.distributions],
+        # With axes and vary, the whole family: validate draws every sequence again from it.
+        "resolved": {
+            "bases": fam.bases,
+            "base": fam.base,
+            "set": [list(o) for o in fam.overrides],
+        },
     }
 
 
@@ -252,13 +271,20 @@ def write_manifest(root: Path, manifest: dict[str, Any]) -> None:
         tmp.write_text(text + "\n", encoding="utf-8")
 
 
-def read_manifest(root: Path) -> dict[str, Any]:
+def read_manifest(root: Path, *, check_entries: bool = True) -> dict[str, Any]:
     """The manifest of the dataset folder ``root``.
+
+    Parameters
+    ----------
+    root : Path
+    check_entries : bool
+        Also check its count, shard size and every entry (:func:`manifest_entries`).
 
     Raises
     ------
     DataError
-        If it is missing, unreadable or not a scenegen dataset manifest.
+        If it is missing, unreadable or not a scenegen dataset manifest, or (with
+        ``check_entries``) an entry is damaged: one line naming the file and the entry.
     """
     p = Path(root) / MANIFEST
     try:
@@ -271,7 +297,191 @@ def read_manifest(root: Path) -> dict[str, Any]:
         raise DataError(f"{p}: not a scenegen dataset manifest (schema {SCHEMA} expected)")
     if not isinstance(data.get("sequences"), list):
         raise DataError(f"{p}: no 'sequences' list")
+    if check_entries:
+        _, bad = manifest_entries(data, p)
+        if bad:
+            more = f" (and {len(bad) - 1} more damaged entries)" if len(bad) > 1 else ""
+            raise DataError(bad[0] + more)
     return data
+
+
+_ENTRY = {"index": int, "name": str, "seed": int, "preset": str, "file": str,
+          "params": dict, "n_frames": int, "width": int, "height": int, "targets": int,
+          "digests": dict}  # fmt: skip
+"""The fields of a manifest entry (:func:`_entry`) and their types."""
+
+
+def _is(value: Any, kind: type) -> bool:
+    return isinstance(value, kind) and not isinstance(value, bool)
+
+
+def manifest_entries(
+    manifest: dict[str, Any], path: Path
+) -> tuple[list[dict[str, Any]], list[str]]:
+    """The sound entries of a manifest, and one line per damaged one.
+
+    An entry is sound when it is a mapping with every field of an entry, each of its type
+    (digests: names to strings), its index in ``0 .. count-1`` and not listed before, and
+    its file the shard its index belongs to. Every reader of a manifest checks it so
+    (:func:`read_manifest`); :func:`scenegen.datasets.validate_dataset` lists every line.
+
+    Parameters
+    ----------
+    manifest : dict
+        As read from ``manifest.json`` (with a ``sequences`` list).
+    path : Path
+        The manifest file, for messages.
+
+    Returns
+    -------
+    sound : list of dict
+    problems : list of str
+        ``"PATH: entry K (NAME): what is wrong"`` per damaged entry, K its position.
+
+    Raises
+    ------
+    DataError
+        If the header's ``count`` or ``shard_size`` is not an integer >= 1.
+    """
+    from scenegen.config import _short
+
+    count, size = manifest.get("count"), manifest.get("shard_size")
+    if not (_is(count, int) and _is(size, int) and count >= 1 and size >= 1):
+        raise DataError(f"{path}: count and shard_size must be integers >= 1")
+    sound: list[dict[str, Any]] = []
+    problems: list[str] = []
+    seen: set[int] = set()
+    for k, e in enumerate(manifest["sequences"]):
+        if not isinstance(e, dict):
+            problems.append(f"{path}: entry {k}: not an entry (a mapping), got {_short(e)}")
+            continue
+        name = f" ({_short(e['name'])})" if isinstance(e.get("name"), str) else ""
+        where = f"{path}: entry {k}{name}"
+        missing = [f for f in _ENTRY if f not in e]
+        wrong = [f for f, kind in _ENTRY.items() if f in e and not _is(e[f], kind)]
+        if missing:
+            problems.append(f"{where}: no {missing[0]!r}")
+        elif wrong:
+            f = wrong[0]
+            kind = {int: "an integer", str: "a string", dict: "a mapping"}[_ENTRY[f]]
+            problems.append(f"{where}: {f} must be {kind}, got {_short(e[f])}")
+        elif not all(isinstance(v, str) for v in e["digests"].values()):
+            problems.append(f"{where}: digests must map array names to strings")
+        elif not 0 <= e["index"] < count:
+            problems.append(f"{where}: index {e['index']} out of range 0..{count - 1}")
+        elif e["index"] in seen:
+            problems.append(f"{where}: index {e['index']} listed twice")
+        elif e["file"] != shard_name(e["index"] // size):
+            problems.append(f"{where}: sequence {e['index']} listed in {_short(e['file'])}, "
+                            f"expected {shard_name(e['index'] // size)!r}")  # fmt: skip
+        else:
+            seen.add(e["index"])
+            sound.append(e)
+    return sound, problems
+
+
+def manifest_axes(manifest: dict[str, Any], path: Path) -> tuple[Axis, ...]:
+    """The grid axes the header of a manifest lists (``axes``).
+
+    Raises
+    ------
+    DataError
+        One line naming ``path`` when ``axes`` is not a list of axes.
+    """
+    try:
+        axes = tuple(Axis(str(a["name"]), tuple(a["paths"]), tuple(map(tuple, a["values"])))
+                     for a in manifest["axes"])  # fmt: skip
+    except (KeyError, TypeError) as err:
+        raise DataError(f"{path}: axes is not a list of grid axes ({type(err).__name__}: "
+                        f"{str(err)[:80]})") from None  # fmt: skip
+    if any(len(v) != len(a.paths) for a in axes for v in a.values):
+        raise DataError(f"{path}: axes is not a list of grid axes (a value per path)")
+    return axes
+
+
+def manifest_family(manifest: dict[str, Any], path: Path) -> Family:
+    """The family a manifest's sequences were drawn from, as its header describes it.
+
+    From the header's ``resolved`` family, ``axes`` and ``vary``, checked against its
+    ``family_digest``; so every entry can be drawn again (:meth:`Family.draw`). A manifest
+    written before the header held ``resolved`` is tried with its ``family_spec`` (which
+    gives the digest only when the order of its sections' keys is the sorted one: the
+    manifest is written with sorted keys).
+
+    Raises
+    ------
+    DataError
+        One line naming ``path``: the header does not describe a family, or one with
+        another digest (edited); for an older manifest whose ``family_spec`` does not give
+        its digest, the command that updates it.
+    """
+    from scenegen.datasets.family import Distribution, family_from_dict
+
+    res, seed = manifest.get("resolved"), manifest.get("seed")
+    if not (_is(seed, int) and seed >= 0):
+        raise DataError(f"{path}: seed must be a non-negative integer")
+    try:
+        if isinstance(res, dict):
+            fam = Family(
+                name=manifest["family"], description=str(manifest.get("description", "")),
+                bases=dict(res["bases"]), base=res["base"],
+                overrides=tuple((str(p), v) for p, v in res["set"]),
+                axes=manifest_axes(manifest, path),
+                distributions=tuple(Distribution(d["path"], d["kind"], tuple(d["args"]))
+                                    for d in manifest["vary"]),
+                count=manifest["count"], seed=seed, source=str(path),
+            )  # fmt: skip
+        else:  # an older manifest: family_spec may name files found no more, and lost
+            try:  # the order of its keys
+                fam = family_from_dict(manifest.get("family_spec"), source="family_spec")
+                ok = fam.digest() == manifest.get("family_digest")
+            except ConfigError:
+                ok = False
+            if not ok:
+                raise DataError(f"{path}: no resolved family in the header (written by an "
+                                "older version of scenegen), and its family_spec does not "
+                                "give its family_digest: run the same `scenegen dataset` "
+                                "command again to update the manifest")  # fmt: skip
+        ok = fam.digest() == manifest.get("family_digest")
+    except DataError:
+        raise
+    except (KeyError, TypeError, ValueError, AttributeError) as err:  # ConfigError too
+        raise DataError(f"{path}: the header does not describe a family "
+                        f"({type(err).__name__}: {str(err)[:120]})") from None  # fmt: skip
+    if not ok:
+        raise DataError(f"{path}: the header's family does not have its family_digest "
+                        "(edited, or made by another version of scenegen)")  # fmt: skip
+    return fam
+
+
+def holds_benchmark_outputs(folder: Path) -> bool:
+    """True for a folder holding what ``scenegen benchmark`` writes (even damaged):
+    ``scores.csv`` or ``leaderboard.md``, or run folders under ``runs/``.
+
+    Defined here, below the lab, so that no dataset is written into one;
+    :func:`scenegen.lab.benchmark_outputs.is_benchmark_folder` uses it.
+    """
+    root = Path(folder)
+    if (root / "scores.csv").is_file() or (root / "leaderboard.md").is_file():
+        return True
+    runs = root / "runs"
+    return runs.is_dir() and any(p.is_dir() for p in runs.iterdir())
+
+
+def make_output_folder(folder: Path) -> None:
+    """Create the output folder ``folder`` (``-o``) and its parents, if missing.
+
+    Raises
+    ------
+    ConfigError
+        One line naming the folder when it cannot be created (a parent is a file, a
+        read-only or virtual file system).
+    """
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as err:
+        raise ConfigError(f"-o {folder}: cannot create the folder "
+                          f"({err.strerror or type(err).__name__})") from None  # fmt: skip
 
 
 def build_dataset(
@@ -323,8 +533,9 @@ def build_dataset(
     Raises
     ------
     ConfigError
-        For a bad family, count, seed, executor or compression, or an ``out`` that holds
-        another dataset.
+        For a bad family, count, seed, executor or compression; a ``frames`` the family
+        sweeps or draws; an ``out`` that cannot be created, holds another dataset, a
+        damaged manifest or a benchmark's outputs.
     """
     from tqdm import tqdm
 
@@ -334,7 +545,10 @@ def build_dataset(
     if frames is not None:
         if isinstance(frames, bool) or not isinstance(frames, int) or frames < 1:
             raise ConfigError(f"--frames must be >= 1, got {frames}")
-        fam = fam.with_overrides({"n_frames": frames})
+        try:
+            fam = fam.with_overrides({"n_frames": frames})
+        except ConfigError as err:
+            raise ConfigError(f"--frames {frames}: {err}") from None
     check_executor(jobs, scheduler)
     filter_options(compression)
     n = fam.count if count is None else count
@@ -348,6 +562,9 @@ def build_dataset(
     root = Path(out)
     if root.exists() and not root.is_dir():
         raise ConfigError(f"{root}: exists and is not a folder")
+    if root.is_dir() and holds_benchmark_outputs(root):
+        raise ConfigError(f"-o {root}: is a benchmark output folder (scenegen benchmark); "
+                          "write the dataset into another folder")  # fmt: skip
     draws = fam.draws(n, s)  # validates every sequence's config before any work
     if scheduler is not None:
         probe(scheduler)  # an unreachable scheduler fails before anything is written
@@ -357,7 +574,8 @@ def build_dataset(
         try:
             old = read_manifest(root)
         except DataError as err:
-            raise ConfigError(f"{err}; remove it or choose another output folder") from None
+            raise ConfigError(f"{err}; cannot resume the dataset in {root}: remove the folder "
+                              "or choose another output folder") from None  # fmt: skip
         diff = [k for k in _IDENTITY if old.get(k) != header[k]]
         if diff:
             was = ", ".join(f"{k}={old.get(k)!r}" for k in diff if k != "family_digest")
@@ -373,7 +591,7 @@ def build_dataset(
             )
         previous = {int(e["index"]): e for e in old["sequences"] if isinstance(e, dict)}
     else:
-        root.mkdir(parents=True, exist_ok=True)
+        make_output_folder(root)
         if any(root.glob("shard-*.h5")):
             raise ConfigError(f"{root}: holds shard files but no {MANIFEST}; choose another folder")
     tasks = plan_shards(draws, root, shard_size, compression, previous)

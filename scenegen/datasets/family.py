@@ -48,8 +48,8 @@ from typing import Any, Literal, get_args, get_origin
 import numpy as np
 
 from scenegen import presets
-from scenegen.config import from_dict, load_config, to_dict
-from scenegen.datasets.paths import leaf_type, set_path
+from scenegen.config import from_dict, load_config, load_data, to_dict
+from scenegen.datasets.paths import canonical_path, leaf_type, set_path
 from scenegen.errors import ConfigError
 
 __all__ = [
@@ -94,6 +94,12 @@ class Axis:
 
     def __len__(self) -> int:
         return len(self.values)
+
+    def level(self, j: int) -> Any:
+        """The axis's value at grid position ``j``: that of its field, the one all its
+        fields share (``occluder_width``: 36, 44, ...), or the list of its fields' values."""
+        vals = list(self.values[j])
+        return vals[0] if all(v == vals[0] for v in vals) else vals
 
 
 @dataclass(frozen=True)
@@ -178,6 +184,11 @@ class Family:
     seed : int
     source : str
         Where it came from (a file name or ``built-in``), for messages.
+    spec : dict
+        The family as given (:meth:`with_overrides` keeps it: its overrides are in
+        ``overrides``).
+    folder : Path or None
+        Folder that relative ``base`` config files are read from.
     """
 
     name: str
@@ -210,11 +221,26 @@ class Family:
         return out
 
     def with_overrides(self, overrides: dict[str, Any]) -> Family:
-        """The family with more ``set`` entries (applied after its own); re-validated."""
+        """The family with more ``set`` entries (applied after its own); re-validated.
+
+        Its ``spec`` stays the family as given.
+
+        Raises
+        ------
+        ConfigError
+            If the family sweeps or draws one of the fields (the override would be
+            ignored), or the result is invalid.
+        """
+        for p in overrides:
+            for where, q in _setters(self.axes, [d.path for d in self.distributions]):
+                if _same_field(self.bases, self.overrides, str(p), q):
+                    raise _fail(self.source, f"{where}.{q}",
+                                f"sets {p} per sequence; it cannot be overridden")  # fmt: skip
         spec = copy.deepcopy(self.spec)
-        spec["set"] = {**(spec.get("set") or {}), **overrides}
+        spec["set"] = {**dict(self.overrides), **overrides}
         spec.setdefault("count", self.count)
-        return family_from_dict(spec, source=self.source, folder=self.folder)
+        fam = family_from_dict(spec, source=self.source, folder=self.folder)
+        return dataclasses.replace(fam, spec=copy.deepcopy(self.spec))
 
     def digest(self) -> str:
         """SHA-256 (hex) of everything that defines the sequences except the count and seed."""
@@ -441,6 +467,31 @@ def _kind_name(tp: Any) -> str:
     return f"a {getattr(tp, '__name__', str(tp))}"
 
 
+def _setters(axes: Any, vary: list[str]) -> list[tuple[str, str]]:
+    """(section, path) of every field path the sweep and vary sections set, in order."""
+    out = [(f"sweep.{a.name}" if len(a.paths) > 1 else "sweep", p)
+           for a in axes for p in a.paths if p != "preset"]  # fmt: skip
+    return out + [("vary", p) for p in vary]
+
+
+def _same_field(bases: dict[str, dict[str, Any]], overrides: Any, a: str, b: str) -> bool:
+    """Whether paths ``a`` and ``b`` name the same field (``clutter[clutter].count`` and
+    ``clutter[0].count``) in one of the bases with ``overrides`` ((path, value) pairs) set."""
+    if a == b:
+        return True
+    for data in bases.values():
+        if overrides:
+            data = copy.deepcopy(data)
+            for p, v in overrides:
+                set_path(data, p, copy.deepcopy(v))
+        try:
+            if canonical_path(data, a) == canonical_path(data, b):
+                return True
+        except ConfigError:  # a path this base lacks (reported where it is checked)
+            continue
+    return False
+
+
 def family_from_dict(data: Any, *, source: str = "family", folder: Path | None = None) -> Family:
     """Parse and validate a family from plain data (as read from YAML/JSON).
 
@@ -497,12 +548,6 @@ def family_from_dict(data: Any, *, source: str = "family", folder: Path | None =
         if "base" not in data:
             raise _fail(source, "base", "is required (a preset name, a config file or a mapping)")
         base, bases[base] = _load_base(data["base"], source, folder)
-    seen: set[str] = set()
-    all_paths = [p for a in axes for p in a.paths if p != "preset"] + list(vary)
-    for p in all_paths:
-        if p in seen:
-            raise _fail(source, str(p), "set by two axes or distributions")
-        seen.add(p)
     # Overrides apply first: later paths are checked against the base with them set.
     checked: dict[str, dict[str, Any]] = {}
     for key, cfg in bases.items():
@@ -523,6 +568,12 @@ def family_from_dict(data: Any, *, source: str = "family", folder: Path | None =
             raise _fail(source, "vary.preset", "sweep the preset instead (sweep: {preset: [...]})")
         tp = _check_path(source, "vary", checked, str(p))
         dists.append(_distribution(source, str(p), spec, tp))
+    setters = _setters(axes, [str(p) for p in vary])
+    for k, (where, p) in enumerate(setters):
+        for other, q in setters[:k]:
+            if _same_field(checked, (), p, q):
+                raise _fail(source, f"{where}.{p}",
+                            f"set by two axes or distributions (also by {other}.{q})")  # fmt: skip
     fam = Family(
         name=name,
         description=description,
@@ -554,12 +605,20 @@ def family_from_dict(data: Any, *, source: str = "family", folder: Path | None =
                     b = v
                 else:
                     sets.append((p, v))
-        fam._config(b, sets, f"{name}-check", "sweep")
+        try:
+            fam._config(b, sets, f"{name}-check", "sweep")
+        except ConfigError:
+            fam._config(b, [], f"{name}-check", "set")  # the set section's own error first
+            raise
     return fam
 
 
 def load_family(path: str | Path) -> Family:
     """Read a family file (``.yaml``, ``.yml`` or ``.json``) and validate it.
+
+    It is read as a scenario config is (:func:`scenegen.config.load_data`: UTF-8, at most
+    :data:`~scenegen.config.MAX_CONFIG_BYTES`, YAML aliases bounded, duplicate keys
+    refused).
 
     Raises
     ------
@@ -568,23 +627,5 @@ def load_family(path: str | Path) -> Family:
         the file and the field path).
     """
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except OSError as err:
-        raise ConfigError(f"{p}: cannot read family: {err.strerror or err}") from None
-    suffix = p.suffix.lower()
-    try:
-        if suffix in (".yaml", ".yml"):
-            import yaml
-
-            data = yaml.safe_load(text)
-        elif suffix == ".json":
-            data = json.loads(text)
-        else:
-            raise ConfigError(f"{p}: a family file must be .yaml, .yml or .json, got {p.suffix!r}")
-    except ConfigError:
-        raise
-    except Exception as err:  # yaml/json parser errors: one line
-        first = str(err).splitlines()[0] if str(err) else type(err).__name__
-        raise ConfigError(f"{p}: not valid {suffix[1:].upper()}: {first}") from None
+    data = load_data(p, "family")
     return family_from_dict(data, source=str(p), folder=p.parent)

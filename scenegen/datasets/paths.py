@@ -29,7 +29,7 @@ from typing import Any, get_args, get_origin
 from scenegen.config import SceneConfig
 from scenegen.errors import ConfigError
 
-__all__ = ["get_path", "leaf_type", "parse_path", "set_path"]
+__all__ = ["canonical_path", "get_path", "leaf_type", "parse_path", "set_path"]
 
 _TOKEN = re.compile(r"\.?([A-Za-z_][A-Za-z0-9_]*)|\[([^\[\]]+)\]")
 
@@ -73,12 +73,14 @@ def _unwrap(tp: Any) -> Any:
     return tp
 
 
-def _walk(data: Any, path: str) -> tuple[Any, str | int, Any]:
-    """(container, key, leaf type) of ``path`` in ``data``; raises naming what is wrong."""
+def _walk(data: Any, path: str) -> tuple[Any, str | int, Any, str]:
+    """(container, key, leaf type, path with every index a number) of ``path`` in ``data``;
+    raises naming what is wrong."""
     tokens = parse_path(path)
     tp: Any = SceneConfig
     cur: Any = data
     done = ""
+    canon = ""
     for i, tok in enumerate(tokens):
         last = i == len(tokens) - 1
         if isinstance(tok, str) and not tok.startswith("["):
@@ -95,6 +97,7 @@ def _walk(data: Any, path: str) -> tuple[Any, str | int, Any]:
                 raise ConfigError(f"{path}: {done} is not a mapping")
             key: str | int = tok
             done = f"{done}.{tok}" if done else tok
+            canon = f"{canon}.{tok}" if canon else tok
         else:
             if get_origin(tp) is not tuple:
                 raise ConfigError(f"{path}: {done} is not a list")
@@ -122,8 +125,9 @@ def _walk(data: Any, path: str) -> tuple[Any, str | int, Any]:
             hint = args[0] if len(args) == 2 and args[1] is Ellipsis else args[key]
             hint = _unwrap(hint)
             done = f"{done}[{tok if isinstance(tok, int) else tok[1:-1]}]"
+            canon = f"{canon}[{key}]"
         if last:
-            return cur, key, hint
+            return cur, key, hint, canon
         nxt = cur[key] if isinstance(cur, list) else cur.get(key)
         if nxt is None:
             raise ConfigError(f"{path}: {done} is null in the base scenario; set it first")
@@ -142,13 +146,26 @@ def leaf_type(data: dict[str, Any], path: str) -> Any:
     return _walk(data, path)[2]
 
 
+def canonical_path(data: dict[str, Any], path: str) -> str:
+    """The field ``path`` names in ``data``, with every index a number:
+    ``clutter[clutter].count`` -> ``clutter[0].count`` (two paths set the same field when
+    these are equal).
+
+    Raises
+    ------
+    ConfigError
+        As :func:`leaf_type`.
+    """
+    return _walk(data, path)[3]
+
+
 def get_path(data: dict[str, Any], path: str) -> Any:
     """The value at ``path`` in plain config data."""
-    cont, key, _ = _walk(data, path)
+    cont, key, _, _ = _walk(data, path)
     return cont[key] if isinstance(cont, list) else cont.get(key)
 
 
 def set_path(data: dict[str, Any], path: str, value: Any) -> None:
     """Set the value at ``path`` in plain config data, in place."""
-    cont, key, _ = _walk(data, path)
+    cont, key, _, _ = _walk(data, path)
     cont[key] = value

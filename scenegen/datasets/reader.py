@@ -129,17 +129,18 @@ class Dataset:
             Conditions keyed by name or by the last field of a path (``count=300``,
             ``position_noise=(4, 8)``). A value matches by equality; a 2-tuple
             ``(low, high)`` is an inclusive range (None: open); a set lists the accepted
-            values; a callable is a predicate.
+            values; a callable is a predicate. Every condition must hold, also two on the
+            same parameter (one in ``where``, one here).
 
         Raises
         ------
         ConfigError
             For a parameter the dataset does not record.
         """
-        conds = {self._param_key(k): v for k, v in {**(where or {}), **params}.items()}
+        conds = [(self._param_key(k), v) for k, v in [*(where or {}).items(), *params.items()]]
         keep = [
             e for e in self.entries
-            if all(_matches(e["params"].get(k), v) for k, v in conds.items())
+            if all(_matches(e["params"].get(k), v) for k, v in conds)
         ]  # fmt: skip
         return Dataset(self.root, self.manifest, keep)
 
@@ -255,7 +256,8 @@ def open_dataset(root: str | Path) -> Dataset:
     Raises
     ------
     DataError
-        If the folder holds no valid manifest.
+        If the folder holds no valid manifest, or one with a damaged entry (one line
+        naming ``manifest.json`` and the entry; :func:`scenegen.datasets.build.manifest_entries`).
     """
     p = Path(root)
     manifest = read_manifest(p)

@@ -6,8 +6,17 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from scenegen.datasets.build import read_manifest, shard_name
-from scenegen.errors import DataError
+from scenegen.datasets.build import (
+    MANIFEST,
+    _entry,
+    _header,
+    is_drawn,
+    manifest_entries,
+    manifest_family,
+    read_manifest,
+)
+from scenegen.datasets.family import Family
+from scenegen.errors import ConfigError, DataError
 
 __all__ = ["validate_dataset"]
 
@@ -17,11 +26,15 @@ def validate_dataset(
 ) -> list[str]:
     """Problems of the dataset folder ``root``, one line each (empty if valid).
 
-    Checks that the manifest is readable and complete (one entry per index 0..count-1,
-    in the shard its index belongs to), that every shard file passes
-    :func:`scenegen.io.validate.check_file`, holds exactly its sequences, and that each
-    sequence's seed and contents match the manifest's seed and digests; shard files the
-    manifest does not list are reported too.
+    Checks that the manifest is readable and complete (one sound entry per index
+    0..count-1, in the shard its index belongs to: :func:`manifest_entries`), that its
+    header describes the family of its ``family_digest`` (:func:`manifest_family`), that
+    every shard file passes :func:`scenegen.io.validate.check_file` and holds exactly its
+    sequences, that each sequence is the one the family draws for its index (seed,
+    preset, config) and its contents match the manifest's digests, and that each entry
+    says what the builder would write for it (name, seed, preset, ``params``,
+    ``n_frames``, width, height, targets); shard files the manifest does not list are
+    reported too.
 
     Parameters
     ----------
@@ -37,60 +50,60 @@ def validate_dataset(
     from scenegen.testing.fixtures import digests
 
     p = Path(root)
+    mpath = p / MANIFEST
     try:
-        man = read_manifest(p)
+        man = read_manifest(p, check_entries=False)
+        entries, problems = manifest_entries(man, mpath)
     except DataError as err:
         return [str(err)]
-    problems: list[str] = []
-    count, size = man.get("count"), man.get("shard_size")
-    if not isinstance(count, int) or not isinstance(size, int) or size < 1:
-        return [f"{p / 'manifest.json'}: count and shard_size must be integers"]
+    count = man["count"]
     if not man.get("complete"):
-        problems.append(f"{p}: incomplete dataset (the build was interrupted); rerun it")
+        problems.insert(0, f"{p}: incomplete dataset (the build was interrupted); rerun it")
+    fam: Family | None = None
+    try:
+        fam = manifest_family(man, mpath)
+    except DataError as err:
+        problems.append(str(err))
+    if fam is not None:
+        want = _header(fam, count, man["seed"], man["shard_size"], man.get("compression"))
+        off = [k for k in ("family", "shards", "params", "axes", "vary") if man.get(k) != want[k]]
+        if off:
+            verb = "differs" if len(off) == 1 else "differ"
+            problems.append(f"{mpath}: {', '.join(off)} {verb} from what its family gives "
+                            "(edited)")  # fmt: skip
     by_file: dict[str, list[dict]] = {}
-    seen: set[int] = set()
-    for e in man["sequences"]:
-        i = e.get("index") if isinstance(e, dict) else None
-        if not isinstance(i, int) or not 0 <= i < count or i in seen:
-            problems.append(f"{p / 'manifest.json'}: bad or duplicate entry index {i!r}")
-            continue
-        seen.add(i)
-        if e.get("file") != shard_name(i // size):
-            problems.append(f"{p / 'manifest.json'}: sequence {i} listed in {e.get('file')!r}, "
-                            f"expected {shard_name(i // size)!r}")  # fmt: skip
-            continue
+    for e in entries:
         by_file.setdefault(e["file"], []).append(e)
-    missing = sorted(set(range(count)) - seen)
+    missing = sorted(set(range(count)) - {e["index"] for e in entries})
     if missing:
         shown = ", ".join(map(str, missing[:5])) + (" ..." if len(missing) > 5 else "")
         problems.append(f"{p}: {len(missing)} of {count} sequences not in the manifest: {shown}")
     listed = set(by_file)
     for extra in sorted(f.name for f in p.glob("shard-*.h5") if f.name not in listed):
         problems.append(f"{p / extra}: shard file not listed in the manifest")
-    for n, (file, entries) in enumerate(sorted(by_file.items())):
+    for n, (file, group) in enumerate(sorted(by_file.items())):
         path = p / file
         if not path.is_file():
-            problems.append(f"{path}: missing shard file ({len(entries)} sequences)")
+            problems.append(f"{path}: missing shard file ({len(group)} sequences)")
             continue
         found = check_file(path, isolate=True)
         if found:
             problems += found
             continue
-        names = [e["name"] for e in sorted(entries, key=lambda e: e["index"])]
+        group = sorted(group, key=lambda e: e["index"])
+        names = [e["name"] for e in group]
         try:
             have = sequence_names(path)
             if have != names:
                 problems.append(f"{path}: holds {have}, the manifest lists {names}")
                 continue
-            for e in entries:
+            for e in group:
                 seq = read(path, e["name"])
-                if seq.seed != e.get("seed"):
-                    problems.append(
-                        f"{path}: {e['name']}: seed {seq.seed}, manifest {e.get('seed')}"
-                    )
+                if fam is not None:
+                    problems += _against_family(fam, man["seed"], e, seq, path, mpath)
                 got = digests(seq)
-                bad = sorted(k for k, v in (e.get("digests") or {}).items() if got.get(k) != v)
-                if bad or not e.get("digests"):
+                bad = sorted(k for k, v in e["digests"].items() if got.get(k) != v)
+                if bad or not e["digests"]:
                     what = ", ".join(bad) if bad else "no digests in the manifest"
                     problems.append(
                         f"{path}: {e['name']}: contents differ from the manifest: {what}"
@@ -108,6 +121,33 @@ def validate_dataset(
         if progress is not None:
             progress(n + 1)
     return problems
+
+
+def _against_family(
+    fam: Family, seed: int, e: dict[str, Any], seq: Any, path: Path, mpath: Path
+) -> list[str]:
+    """The sequence ``seq`` stored for entry ``e`` against the family's draw for its index,
+    and ``e`` against the entry the builder makes of them (:func:`_entry`): one line each."""
+    from scenegen.config import _short
+
+    try:
+        d = fam.draw(e["index"], seed)
+    except ConfigError as err:
+        return [f"{mpath}: sequence {e['index']} cannot be drawn again: {err}"]
+    if not is_drawn(seq, d):
+        return [f"{path}: {e['name']}: is not the sequence its family draws for index "
+                f"{e['index']} (seed, preset or config differ)"]  # fmt: skip
+    want = _entry(d, e["file"], seq, e["digests"])
+    off = [k for k in want if e.get(k) != want[k]]
+    if not off:
+        return []
+    k, have, should = off[0], e.get(off[0]), want[off[0]]
+    if k == "params":  # name the first parameter that differs
+        keys = [q for q in {**should, **have} if have.get(q, None) != should.get(q, None)]
+        k, have, should = f"params[{keys[0]!r}]", have.get(keys[0]), should.get(keys[0])
+    verb = "differs" if len(off) == 1 else "differ"
+    return [f"{mpath}: entry of {e['name']}: {', '.join(off)} {verb} from its sequence "
+            f"({k}: {_short(have)} in the manifest, {_short(should)} drawn)"]  # fmt: skip
 
 
 def _regenerate(seq: Any) -> Any:

@@ -248,7 +248,7 @@ def plan_benchmark(
     DataError
         If ``root`` is not a dataset folder.
     """
-    from scenegen.datasets import read_manifest
+    from scenegen.datasets.build import manifest_axes, read_manifest
 
     if not trackers:
         raise ConfigError("give at least one --tracker")
@@ -269,12 +269,20 @@ def plan_benchmark(
     man = read_manifest(root)
     if not man.get("complete"):
         raise ConfigError(f"{root}: the dataset is incomplete; finish it with scenegen dataset")
+    # A named axis (several fields moved together) is recorded by its grid position in the
+    # manifest (what ds.select takes); the records, scores and curves take its value.
+    named = [a for a in manifest_axes(man, root / "manifest.json") if len(a.paths) > 1]
     tasks = []
     for t in trackers:
         p = tuple(sorted(per[t].items()))
         for e in sorted(man["sequences"], key=lambda e: e["index"]):
             fd = str((e.get("digests") or {}).get("frames", ""))
-            sp = json.dumps(e.get("params", {}), sort_keys=True)
+            values = dict(e["params"])
+            for a in named:
+                j = values.get(a.name)
+                if isinstance(j, int) and not isinstance(j, bool) and 0 <= j < len(a):
+                    values[a.name] = a.level(j)
+            sp = json.dumps(values, sort_keys=True)
             tasks.append(
                 BenchTask(str(root), int(e["index"]), e["name"], e["file"], int(e["seed"]),
                           fd, t, p, sp)
@@ -520,12 +528,13 @@ def run_benchmark(
     ------
     ConfigError
         As :func:`plan_benchmark`; a bad ``jobs`` or an unreachable scheduler; ``out``
-        holding a dataset (its ``manifest.json``).
+        holding a dataset (its ``manifest.json``) or that cannot be created.
     DataError
         ``dataset`` is not a dataset folder, or a shard is damaged.
     """
     from tqdm import tqdm
 
+    from scenegen.datasets.build import make_output_folder
     from scenegen.datasets.executor import check_executor, probe, run_tasks
     from scenegen.lab.benchmark_outputs import listed_digests, load_record
 
@@ -539,7 +548,7 @@ def run_benchmark(
         what = "the dataset folder" if outp.resolve() == root.resolve() else "a dataset folder"
         raise ConfigError(f"-o {outp}: is {what} (manifest.json); write the benchmark into "
                           "another folder")  # fmt: skip
-    outp.mkdir(parents=True, exist_ok=True)
+    make_output_folder(outp)
     meta = dataset_meta(man, root)
     listed = listed_digests(outp, meta)
     records: dict[tuple[str, int], dict[str, Any]] = {}

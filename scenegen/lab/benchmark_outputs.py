@@ -31,6 +31,7 @@ from typing import Any
 from scenegen.errors import DataError
 from scenegen.io.sealed import Unsealed, content_digest, read_sealed_json
 from scenegen.lab.experiments.outputs import _more, parse_listing, read_checked, warn
+from scenegen.lab.experiments.runner import _round
 
 __all__ = [
     "RESULTS",
@@ -175,7 +176,9 @@ def load_record(path: Path, task: Any, listed: tuple[str, dict[str, Any]] | None
     ``results.json`` (``listed``: :func:`listed_digests`' entry for the file, computed on
     this dataset) with another digest while that listing was computed with the same
     tracker parameters: None, with one warning line. Missing, or stored for another key
-    of the same file (other tracker parameters, another dataset): None, silently.
+    of the same file (other tracker parameters, another dataset) or with other sequence
+    parameters (a named axis by its grid position, as before its value was recorded):
+    None, silently.
     """
     if not path.exists():
         return None
@@ -192,7 +195,9 @@ def load_record(path: Path, task: Any, listed: tuple[str, dict[str, Any]] | None
         warn(f"{path}: is not the run {RESULTS} lists (edited or replaced since); "
              "running it again")  # fmt: skip
         return None
-    if data["key"] != task.key():
+    if data["key"] != task.key() or data["sequence_params"] != _round(
+        json.loads(task.sequence_params)
+    ):  # another run, or the sequence's parameters as an earlier version recorded them
         return None
     return data
 
@@ -200,13 +205,12 @@ def load_record(path: Path, task: Any, listed: tuple[str, dict[str, Any]] | None
 def is_benchmark_folder(folder: str | Path) -> bool:
     """True for a folder that ``scenegen benchmark`` wrote (even a damaged one): it has
     ``scores.csv`` or ``leaderboard.md``, or run folders under ``runs/``."""
+    from scenegen.datasets.build import holds_benchmark_outputs
+
     root = Path(folder)
     if not root.is_dir() or (root / "manifest.json").exists():
         return False
-    if (root / "scores.csv").is_file() or (root / "leaderboard.md").is_file():
-        return True
-    runs = root / "runs"
-    return runs.is_dir() and any(p.is_dir() for p in runs.iterdir())
+    return holds_benchmark_outputs(root)
 
 
 def check_benchmark(folder: str | Path, *, deep: bool = False,

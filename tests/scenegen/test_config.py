@@ -140,3 +140,56 @@ def test_load_config_errors_name_the_file(tmp_path):
     inv.write_text(yaml.safe_dump(mutate(["width"], -1)))
     with pytest.raises(ConfigError, match=r"inv\.yaml: width: must be >= 1"):
         load_config(inv)
+
+
+def test_numpy_scalars_are_numbers():
+    import numpy as np
+
+    cfg = from_dict({**base(), "width": np.int64(40), "height": np.uint8(30),
+                     "sensor_noise": np.float32(1.5), "n_frames": np.float64(2.0)})  # fmt: skip
+    assert (cfg.width, cfg.height, cfg.n_frames, cfg.sensor_noise) == (40, 30, 2, 1.5)
+    assert type(cfg.width) is int and type(cfg.sensor_noise) is float
+    assert from_dict(to_dict(cfg)) == cfg
+    for field, value, message in (("width", np.bool_(True), "must be an integer"),
+                                  ("width", np.float32(3.5), "must be an integer"),
+                                  ("sensor_noise", np.True_, "must be a number")):  # fmt: skip
+        with pytest.raises(ConfigError, match=f"^{field}: {message}"):
+            from_dict({**base(), field: value})
+
+
+@pytest.mark.parametrize(
+    ("name", "text", "message"),
+    [
+        ("dup.yaml", "width: 40\nheight: 30\nn_frames: 5\nn_frames: 7\n",
+         "duplicate key 'n_frames' (line 4)"),
+        ("dup.json", '{"width": 40, "height": 30, "n_frames": 5, "n_frames": 7}',
+         "duplicate key 'n_frames'"),
+        ("nested.yaml", "width: 40\nheight: 30\nn_frames: 5\nbackground:\n  low: 1\n"
+         "  low: 2\n", "duplicate key 'low' (line 6)"),
+        ("y2.yaml", "width: 40\nheight: 30\nn_frames: 5\nentities:\n  - name: a\n"
+         "   role: target\n",
+         "not valid YAML: expected <block end>, but found '<block mapping start>' "
+         "(line 6, column 4)"),
+        ("bad.json", '{"width": 40,\n "height"}',
+         "not valid JSON: Expecting ':' delimiter: line 2 column 10 (char 23)"),
+    ],
+)  # fmt: skip
+def test_duplicate_keys_and_parser_errors_are_one_line_with_where(tmp_path, capsys, name,
+                                                                    text, message):  # fmt: skip
+    from scenegen.cli import main
+
+    path = tmp_path / name
+    path.write_text(text)
+    with pytest.raises(ConfigError) as info:
+        load_config(path)
+    assert str(info.value) == f"{path}: {message}"
+    assert main(["generate", "--config", str(path), "--seed", "1",
+                 "-o", str(tmp_path / "d.h5")]) == 2  # fmt: skip
+    assert capsys.readouterr().err == f"scenegen: error: {path}: {message}\n"
+    assert not (tmp_path / "d.h5").exists()
+
+
+def test_yaml_merge_keys_may_be_overridden(tmp_path):
+    path = tmp_path / "m.yaml"
+    path.write_text("<<: {width: 40, height: 30, n_frames: 3}\nwidth: 20\n")
+    assert load_config(path) == from_dict({"width": 20, "height": 30, "n_frames": 3})

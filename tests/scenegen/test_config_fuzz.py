@@ -28,6 +28,7 @@ from scenegen.config import (
     MAX_FRAMES,
     MAX_MAGNITUDE,
     MAX_SIDE,
+    MAX_TEMPLATE_PIXELS,
     Appearance,
     Background,
     ClutterSpec,
@@ -261,6 +262,15 @@ ENTITY = {"name": "a", "role": "target", "position": [10, 10]}
          f"must be in (0, {MAX_BLUR:g}]"),
         (base(clutter=[{"count": 3, "n_colors": 10**9}]), "clutter[0].n_colors",
          "must be in 1..256"),
+        (base(entities=[{**ENTITY, "appearance": {"size": [8192, 8192]}}]),
+         "entities[0].appearance.size", "the appearance templates (entities, and clutter "
+         f"count x size) would hold 67,108,864 pixels, more than {MAX_TEMPLATE_PIXELS:,}"),
+        (base(entities=[{**ENTITY, "appearance": {"size": [4096, 4096]}},
+                        {**ENTITY, "name": "b", "role": "distractor", "position": None,
+                         "mimic": "a", "depth": 1}]),
+         "entities[1].appearance.size", "would hold 33,554,432 pixels"),
+        (base(clutter=[{"count": 200, "appearance": {"size": [8192, 8192]}}]),
+         "clutter[0].appearance.size", "would hold 13,421,772,800 pixels"),
     ],
 )  # fmt: skip
 def test_absurd_sizes_are_rejected_not_attempted(data, field, needle):
@@ -298,3 +308,13 @@ def test_generate_cli_on_mutated_configs_exits_0_or_2_with_one_line(folder, data
         assert not out.exists()
     else:
         assert code == 0 and check_file(out) == []
+
+
+def test_the_template_limit_leaves_room_for_every_preset():
+    for name in presets.names():
+        cfg = presets.get(name)
+        pixels = sum(e.appearance.size[0] * e.appearance.size[1] for e in cfg.entities)
+        pixels += sum(c.count * c.appearance.size[0] * c.appearance.size[1] for c in cfg.clutter)
+        assert pixels * 100 < MAX_TEMPLATE_PIXELS, name
+    big = base(entities=[{**ENTITY, "appearance": {"size": [4096, 4096]}}])
+    assert from_dict(big).entities[0].appearance.size == (4096, 4096)  # exactly the limit

@@ -88,3 +88,58 @@ def test_validate_an_unknown_folder_says_what_it_looked_for(tmp_path, capsys):
     assert capsys.readouterr().err.strip() == (
         f"{tmp_path}: not a scenegen folder (no manifest.json of a dataset, results.json of "
         "an experiment, report or benchmark, or runs/)")  # fmt: skip
+
+
+def test_outputs_that_cannot_be_created_exit_2(tmp_path, capsys):
+    family = tmp_path / "tiny.json"
+    family.write_text(json.dumps(TINY))
+    (tmp_path / "afile").write_text("x")
+    bad = tmp_path / "afile" / "out"
+    assert main(["dataset", str(family), "-o", str(bad), "--count", "1", "--jobs", "1"]) == 2
+    assert capsys.readouterr().err == (f"scenegen: error: -o {bad}: cannot create the folder "
+                                       "(Not a directory)\n")  # fmt: skip
+    out = tmp_path / "ds"
+    assert main(["dataset", str(family), "-o", str(out), "--jobs", "1"]) == 0
+    capsys.readouterr()
+    assert main(["benchmark", str(out), "--tracker", "kalman", "-o", str(bad)]) == 2
+    assert capsys.readouterr().err == (f"scenegen: error: -o {bad}: cannot create the folder "
+                                       "(Not a directory)\n")  # fmt: skip
+
+
+def test_a_shard_size_of_0_is_refused(tmp_path, capsys):
+    args = ["dataset", "kams", "--count", "1", "-o", str(tmp_path / "a"), "--shard-size", "0"]
+    assert main(args) == 2
+    assert capsys.readouterr().err == "scenegen: error: --shard-size must be >= 1, got 0\n"
+    assert not (tmp_path / "a").exists()
+
+
+def test_a_damaged_manifest_entry_is_one_line_for_each_verb(tmp_path, capsys):
+    family = tmp_path / "tiny.json"
+    family.write_text(json.dumps(TINY))
+    out = tmp_path / "ds"
+    assert main(["dataset", str(family), "-o", str(out), "--jobs", "1"]) == 0
+    capsys.readouterr()
+    path = out / "manifest.json"
+    man = json.loads(path.read_text())
+    del man["sequences"][1]["name"]
+    path.write_text(json.dumps(man))
+    line = f"{path}: entry 1: no 'name'"
+    assert main(["validate", str(out)]) == 1
+    assert capsys.readouterr().err.splitlines()[0] == line
+    assert main(["benchmark", str(out), "--tracker", "kalman", "-o", str(tmp_path / "b")]) == 1
+    assert capsys.readouterr().err == f"scenegen: error: {line}\n"
+    assert main(["dataset", str(family), "-o", str(out), "--jobs", "1"]) == 2
+    assert capsys.readouterr().err == (f"scenegen: error: {line}; cannot resume the dataset in "
+                                       f"{out}: remove the folder or choose another output "
+                                       "folder\n")  # fmt: skip
+
+
+def test_frames_with_a_swept_frame_count_exits_2(tmp_path, capsys):
+    family = tmp_path / "nf.yaml"
+    family.write_text("name: nf\nbase: kams-a\nsweep:\n  n_frames: [6, 7]\n")
+    out = tmp_path / "nfd"
+    assert main(["dataset", str(family), "-o", str(out), "--count", "2", "--frames", "3",
+                 "--jobs", "1"]) == 2  # fmt: skip
+    assert capsys.readouterr().err == (f"scenegen: error: --frames 3: {family}: sweep.n_frames: "
+                                       "sets n_frames per sequence; it cannot be overridden\n")
+    assert not out.exists()

@@ -113,6 +113,20 @@ BAD = [
     ({"count": 0}, "count: must be an integer >= 1"),
     ({"base": "kams-z"}, "base: unknown preset 'kams-z'"),
     ({"name": "a/b"}, "name: is required"),
+    ({"set": {"n_frames": -10}}, "f.yaml: set: n_frames: must be >= 1, got -10"),
+    ({"set": {"n_frames": -10}, "sweep": {"clutter[0].count": [1, 2]}},
+     "f.yaml: set: n_frames: must be >= 1, got -10"),
+    ({"sweep": {"clutter[0].count": [0, 600]}, "vary": {"clutter[0].count": {"randint": [1, 2]}}},
+     "f.yaml: vary.clutter[0].count: set by two axes or distributions (also by "
+     "sweep.clutter[0].count)"),
+    ({"sweep": {"clutter[clutter].count": [0, 600]},
+      "vary": {"clutter[0].count": {"randint": [100, 110]}}},
+     "f.yaml: vary.clutter[0].count: set by two axes or distributions (also by "
+     "sweep.clutter[clutter].count)"),
+    ({"sweep": {"w": {"entities[target].appearance.size[0]": [9, 10], "n_frames": [3, 4]},
+                "entities[0].appearance.size[0]": [5, 6]}},
+     "f.yaml: sweep.entities[0].appearance.size[0]: set by two axes or distributions (also "
+     "by sweep.w.entities[target].appearance.size[0])"),
 ]  # fmt: skip
 
 
@@ -129,3 +143,48 @@ def test_bad_family_is_one_line_naming_the_field(change, message):
 def test_unknown_family_name_lists_the_valid_ones():
     with pytest.raises(ConfigError, match="built-in families: kams"):
         resolve_family("nope")
+
+
+def test_overrides_keep_the_family_as_given_and_refuse_swept_fields():
+    fam = family_from_dict(FAMILY)
+    more = fam.with_overrides({"n_frames": 3}).with_overrides({"width": 60})
+    assert more.spec == FAMILY and dict(more.overrides)["n_frames"] == 3
+    assert more.draw(0).config["n_frames"] == 3 and more.draw(0).config["width"] == 60
+    with pytest.raises(ConfigError, match=r"^family: sweep.clutter\[0\].count: sets "
+                       r"clutter\[clutter\].count per sequence; it cannot be overridden$"):
+        fam.with_overrides({"clutter[clutter].count": 3})
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        (b"name: f\ndescription: caf\xe9\nbase: kams-a\n",
+         "family is not UTF-8 text (invalid continuation byte)"),
+        (b"name: f\nbase: kams-a\nname: g\n", "duplicate key 'name' (line 3)"),
+        (b"name: f\nbase: kams-a\nsweep:\n  a: [1]\n b: [2]\n",
+         "not valid YAML: expected <block end>, but found '<block mapping start>' "
+         "(line 5, column 2)"),
+        ("\n".join(["name: f", "base: kams-a", 'l0: &l0 ["lol","lol","lol","lol","lol"]']
+                   + [f"l{i}: &l{i} [" + ",".join([f"*l{i - 1}"] * 9) + "]"
+                      for i in range(1, 9)]).encode(),
+         "the YAML's aliases expand to more than 100,000 values"),
+    ],
+)  # fmt: skip
+def test_a_family_file_is_read_as_a_config_is(tmp_path, text, message):
+    path = tmp_path / "f.yaml"
+    path.write_bytes(text)
+    with pytest.raises(ConfigError) as info:
+        load_family(path)
+    assert str(info.value) == f"{path}: {message}"
+    dup = tmp_path / "f.json"
+    dup.write_text('{"name": "f", "base": "kams-a", "name": "g"}')
+    with pytest.raises(ConfigError, match=r"f\.json: duplicate key 'name'$"):
+        load_family(dup)
+
+
+def test_an_axis_level_is_the_value_its_fields_share():
+    from scenegen.datasets.family import Axis
+
+    axis = Axis("w", ("a", "b"), ((36, 36), (44, 50)))
+    assert axis.level(0) == 36 and axis.level(1) == [44, 50]
+    assert Axis("p", ("p",), ((1,), (2,))).level(1) == 2

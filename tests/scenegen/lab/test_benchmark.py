@@ -339,3 +339,45 @@ def test_every_value_edited_and_resealed_is_one_line(reference, tmp_path, target
         problems = check_benchmark(out)
         assert 1 <= len(problems) <= 2 and all(ln.startswith(str(out)) for ln in problems), (
             p, problems)
+
+
+def test_a_dataset_is_not_written_into_a_benchmark_folder(reference, tmp_path):
+    from scenegen.errors import ConfigError
+
+    out = tmp_path / "b"
+    shutil.copytree(reference, out)
+    with pytest.raises(ConfigError, match=f"^-o {out}: is a benchmark output folder "):
+        build_dataset(FAMILY, out, jobs=1)
+    assert files(out) == files(reference)
+
+
+def test_a_named_axis_is_plotted_by_its_values(tmp_path):
+    import csv
+
+    from scenegen.datasets import open_dataset
+
+    named = {"name": "sizes", "base": TWO, "count": 2, "set": {"n_frames": 3},
+             "sweep": {"size": {"entities[a].appearance.size[0]": [10, 14],
+                                "entities[b].appearance.size[0]": [10, 14]}}}  # fmt: skip
+    data = tmp_path / "ds"
+    build_dataset(named, data, jobs=1)
+    ds = open_dataset(data)
+    assert [e["params"]["size"] for e in ds.entries] == [0, 1]  # the manifest: positions
+    assert [e["index"] for e in ds.select(size=1).entries] == [1]
+    res = run_benchmark(data, ["kalman"], tmp_path / "b", jobs=1)
+    curve = next(c for c in res["curves"] if c["axis"] == "size")
+    assert curve["labels"] == ["10", "14"] and curve["x"] == [10.0, 14.0]
+    rows = list(csv.DictReader((tmp_path / "b" / "scores.csv").open()))
+    assert [r["size"] for r in rows] == ["10", "14"]
+    # A record stored with the position (as before) is run again, silently.
+    from scenegen.io.sealed import read_sealed_json, write_sealed_json
+
+    run = tmp_path / "b" / "runs" / "kalman" / "00001.json"
+    rec = read_sealed_json(run)
+    rec["sequence_params"]["size"] = 1
+    write_sealed_json(run, rec)
+    (tmp_path / "b" / "results.json").unlink()
+    ran = []
+    run_benchmark(data, ["kalman"], tmp_path / "b", jobs=1, on_done=ran.append)
+    assert [t.index for t in ran] == [1]
+    assert read_sealed_json(run)["sequence_params"]["size"] == 14
