@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import sys
 from collections.abc import Sequence
+from typing import NoReturn
 
 from scenegen.errors import ConfigError, DataError, TrackerError
 
@@ -22,7 +23,7 @@ def _parser() -> argparse.ArgumentParser:
     from scenegen.cli import benchmark as benchmark_verb
     from scenegen.cli import dataset as dataset_verb
 
-    parser = argparse.ArgumentParser(
+    parser = _OneLineParser(
         prog="scenegen",
         description="Synthetic video scenarios with exact ground truth, and trackers to test.",
     )
@@ -39,6 +40,28 @@ def _parser() -> argparse.ArgumentParser:
         if verb.description is None and action.help:
             verb.description = action.help[0].upper() + action.help[1:] + "."
     return parser
+
+
+class _OneLineParser(argparse.ArgumentParser):
+    """argparse, with a usage error as one line (the contract: an error is one line on
+    stderr) that points at the verb's ``--help`` instead of printing the usage block.
+    The verbs' parsers are of this class too (``add_subparsers`` makes its own kind)."""
+
+    def error(self, message: str) -> NoReturn:
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
+def _interrupted(err: BaseException) -> bool:
+    """Whether ``err`` came of a Ctrl-C: a compiled kernel interrupted mid-call raises
+    ``SystemError`` with the ``KeyboardInterrupt`` as its cause."""
+    seen: set[int] = set()
+    cur: BaseException | None = err
+    while cur is not None and id(cur) not in seen:
+        if isinstance(cur, KeyboardInterrupt):
+            return True
+        seen.add(id(cur))
+        cur = cur.__cause__ or cur.__context__
+    return False
 
 
 def _silence_stdout() -> None:
@@ -85,6 +108,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"scenegen: error: {err}", file=sys.stderr)
         return 1
     except Exception as err:
+        if _interrupted(err):
+            print("scenegen: interrupted", file=sys.stderr)
+            return 130
         if debug:
             raise
         first = str(err).strip().splitlines()[0] if str(err).strip() else ""

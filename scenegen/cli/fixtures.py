@@ -58,6 +58,18 @@ def _count(args: argparse.Namespace) -> int:
     return n_fix * (n_trk + 1)
 
 
+def _regen_command(args: argparse.Namespace) -> str:
+    """The ``regen`` command for the folder, fixtures and trackers ``verify`` was given."""
+    import shlex
+
+    words = ["scenegen", "fixtures", "regen"]
+    if args.dir is not None:
+        words += ["--dir", str(args.dir)]
+    words += [w for n in args.fixture or [] for w in ("--fixture", n)]
+    words += [w for n in args.tracker or [] for w in ("--tracker", n)]
+    return shlex.join(words)
+
+
 def cmd_verify(args: argparse.Namespace) -> int:
     from scenegen.lab.regen import verify
     from scenegen.testing.fixtures import default_dir
@@ -77,7 +89,7 @@ def cmd_verify(args: argparse.Namespace) -> int:
     if problems:
         print(
             f"{folder}: {len(problems)} mismatches ({took:.1f} s); if the changes are "
-            "intended, run `scenegen fixtures regen` and commit the folder"
+            f"intended, run `{_regen_command(args)}` and commit the folder"
         )
         return 1
     print(f"{folder}: fixtures and tracker outputs match ({took:.1f} s)")

@@ -17,8 +17,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from scenegen.config import from_dict, to_dict
+from scenegen.datasets.build import make_output_folder
 from scenegen.errors import ConfigError, DataError
 from scenegen.lab.run import run_tracker
+from scenegen.testing.compare import load_expected
 from scenegen.testing.fixtures import (
     EXPECTED_ATOL,
     FAST_PARTICLES,
@@ -95,6 +97,8 @@ def verify(
     names = select_names(fixtures, "fixture", defs)
     tnames = select_names(tracker_names, "tracker", trackers.names())
     entries = reg.get("fixtures", {})
+    if not isinstance(entries, dict):
+        raise DataError(f"{root / 'registry.json'}: 'fixtures' is not a mapping")
     problems: list[str] = []
     if fixtures is None:
         problems += [
@@ -108,9 +112,16 @@ def verify(
         if entry is None:
             problems.append(f"fixture {name}: not in the registry (run `scenegen fixtures regen`)")
             continue
-        seq, found = _verify_sequence(root, name, defs[name], entry)
+        try:
+            seq, found = _verify_sequence(root, name, defs[name], entry)
+        except (AttributeError, KeyError, TypeError, ValueError) as err:  # ConfigError too
+            problems.append(f"fixture {name}: its registry entry is damaged ({_error_line(err)})")
+            continue
         problems += found
         runs = entry.get("trackers", {})
+        if not isinstance(runs, dict):
+            problems.append(f"fixture {name}: its registry entry's trackers are damaged")
+            continue
         for tname in tnames:
             if tname in runs and progress is not None:
                 progress(f"{name} {tname}")
@@ -159,6 +170,8 @@ def _verify_run(root: Path, seq: Any, tname: str, run: dict[str, Any] | None) ->
     exp_path = root / run.get("expected", "")
     if refusal is None and not exp_path.is_file():
         return f"{exp_path} is missing"
+    if not isinstance(run, dict) or "params" not in run or "seed" not in run:
+        return "its registry entry is damaged (run `scenegen fixtures regen`)"
     try:
         boxes = _run(seq, tname, run["params"], int(run["seed"]))
     except Exception as err:  # any tracker failure is a mismatch to report
@@ -167,7 +180,10 @@ def _verify_run(root: Path, seq: Any, tname: str, run: dict[str, Any] | None) ->
         return None
     if refusal is not None:
         return f"expected {refusal}, ran"
-    diff = compare_boxes(boxes, np.load(exp_path))
+    expected = load_expected(exp_path)
+    if expected is None:
+        return f"{exp_path} is not a readable .npy file (run `scenegen fixtures regen`)"
+    diff = compare_boxes(boxes, expected)
     return None if diff is None else f"boxes {diff}"
 
 
@@ -203,12 +219,16 @@ def regen(
     import trackers
 
     root = default_dir() if folder is None else Path(folder)
-    root.mkdir(parents=True, exist_ok=True)
+    make_output_folder(root)
     reg = load_registry(root, missing_ok=True)
     defs = definitions()
     names = select_names(fixtures, "fixture", defs)
     tnames = select_names(tracker_names, "tracker", trackers.names())
-    entries: dict[str, Any] = dict(reg.get("fixtures", {}))
+    held = reg.get("fixtures", {})
+    # A damaged registry is rebuilt: its entries are only what the files are checked by.
+    entries: dict[str, Any] = {
+        n: e for n, e in (held.items() if isinstance(held, dict) else ()) if isinstance(e, dict)
+    }
     changes: list[str] = []
     errors: list[str] = []
     if fixtures is None:
@@ -220,7 +240,11 @@ def regen(
         old_entry = entries.get(name, {})
         seq, new, change = _regen_sequence(root, d, old_entry.get("digests", {}))
         changes += [change] if change else []
-        runs: dict[str, Any] = dict(old_entry.get("trackers", {}))
+        held_runs = old_entry.get("trackers", {})
+        runs: dict[str, Any] = {
+            t: r for t, r in (held_runs.items() if isinstance(held_runs, dict) else ())
+            if isinstance(r, dict)
+        }  # fmt: skip
         for tname in tnames:
             if progress is not None:
                 progress(f"{name} {tname}")
@@ -266,17 +290,25 @@ def _regen_sequence(
 ) -> tuple[Any, dict[str, str], str | None]:
     """Generate fixture ``d``; write its file if its digests differ from ``old`` or it is
     missing. Returns the sequence, its digests and the change line (None: unchanged)."""
-    from scenegen.io import write
+    from scenegen.io import read, write
     from scenegen.render.plan import generate
 
     seq = generate(d.config, seed=d.seed)
     new = digests(seq)
     path = root / f"{d.name}.h5"
+    damaged = False
     if old == new and path.exists():
-        return seq, new, None
+        try:  # the file itself, not only the registry: a damaged file is rewritten
+            if digests(read(path)) == new:
+                return seq, new, None
+        except DataError:
+            pass
+        damaged = True
     write(path, seq, compression="gzip")
     if not old:
         return seq, new, f"fixture {d.name}: new"
+    if damaged:
+        return seq, new, f"fixture {d.name}: rewritten (its file was damaged or edited)"
     bad = _differing(old, new)
     return seq, new, f"fixture {d.name}: rewritten ({', '.join(bad) or 'file missing'})"
 
@@ -303,7 +335,7 @@ def _regen_run(
         return {"params": params, "seed": TRACKER_SEED, "raises": refusal}, change, None
     except Exception as err:  # reported; the other trackers still get written
         return None, None, f"raised {_error_line(err)}"
-    previous = np.load(exp_path) if exp_path.exists() else None
+    previous = load_expected(exp_path) if exp_path.exists() else None  # damaged: rewritten
     change = None
     if previous is None or not np.array_equal(previous, boxes, equal_nan=True):
         write_npy(exp_path, boxes, parents=True)

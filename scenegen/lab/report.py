@@ -20,6 +20,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from scenegen.datasets.build import make_output_folder
 from scenegen.errors import DataError
 from scenegen.io.sealed import write_sealed_json
 from scenegen.lab.experiments import get, names, run_experiment, verdict_counts
@@ -148,7 +149,8 @@ def markdown_to_html(md: str) -> str:
         elif line.startswith("|"):
             rows = []
             while i < len(lines) and lines[i].startswith("|"):
-                rows.append([c.strip() for c in lines[i].strip().strip("|").split("|")])
+                cells = re.split(r"(?<!\\)\|", lines[i].strip()[1:-1])  # "\|" is no border
+                rows.append([c.strip().replace("\\|", "|") for c in cells])
                 i += 1
             body = [r for r in rows[1:] if not all(set(c) <= {"-", ":"} for c in r)]
             out.append("<table>")
@@ -247,7 +249,7 @@ def build_report(out_dir: str | Path) -> Path:
         The ``index.html`` written.
     """
     root = Path(out_dir)
-    root.mkdir(parents=True, exist_ok=True)
+    make_output_folder(root)
     page, all_results = render_report(root)
     index = root / "index.html"
     _write_atomic(index, page)

@@ -80,3 +80,12 @@ def test_track_stacks_extras_and_names_a_missing_key():
     assert np.isnan(out.extras["score"][0, 0]) and out.extras["score"][2, 0] == 1.0
     with pytest.raises(ValueError, match="extras lacks 'score'"):
         trackers.track(WithExtras(), _frames(4), [[2, 3, 5, 6]])
+
+
+@pytest.mark.parametrize("value", ["abc", [1, 2], None, True])
+def test_matcher_parameters_of_the_wrong_type_are_named(value):
+    # numpy's "ufunc 'isfinite' not supported" named no parameter.
+    from trackers.models.layered import check_matcher_params
+
+    with pytest.raises(ValueError, match=r"blur must be in \[0, 20\] pixels, got"):
+        check_matcher_params(5, 1, 0.5, "box", value)

@@ -308,12 +308,23 @@ def check_matcher_params(
         raise ValueError(f"search_radius must be an int in [1, 200], got {search_radius!r}")
     if not isinstance(step, (int, np.integer)) or not 1 <= step <= 8:
         raise ValueError(f"step must be an int in [1, 8], got {step!r}")
-    if not (np.isfinite(min_visible) and 0 < min_visible <= 1):
+    if not 0 < _real(min_visible) <= 1:
         raise ValueError(f"min_visible must be in (0, 1], got {min_visible!r}")
-    if support not in SUPPORTS:
+    if not isinstance(support, str) or support not in SUPPORTS:
         raise ValueError(f"unknown support {support!r}; valid: {', '.join(SUPPORTS)}")
-    if not (np.isfinite(blur) and 0 <= blur <= 20):
+    if not 0 <= _real(blur) <= 20:
         raise ValueError(f"blur must be in [0, 20] pixels, got {blur!r}")
+
+
+def _real(value: object) -> float:
+    """``value`` as a finite float, or NaN (which fails every bound) for anything else: a
+    string, a list, a bool, inf."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(
+        value, (int, float, np.integer, np.floating)
+    ):
+        return float("nan")
+    x = float(value)
+    return x if np.isfinite(x) else float("nan")
 
 
 def _support_mask(kind: str, th: int, tw: int) -> NDArray[np.bool_]:

@@ -35,6 +35,7 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
+from scenegen.datasets.build import make_output_folder
 from scenegen.errors import ConfigError
 from scenegen.lab.experiments.definitions import EXPERIMENTS, PAPER, Experiment, Method, get, names
 from scenegen.lab.experiments.outputs import (
@@ -127,6 +128,30 @@ def results_document(exp: Experiment, records: list[dict[str, Any]]) -> dict[str
     return _round(json.loads(json.dumps(results)))
 
 
+def _refuse_other_outputs(out: Path, name: str) -> None:
+    """Refuse an output folder holding another experiment's results, or a report of
+    ``experiment all``: its figures and runs would be mixed with this one's.
+
+    Raises
+    ------
+    ConfigError
+        Naming the folder and what it holds.
+    """
+    if (out / "experiments").is_dir() and (out / "index.html").exists():
+        raise ConfigError(
+            f"-o {out}: holds a report of `scenegen experiment all`; choose another folder"
+        )
+    try:
+        held = json.loads((out / "results.json").read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, ValueError):
+        return  # none, or damaged: the run rewrites it
+    other = held.get("experiment") if isinstance(held, dict) else None
+    if isinstance(other, str) and other != name:
+        raise ConfigError(
+            f"-o {out}: holds the results of experiment {other!r}; choose another folder"
+        )
+
+
 def run_experiment(
     name: str,
     out_dir: str | Path,
@@ -198,7 +223,8 @@ def run_experiment(
     tasks = plan_tasks(exp, runs=r, scenes=s, seed=int(seed), quick=quick, methods=methods,
                        values=values, overrides=overrides)
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    _refuse_other_outputs(out, exp.name)
+    make_output_folder(out)
     records = execute(tasks, out / "runs", jobs=jobs, scheduler=scheduler, progress=progress)
     results = results_document(exp, records)
     write_results(out / "results.json", results)

@@ -631,6 +631,8 @@ def check_report(folder: str | Path,
     page = index_problem(root) if index_problem is not None else None
     if page == "stale":
         page = f"is not the report of this folder (damaged, edited, or stale{redo('')})"
+    elif page is not None:
+        page = f"{page}{redo('')}"
     if page is not None:
         problems.append(f"{root / 'index.html'}: {page}")
     return problems

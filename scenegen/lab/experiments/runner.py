@@ -186,6 +186,9 @@ def plan_tasks(
     if seed < 0:
         raise ConfigError(f"seed must be a non-negative integer, got {seed}")
     chosen = [exp.method(m) for m in methods] if methods else list(exp.methods)
+    for i, m in enumerate(chosen):
+        if m in chosen[:i]:  # each run would be stored and counted twice
+            raise ConfigError(f"method {m.label!r} is given twice (--method)")
     sweep = exp.sweep_values(quick)
     if values is not None:
         wanted = [float(v) for v in values]
@@ -284,9 +287,9 @@ def tracker_params(exp: Experiment, task: Task) -> dict[str, Any]:
     params = exp.method(task.method).param_dict()
     if task.param:
         params[task.param] = task.value
-    params.update(task.overrides)
     if task.quick and "n_particles" in params:
         params["n_particles"] = min(int(params["n_particles"]), exp.quick_particles)
+    params.update(task.overrides)  # what the user sets (--param) wins over --quick's cap
     return params
 
 

@@ -52,10 +52,17 @@ def claims_table(results: dict[str, Any]) -> list[str]:
         lo, hi = c["interval"]
         v = c["verdict"]
         lines.append(
-            f"| {c['claim']} | {c['ours']} | {c['test']} | {_p(c['p_value'])} | "
+            f"| {_cell(c['claim'])} | {_cell(c['ours'])} | {_cell(c['test'])} | "
+            f"{_p(c['p_value'])} | "
             f"{_num(c['effect'])} [{_num(lo)}, {_num(hi)}] | {_num(c['delta'])} "
             f"({c['delta_source']}) | {'**' + v + '**' if v != 'reproduced' else v} |")
     return lines
+
+
+def _cell(text: Any) -> str:
+    """Text for a Markdown table cell: a ``|`` in it (``|P − 1/L|``) escaped, so that it
+    does not split the cell."""
+    return str(text).replace("|", "\\|")
 
 
 def render_table(exp: Experiment, results: dict[str, Any], why: str = "") -> str:
