@@ -18,10 +18,37 @@ from typing import Any
 
 from scenegen.errors import ConfigError
 
-__all__ = ["SCHEDULER_TIMEOUT", "check_executor", "connect", "probe", "run_tasks"]
+__all__ = [
+    "SCHEDULER_TIMEOUT",
+    "WORKER_TIMEOUT",
+    "check_executor",
+    "connect",
+    "probe",
+    "run_tasks",
+    "worker_timeout",
+]
 
 SCHEDULER_TIMEOUT = 5.0
 """Seconds to wait for a Dask scheduler before giving up."""
+
+WORKER_TIMEOUT = 60.0
+"""Seconds to wait for a Dask scheduler with no worker to get one (environment variable
+``SCENEGEN_DASK_WORKER_TIMEOUT`` overrides it) before giving up instead of waiting forever."""
+
+
+def worker_timeout() -> float:
+    """:data:`WORKER_TIMEOUT`, or ``SCENEGEN_DASK_WORKER_TIMEOUT`` when set to a positive
+    number (ConfigError naming it otherwise)."""
+    text = os.environ.get("SCENEGEN_DASK_WORKER_TIMEOUT")
+    if text is None:
+        return WORKER_TIMEOUT
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not value > 0 or value == float("inf"):
+        raise ConfigError(f"SCENEGEN_DASK_WORKER_TIMEOUT must be a positive number, got {text!r}")
+    return value
 
 
 def check_executor(jobs: int | None, scheduler: str | None) -> None:
@@ -182,6 +209,14 @@ def _run_dask(
     client = connect(address)
     name = f"{name}-{uuid.uuid4().hex[:8]}"  # two runs on one cluster never share keys
     try:
+        limit = worker_timeout()
+        try:
+            client.wait_for_workers(1, timeout=limit)
+        except TimeoutError:  # a scheduler no worker serves: it would wait forever
+            raise ConfigError(
+                f"the Dask scheduler at {address!r} has no worker (waited {limit:g} s; "
+                "start one with `dask worker ADDRESS`)"
+            ) from None
         futures = {}
         for t in tasks:
             fut = client.submit(fn, t, key=f"{name}-{key(t)}", retries=3, pure=False)

@@ -351,3 +351,19 @@ def test_select_keeps_both_conditions_on_one_parameter(reference):
     assert ds.select({"clutter[0].count": 0}, count=6).entries == []
     both = ds.select({"clutter[0].count": (0, 6)}, count=6)
     assert [e["index"] for e in both.entries] == [1, 3, 5]
+
+
+def test_a_scheduler_without_workers_is_one_line_not_a_hang(monkeypatch):
+    # A reachable scheduler with no worker left `--scheduler` waiting forever.
+    distributed = pytest.importorskip("distributed")
+    from scenegen.datasets.executor import run_tasks
+
+    monkeypatch.setenv("SCENEGEN_DASK_WORKER_TIMEOUT", "1")
+    with distributed.LocalCluster(n_workers=0, processes=False, dashboard_address=None) as c:
+        with pytest.raises(ConfigError, match="has no worker \\(waited 1 s"):
+            run_tasks(abs, [1, 2], lambda t, r: None, scheduler=c.scheduler_address)
+    monkeypatch.setenv("SCENEGEN_DASK_WORKER_TIMEOUT", "soon")
+    with pytest.raises(ConfigError, match="SCENEGEN_DASK_WORKER_TIMEOUT must be a positive"):
+        from scenegen.datasets.executor import worker_timeout
+
+        worker_timeout()

@@ -447,8 +447,9 @@ def test_a_stale_report_names_the_command_that_writes_it_again(tmp_path, monkeyp
         (lambda: index.write_bytes(page[: len(page) // 2]),
          f"is not the report of this folder (damaged, edited, or stale; `{command}` writes "
          "it again)"),
-        (lambda: index.write_bytes(b"\xff\xfe" + page), "unreadable (UnicodeDecodeError)"),
-        (index.unlink, "missing"),
+        (lambda: index.write_bytes(b"\xff\xfe" + page),
+         f"unreadable (UnicodeDecodeError); `{command}` writes it again"),
+        (index.unlink, f"missing; `{command}` writes it again"),
     ]:
         damage()
         assert main(["validate", str(tmp_path)]) == 1
