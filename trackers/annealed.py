@@ -47,6 +47,10 @@ __all__ = [
     "weighted_estimate",
 ]
 
+#: Largest number of annealing layers (the papers use up to 10; each layer is a full
+#: weighting of every particle).
+MAX_LAYERS = 1000
+
 #: β schedules of ``AnnealedPF``.
 SCHEDULES = ("adaptive", "geometric")
 
@@ -170,7 +174,7 @@ class AnnealedParams(ColourParams):
     def __post_init__(self) -> None:
         super().__post_init__()
         check_particles(self)
-        check_integer(self, "n_layers", low=1)
+        check_integer(self, "n_layers", low=1, high=MAX_LAYERS)
         check_choice(self, "schedule", SCHEDULES)
         check_choice(self, "estimate", ESTIMATES)
         check_number(self, "alpha", low=0.0, high=1.0, low_open=True, high_open=True)
@@ -348,10 +352,15 @@ class AnnealedPF(Tracker):
 def _layer_sigmas(sigma: float | Sequence[float], decay: float,
                   n_layers: int) -> NDArray[np.float64]:
     """Noise standard deviation (n_layers,) of each layer, first layer first."""
-    if np.ndim(sigma) == 0:
-        sigmas = float(sigma) * decay ** np.arange(n_layers)
-    else:
-        sigmas = np.asarray(sigma, dtype=np.float64)
+    try:
+        if np.ndim(sigma) == 0:
+            sigmas = float(sigma) * decay ** np.arange(n_layers)  # type: ignore[arg-type]
+        else:
+            sigmas = np.asarray(sigma, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"sigma must be a number or {n_layers} numbers (one per layer), "
+                         f"got {sigma!r}") from None
+    if np.ndim(sigma) != 0:
         if sigmas.shape != (n_layers,):
             raise ValueError(f"sigma must be a number or {n_layers} numbers (one per layer), "
                              f"got {list(np.ravel(sigma))}")

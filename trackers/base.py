@@ -113,6 +113,8 @@ def as_generator(rng: RngLike) -> np.random.Generator:
     """Turn an ``rng`` argument into a Generator (a Generator is used as is)."""
     if isinstance(rng, np.random.Generator):
         return rng
+    if isinstance(rng, (int, np.integer)) and not isinstance(rng, bool) and rng < 0:
+        raise ValueError(f"rng must be a numpy Generator, a non-negative int or None, not {rng!r}")
     if rng is None or isinstance(rng, (int, np.integer)):
         return np.random.default_rng(rng)
     raise ValueError(f"rng must be a numpy Generator, an int or None, not {rng!r}")
@@ -141,7 +143,7 @@ def check_frame(frame: Any, expected_shape: tuple[int, ...] | None = None) -> ND
     Raises
     ------
     ValueError
-        If the frame is not (H, W, 3), or its shape differs from ``expected_shape``.
+        If the frame is not (H, W, 3) uint8, or its shape differs from ``expected_shape``.
     """
     arr = np.asarray(frame)
     if arr.ndim != 3 or arr.shape[2] != 3 or arr.shape[0] < 1 or arr.shape[1] < 1:
@@ -151,9 +153,13 @@ def check_frame(frame: Any, expected_shape: tuple[int, ...] | None = None) -> ND
             f"frame shape changed mid-sequence: got {arr.shape}, expected {tuple(expected_shape)}"
         )
     if arr.dtype != np.uint8:
-        if np.issubdtype(arr.dtype, np.floating) and arr.size and arr.max() <= 1.0:
-            arr = arr * 255.0
-        arr = np.clip(arr, 0, 255).astype(np.uint8)
+        # Converting here was garbage in: a 16-bit image clipped to 0/255, NaN to 0, and a
+        # float frame rescaled or not by its own maximum, so frames of one sequence
+        # differently. The protocol's frame is uint8: the caller knows its scale.
+        raise ValueError(
+            f"frame must be uint8 RGB, got dtype {arr.dtype} (convert it first, e.g. "
+            "(img * 255).round().astype(np.uint8) for floats in [0, 1])"
+        )
     return np.ascontiguousarray(arr)
 
 

@@ -28,11 +28,16 @@ from numpy.typing import NDArray
 from trackers.base import Estimate, Tracker
 from trackers.filters.kalman import KalmanFilter, MotionModel
 from trackers.models.layered import LayeredMatcher, check_matcher_params
-from trackers.params import TrackerParams, check_choice, check_number
+from trackers.params import TrackerParams, check_choice, check_integer, check_number
 
 __all__ = ["MOTIONS", "KalmanParams", "KalmanTracker"]
 
 MOTIONS = ("cv", "ar2")
+
+#: Upper bounds of the motion parameters (pixels; AR2 coefficients): far above any use, and
+#: low enough that no accepted value overflows the filter.
+MAX_STD = 1e6
+MAX_AR = 100.0
 
 
 def motion_model(
@@ -86,12 +91,16 @@ class KalmanParams(TrackerParams):
 
     def __post_init__(self) -> None:
         check_choice(self, "motion", MOTIONS)
-        check_number(self, "process_std", low=0.0)
-        check_number(self, "a1")
-        check_number(self, "a2")
-        check_number(self, "velocity_std", low=0.0, low_open=True)
+        # Bounded so that no accepted value overflows (1e300 did, in the squared noise).
+        check_number(self, "process_std", low=0.0, high=MAX_STD)
+        check_number(self, "a1", low=-MAX_AR, high=MAX_AR)
+        check_number(self, "a2", low=-MAX_AR, high=MAX_AR)
+        check_number(self, "velocity_std", low=0.0, low_open=True, high=MAX_STD)
         check_number(self, "r_gain", low=0.0)
         check_number(self, "r_floor", low=0.0, low_open=True)
+        # Integral floats (12.0, as --param may give them) are stored as int first.
+        check_integer(self, "search_radius", low=1, high=200)
+        check_integer(self, "step", low=1, high=8)
         check_matcher_params(self.search_radius, self.step, self.min_visible, self.support,
                              self.blur)
 

@@ -95,19 +95,32 @@ def set_mean_shift(obs: FrameObservation, centres: NDArray[np.float64],
 
 def check_kernel_bins(kernel: str, bins: int) -> None:
     """Raise ``ValueError`` for an unknown kernel name or a bin count outside [1, 32]."""
-    if kernel not in MEAN_SHIFT_KERNELS:
+    if not isinstance(kernel, str) or kernel not in MEAN_SHIFT_KERNELS:
         raise ValueError(f"unknown kernel {kernel!r}; valid kernels: "
                          f"{', '.join(MEAN_SHIFT_KERNELS)}")
-    if int(bins) != bins or not 1 <= bins <= 32:
+    if not _whole(bins, 1, 32):
         raise ValueError(f"bins must be an integer in [1, 32], got {bins!r}")
 
 
 def check_mean_shift(max_iter: int, eps: float) -> None:
-    """Raise ``ValueError`` for a negative or non-integer ``max_iter`` or negative ``eps``."""
-    if int(max_iter) != max_iter or max_iter < 0:
-        raise ValueError(f"max_iter must be an integer >= 0, got {max_iter!r}")
-    if not eps >= 0.0:
-        raise ValueError(f"eps must be >= 0 (pixels), got {eps!r}")
+    """Raise ``ValueError`` for a ``max_iter`` that is not an integer in [0, MAX_ITER] or an
+    ``eps`` that is not a finite number >= 0."""
+    if not _whole(max_iter, 0, MAX_ITER):
+        raise ValueError(f"max_iter must be an integer in [0, {MAX_ITER}], got {max_iter!r}")
+    ok = not isinstance(eps, bool) and isinstance(eps, (int, float, np.integer, np.floating))
+    if not (ok and np.isfinite(eps) and eps >= 0.0):
+        raise ValueError(f"eps must be a finite number >= 0 (pixels), got {eps!r}")
+
+
+#: Largest ``max_iter`` of a mean-shift search (the papers use 20-50 iterations).
+MAX_ITER = 10_000
+
+
+def _whole(value: object, low: int, high: int) -> bool:
+    """Whether ``value`` is an integer (or an integral float) in [low, high]; never raises."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        return False
+    return bool(np.isfinite(value)) and int(value) == value and low <= value <= high
 
 
 def keep_inside(centres: NDArray[np.float64], frame_shape: tuple[int, ...]) -> None:

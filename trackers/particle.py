@@ -86,6 +86,7 @@ from trackers.models.observation import (
     ObservationModel,
 )
 from trackers.params import (
+    MAX_PARTICLES,
     TrackerParams,
     check_choice,
     check_integer,
@@ -179,7 +180,7 @@ class ParticleParams(TrackerParams):
         check_number(self, "lam", low=0.0, low_open=True)
         check_choice(self, "model", MODELS, what="observation model")
         check_integer(self, "bins", low=1, high=256)
-        check_integer(self, "n_parts", low=1, optional=True)
+        check_integer(self, "n_parts", low=1, high=MAX_PARTICLES, optional=True)
         if self.kernel is not None:
             check_choice(self, "kernel", KERNELS)
         check_integer(self, "box_levels", low=1, high=16)

@@ -57,7 +57,7 @@ def test_failure_is_nan():
     [
         ("KCFX", {}, "unknown OpenCV tracker 'KCFX'"),
         ("MIL", {"bogus": 1}, "unknown parameter 'bogus' for cv2.TrackerMIL; valid: "),
-        ("MIL", {"samplerSearchWinSize": "x"}, "samplerSearchWinSize='x'"),
+        ("MIL", {"samplerSearchWinSize": "x"}, "samplerSearchWinSize must be a finite number"),
         ("MIL", {"rng": 1.5}, "rng of an OpenCV tracker must be a Generator, an int seed or "
                               "None, not 1.5"),
         ("MIL", {"rng": -(2**31) - 1}, "rng of an OpenCV tracker must be >= -2**31"),

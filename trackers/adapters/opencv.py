@@ -120,6 +120,7 @@ class OpenCVTracker:
                     f"unknown parameter {key!r} for cv2.Tracker{self.name}; valid: "
                     f"{', '.join(valid)}"
                 )
+            _check_value(self.name, key, value, getattr(p, key))
             try:
                 setattr(p, key, value)
             except (TypeError, cv2.error) as err:
@@ -145,7 +146,12 @@ class OpenCVTracker:
         for box in boxes:
             t = self._make()
             px = _pixel_box(box, rgb.shape)
-            t.init(bgr, px)
+            try:
+                t.init(bgr, px)
+            except cv2.error as err:
+                raise ValueError(
+                    f"cv2.Tracker{self.name} could not start on box {px}: {_cv2_message(err)}"
+                ) from None
             self._trackers.append(t)
             grown = px[2] > np.ceil(box[2]) or px[3] > np.ceil(box[3])
             self._sizes.append((float(box[2]), float(box[3])) if grown else None)
@@ -238,3 +244,30 @@ def opencv(name: str, **kw: Any) -> OpenCVTracker:
     See :class:`OpenCVTracker`.
     """
     return OpenCVTracker(name, **kw)
+
+
+#: A numeric parameter whose default is positive may be at most this many times its
+#: default: OpenCV does not check them (MIL's ``featureSetNumFeatures=0`` crashed the
+#: process, -3 asked for 2^64 bytes).
+MAX_PARAM_FACTOR = 100
+
+
+def _check_value(name: str, key: str, value: Any, default: Any) -> None:
+    """Refuse a numeric parameter OpenCV would take and then crash on: not finite, or, where
+    the default is positive, not in (0, MAX_PARAM_FACTOR x default].
+
+    Raises
+    ------
+    ValueError
+        Naming the tracker, the parameter and the value.
+    """
+    numeric = (int, float, np.integer, np.floating)
+    if isinstance(default, bool) or not isinstance(default, numeric):
+        return
+    if isinstance(value, bool) or not isinstance(value, numeric) or not np.isfinite(value):
+        raise ValueError(f"cv2.Tracker{name} parameter {key} must be a finite number, "
+                         f"got {value!r}")
+    if default > 0 and not 0 < value <= MAX_PARAM_FACTOR * default:
+        raise ValueError(f"cv2.Tracker{name} parameter {key} must be in "
+                         f"(0, {MAX_PARAM_FACTOR * default:g}] ({MAX_PARAM_FACTOR}x its "
+                         f"default {default:g}), got {value!r}")

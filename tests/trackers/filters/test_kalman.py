@@ -230,7 +230,7 @@ def test_kalman_tracker_ar2_motion_tracks():
     "params, match",
     [
         (dict(motion="spline"), "unknown motion 'spline'; valid: cv, ar2"),
-        (dict(process_std=-1.0), "process_std must be finite and >= 0"),
+        (dict(process_std=-1.0), r"process_std must be in \[0, 1e\+06\]"),
         (dict(r_floor=0.0), "r_floor"),
         (dict(r_gain=np.nan), "r_gain"),
         (dict(search_radius=0), "search_radius"),

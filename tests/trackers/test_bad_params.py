@@ -1,0 +1,82 @@
+"""Bad parameter values are one ValueError naming the parameter, never an OverflowError,
+a MemoryError, numpy's own message or a crash (each case was one of those)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import trackers
+
+
+@pytest.mark.parametrize(
+    ("name", "params", "needle"),
+    [
+        ("meanshift", {"bins": float("inf")}, "bins must be an integer in [1, 32]"),  # Overflow
+        ("meanshift", {"bins": None}, "bins must be an integer in [1, 32]"),
+        ("meanshift", {"max_iter": float("nan")}, "max_iter must be an integer in [0, 10000]"),
+        ("meanshift", {"eps": "abc"}, "eps must be a finite number >= 0"),
+        ("meanshift", {"kernel": [1]}, "unknown kernel [1]"),  # was "unhashable type"
+        ("annealed", {"sigma": "abc"}, "sigma must be a number or"),
+        ("kams", {"n_layers": 10**8}, "n_layers must be an integer in [1, 1000]"),  # 23 s, 1.6 GB
+        ("condensation", {"n_parts": 10**12}, "n_parts must be an integer in [1, 1000000]"),
+        ("condensation", {"rng": -1}, "rng must be a numpy Generator, a non-negative int"),
+        ("kalman", {"process_std": 1e300}, "process_std must be in [0, 1e+06]"),  # Overflow
+        ("kalman", {"motion": "ar2", "a1": 1e300}, "a1 must be in [-100, 100]"),  # NaN boxes
+        ("shm", {"velocity_std": 1e300}, "velocity_std must be in (0, 1e+06]"),
+    ],
+)
+def test_bad_values_name_the_parameter(name, params, needle):
+    with pytest.raises(ValueError) as info:
+        trackers.make(name, **params)
+    assert needle in str(info.value)
+
+
+def test_integral_floats_are_integers_for_the_matcher_too():
+    # search_radius=12.0 was refused though every other integer field takes it.
+    t = trackers.make("kalman", search_radius=12.0, step=2.0)
+    assert t.params.search_radius == 12 and isinstance(t.params.search_radius, int)
+
+
+@pytest.mark.parametrize(
+    ("params", "needle"),
+    [
+        ({"featureSetNumFeatures": 0}, "featureSetNumFeatures must be in (0, 25000]"),  # SIGSEGV
+        ({"featureSetNumFeatures": -3}, "featureSetNumFeatures must be in (0, 25000]"),
+        ({"samplerSearchWinSize": float("nan")}, "samplerSearchWinSize must be a finite"),
+        ({"samplerSearchWinSize": 1e30}, "samplerSearchWinSize must be in (0, 2500]"),
+    ],
+)
+def test_opencv_parameters_that_would_crash_it_are_refused(params, needle):
+    from trackers.adapters import opencv
+
+    with pytest.raises(ValueError) as info:
+        opencv("MIL", rng=0, **params)
+    assert needle in str(info.value)
+
+
+def test_an_opencv_tracker_that_cannot_start_is_one_line(monkeypatch):
+    # cv2's init raised its multi-line cv2.error (here: made to, whatever cv2's version).
+    import cv2
+
+    from trackers.adapters import opencv
+
+    class Refuses:
+        def init(self, frame, box):
+            raise cv2.error("OpenCV(5.0.0) matrix.cpp:1226: error: (-215:Assertion failed)\nmore")
+
+    frame = np.zeros((60, 80, 3), np.uint8)
+    t = opencv("MIL", rng=0)
+    monkeypatch.setattr(t, "_make", lambda: Refuses())
+    with pytest.raises(ValueError, match=r"cv2.TrackerMIL could not start on box") as info:
+        t.init(frame, [[30, 20, 20, 20]])
+    assert "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize("dtype", [np.uint16, np.float32, bool])
+def test_frames_that_are_not_uint8_are_refused_not_converted(dtype):
+    # A 16-bit frame was clipped to 0/255, a float one rescaled by its own maximum.
+    t = trackers.make("meanshift")
+    frame = np.zeros((40, 40, 3), dtype=dtype)
+    with pytest.raises(ValueError, match=f"frame must be uint8 RGB, got dtype {np.dtype(dtype)}"):
+        t.init(frame, [[10, 10, 8, 8]])
