@@ -110,16 +110,18 @@ class NotApplicable(Exception):
 def label(factory: Any) -> str:
     """A name for ``factory`` that is the same in every process (a pytest test id).
 
-    ``functools.partial(f, a, k=v)`` is ``f(a, k=v)``; an object with no name is named by
-    its type (a ``repr`` may hold a memory address, which changes from run to run).
+    Its ``__qualname__`` (or ``__name__``) when it has one, even a ``functools.partial``
+    given one; else a partial ``functools.partial(f, a, k=v)`` is ``f(a, k=v)``, and
+    another object with no name is named by its type (a ``repr`` may hold a memory
+    address, which changes from run to run).
     """
+    name = getattr(factory, "__qualname__", None) or getattr(factory, "__name__", None)
+    if isinstance(name, str) and name:  # a partial given a name keeps it
+        return name
     if isinstance(factory, partial):
         args = [_stable_repr(a) for a in factory.args]
         args += [f"{k}={_stable_repr(v)}" for k, v in factory.keywords.items()]
         return f"{label(factory.func)}({', '.join(args)})"
-    name = getattr(factory, "__qualname__", None) or getattr(factory, "__name__", None)
-    if isinstance(name, str) and name:
-        return name
     return _stable_repr(factory)
 
 
