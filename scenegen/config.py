@@ -977,8 +977,15 @@ def _expanded_size(root: Any) -> int:
     return sizes[id(root)]
 
 
-def _json_object(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
-    """A JSON object, refusing a key given twice (``json.loads`` would keep the last)."""
+def json_object(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    """A JSON object, refusing a key given twice (``json.loads`` would keep the last): the
+    ``object_pairs_hook`` of every JSON file scenegen reads.
+
+    Raises
+    ------
+    ConfigError
+        ``duplicate key 'NAME'``.
+    """
     out: dict[str, Any] = {}
     for k, v in pairs:
         if k in out:
@@ -1033,7 +1040,7 @@ def load_data(path: str | Path, what: str = "config") -> Any:
         if p.suffix.lower() in (".yaml", ".yml"):
             return _load_yaml(text)
         if p.suffix.lower() == ".json":
-            return json.loads(text, object_pairs_hook=_json_object)
+            return json.loads(text, object_pairs_hook=json_object)
         raise ConfigError(f"{p}: {what} must be .yaml, .yml or .json, got {_short(p.suffix)}")
     except ConfigError as err:
         raise ConfigError(str(err) if str(err).startswith(f"{p}: ") else f"{p}: {err}") from None

@@ -35,6 +35,7 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
+from scenegen.config import json_object
 from scenegen.errors import DataError
 from scenegen.io.atomic import write_json
 
@@ -119,22 +120,8 @@ def write_sealed_json(
     return str(doc[SEAL])
 
 
-def _no_duplicates(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
-    out: dict[str, Any] = {}
-    for k, v in pairs:
-        if k in out:
-            raise ValueError(f"key {_short(k)} appears twice")
-        out[k] = v
-    return out
-
-
 def _no_constant(name: str) -> Any:
     raise ValueError(f"{name} is not JSON")
-
-
-def _short(text: str, limit: int = 40) -> str:
-    r = repr(text)
-    return r if len(r) <= limit else r[: limit - 4] + "...'"
 
 
 def _parse(p: Path) -> Any:
@@ -158,7 +145,7 @@ def _parse(p: Path) -> Any:
     except UnicodeDecodeError as err:
         raise DataError(f"{p}: not a readable JSON file (not UTF-8 at byte {err.start})") from None
     try:
-        return json.loads(text, object_pairs_hook=_no_duplicates, parse_constant=_no_constant)
+        return json.loads(text, object_pairs_hook=json_object, parse_constant=_no_constant)
     except json.JSONDecodeError as err:
         msg = err.msg.removesuffix(" at")
         raise DataError(f"{p}: not a readable JSON file ({msg} at line {err.lineno} "

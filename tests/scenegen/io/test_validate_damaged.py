@@ -555,7 +555,7 @@ def test_sealed_documents_round_trip_and_name_each_problem(tmp_path, monkeypatch
         b'{"a": 1': "not a readable JSON file (Expecting ',' delimiter at line 1 column 8: "
                     "truncated or damaged)",
         b"\xff{}": "not a readable JSON file (not UTF-8 at byte 0)",
-        b'{"a": 1, "a": 2}': "not a readable JSON file (key 'a' appears twice)",
+        b'{"a": 1, "a": 2}': "not a readable JSON file (duplicate key 'a')",
         b'{"a": NaN}': "not a readable JSON file (NaN is not JSON)",
         b"[" * 100_000 + b"]" * 100_000: "not a readable JSON file (nested too deeply)",
         b"[1]": "not a sealed JSON document (a JSON object is expected, found list)",
