@@ -469,6 +469,7 @@ class _Partitioned(_ParticleTracker):
         log_g = np.zeros(n)
         hook = self.propagation_hook
         rows = np.arange(n)
+        starts = np.cumsum(sizes) - sizes
         stage_only = self.params.weighting == "stage"
         g_only = self.params.weighting == "g-only"
         # resample_scope "placed": placed[r, o] marks the objects row r has placed so far;
@@ -495,14 +496,15 @@ class _Partitioned(_ParticleTracker):
             # π / ρ. "stage": g_j = p(Z | X_{o_j}); "placed": g_j = Π_{i<=j} p(Z | X_{o_i}),
             # the objects placed so far (with π ∝ 1 / g_{j-1}, ancestors ∝ p(Z | X_{o_j}));
             # "g-only": ρ ∝ g_j of the placed objects, π ignored.
-            # Constant factors of π and g cancel: scale by the largest for range.
+            # Constant factors of π and g cancel in each group: scale by the group's
+            # largest for range (a group far below the others is still resampled).
             if stage_only:
                 log_g.fill(0.0)
-            shifted, finite = stage_log_weights(stage, ll, log_g, logpi, obj)
+            shifted, finite = stage_log_weights(stage, ll, log_g, logpi, obj, sizes)
             if g_only:
                 # ρ ∝ g_j alone (π π'/π = g): pass g / π as the weighting function.
                 d = shifted[1] - shifted[0]
-                shifted[1] = d - d.max()
+                shifted[1] = d - np.repeat(np.maximum.reduceat(d, starts), sizes)
             pi_g = np.exp(shifted)
             out = None
             if mode is not None and finite:

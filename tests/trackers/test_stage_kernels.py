@@ -184,7 +184,8 @@ def test_invalid_weights_leave_the_kernels_for_the_checked_path():
     with pytest.raises(ValueError, match="finite"), np.errstate(over="ignore"):
         resample(np.array([1e308, 1e308]), rng=np.random.default_rng(0))
     shifted, finite = stage_log_weights(np.zeros(2), np.zeros((2, 1)), np.zeros(2),
-                                        np.array([0.0, np.nan]), np.zeros(2, dtype=np.int64))
+                                        np.array([0.0, np.nan]), np.zeros(2, dtype=np.int64),
+                                        np.array([2]))
     assert not finite
 
 
@@ -308,9 +309,11 @@ def _reference_step(tr, frame):
         ll[rows, obj] = stage
         if j < m - 1:
             log_g = stage.copy() if tr.params.weighting == "stage" else log_g + stage
-            a, b = logpi - logpi.max(), log_g - log_g.max()
+            starts = np.cumsum(sizes) - sizes
+            a = logpi - np.repeat(np.maximum.reduceat(logpi, starts), sizes)
+            b = log_g - np.repeat(np.maximum.reduceat(log_g, starts), sizes)
             if tr.params.weighting == "g-only":  # ρ ∝ g: weighting function g / π
-                b = (b - a) - (b - a).max()
+                b = (b - a) - np.repeat(np.maximum.reduceat(b - a, starts), sizes)
             k, w = weighted_resample_groups(np.exp(a), np.exp(b), sizes,
                                             method=tr.params.resampler, rng=tr.rng)
             x, prev, ll, log_g = x[k], prev[k], ll[k], log_g[k]
@@ -355,3 +358,28 @@ def test_compiled_step_equals_the_numpy_reference_step(name, params):
 
 def test_every_resampler_is_covered():
     assert set(RESAMPLE_MODES) | {"residual"} == set(RESAMPLERS)
+
+
+def test_stage_weights_are_shifted_per_group():
+    # Group 1's log-weights are all ~2000 below group 0's: with one shift for the whole
+    # set its weights underflow to 0 and it cannot be resampled within itself.
+    logpi = np.array([0.0, -1.0, -2000.0, -2001.0])
+    log_g = np.array([-1.0, 0.0, -3000.0, -3002.0])
+    shifted, finite = stage_log_weights(np.zeros(4), np.zeros((4, 1)), log_g.copy(), logpi,
+                                        np.zeros(4, dtype=np.int64), np.array([2, 2]))
+    assert finite
+    assert np.array_equal(shifted, [[0.0, -1.0, 0.0, -1.0], [-1.0, 0.0, 0.0, -2.0]])
+
+
+@pytest.mark.parametrize("weighting", ["stage", "g-only"])
+def test_dps_with_a_very_peaked_likelihood_keeps_every_group(weighting):
+    # λ = 1e5: the groups' likelihoods differ by far more than exp's range (before the
+    # per-group shift the step raised "weights * g must have a positive sum").
+    frames, boxes0 = _scene(12)
+    tr = DistributedPartitionedSampling(n_particles=90, rng=1, model="rgb", bins=6,
+                                        lam=1e5, weighting=weighting)
+    tr.init(frames[0], boxes0)
+    for f in frames[1:]:
+        est = tr.step(f)
+        assert np.isfinite(est.boxes).all()
+    assert np.isfinite(tr.weights).all() and np.isclose(tr.weights.sum(), 1.0)

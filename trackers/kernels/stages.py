@@ -255,36 +255,45 @@ def state_boxes(states: NDArray[np.float64], scale: NDArray[np.float64],
 
 
 @njit(cache=True)
-def _stage_log_weights(stage, ll, log_g, logpi, obj):
+def _stage_log_weights(stage, ll, log_g, logpi, obj, sizes):
     n = stage.shape[0]
     out = np.empty((2, n))
-    top_pi = -np.inf
-    top_g = -np.inf
     ok = True
     for r in range(n):
         ll[r, obj[r]] = stage[r]
         log_g[r] += stage[r]
         if logpi[r] != logpi[r] or log_g[r] != log_g[r]:
             ok = False
-        top_pi = max(top_pi, logpi[r])
-        top_g = max(top_g, log_g[r])
-    for r in range(n):
-        out[0, r] = logpi[r] - top_pi
-        out[1, r] = log_g[r] - top_g
+    start = 0
+    for c in range(sizes.shape[0]):
+        top_pi = -np.inf
+        top_g = -np.inf
+        for r in range(start, start + sizes[c]):
+            top_pi = max(top_pi, logpi[r])
+            top_g = max(top_g, log_g[r])
+        for r in range(start, start + sizes[c]):
+            out[0, r] = logpi[r] - top_pi
+            out[1, r] = log_g[r] - top_g
+        start += sizes[c]
     return out, ok
 
 
 def stage_log_weights(stage: NDArray[np.float64], ll: NDArray[np.float64],
                       log_g: NDArray[np.float64], logpi: NDArray[np.float64],
-                      obj: NDArray[np.int64]) -> tuple[NDArray[np.float64], bool]:
+                      obj: NDArray[np.int64], sizes: NDArray[np.int64]
+                      ) -> tuple[NDArray[np.float64], bool]:
     """Record a stage's log-likelihoods and shift the log-weights for exponentiation.
 
     Sets ll[r, obj[r]] = stage[r] and log_g += stage in place, and returns the (2, N)
-    array [logpi − max logpi, log_g − max log_g] (the exponents of the weighted
-    resampling, DPS §3), and False if a log-weight is NaN (the caller then takes the
-    checked numpy path, which raises). Shapes: stage, log_g, logpi (N,), ll (N, K).
+    array [logpi − its group's max, log_g − its group's max] (the exponents of the
+    weighted resampling, DPS §3, which resamples inside each group: a group whose
+    weights are all far below another group's still has a largest weight of 1), and
+    False if a log-weight is NaN (the caller then takes the checked numpy path, which
+    raises). Shapes: stage, log_g, logpi (N,), ll (N, K); ``sizes`` (C,) the contiguous
+    groups' lengths.
     """
-    return _stage_log_weights(stage, ll, log_g, logpi, obj)
+    return _stage_log_weights(stage, ll, log_g, logpi, obj,
+                              np.ascontiguousarray(sizes, dtype=np.int64))
 
 
 @njit(cache=True)
