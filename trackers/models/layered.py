@@ -125,9 +125,9 @@ class LayeredMatcher:
     templates : ndarray of shape (M, TH, TW, 3), uint8
         Reference images (blurred if ``blur`` > 0), padded to the largest box.
     support : ndarray of shape (M, TH, TW), bool
-        Support of each template (False in the padding and outside frame 0).
+        Support of each template (False in the padding).
     sizes : ndarray of shape (M, 2), int64
-        Template (height, width).
+        Template (height, width): the box's part inside frame 0.
 
     Example
     -------
@@ -163,24 +163,28 @@ class LayeredMatcher:
         # so every template has at least one pixel inside the frame.
         tl[:, 0] = np.clip(tl[:, 0], 1 - size[:, 0], w - 1)
         tl[:, 1] = np.clip(tl[:, 1], 1 - size[:, 1], h - 1)
-        th_max, tw_max = int(size[:, 1].max()), int(size[:, 0].max())
+        # Template pixels outside frame 0 have no reference and are never in the support,
+        # so each template is cut to its part inside frame 0 (the box's rows r0:r1 and
+        # columns c0:c1): the same matches, and memory bounded by the frame's size
+        # whatever the box's.
+        r0 = np.maximum(0, -tl[:, 1])
+        r1 = np.minimum(size[:, 1], h - tl[:, 1])
+        c0 = np.maximum(0, -tl[:, 0])
+        c1 = np.minimum(size[:, 0], w - tl[:, 0])
+        cut = np.stack([r1 - r0, c1 - c0], axis=1).astype(np.int64)  # (h, w)
+        th_max, tw_max = int(cut[:, 0].max()), int(cut[:, 1].max())
         self.templates = np.zeros((m, th_max, tw_max, 3), dtype=np.uint8)
         self.support = np.zeros((m, th_max, tw_max), dtype=bool)
-        self.sizes = np.stack([size[:, 1], size[:, 0]], axis=1).astype(np.int64)  # (h, w)
+        self.sizes = cut
         for k in range(m):
-            tw, th = int(size[k, 0]), int(size[k, 1])
-            x0, y0 = int(tl[k, 0]), int(tl[k, 1])
-            sup = _support_mask(support, th, tw)
-            # Template pixels outside frame 0 have no reference: leave them out of support.
-            rows = np.arange(y0, y0 + th)
-            cols = np.arange(x0, x0 + tw)
-            inside = ((rows >= 0) & (rows < h))[:, None] & ((cols >= 0) & (cols < w))[None, :]
+            th, tw = int(cut[k, 0]), int(cut[k, 1])
+            x0, y0 = int(tl[k, 0] + c0[k]), int(tl[k, 1] + r0[k])
+            sup = _support_mask(support, int(size[k, 1]), int(size[k, 0]),
+                                (int(r0[k]), int(r1[k])), (int(c0[k]), int(c1[k])))
             # A sliver box whose shape support misses the frame falls back to its box pixels.
-            sup = sup & inside if (sup & inside).any() else inside
-            rr = np.clip(rows, 0, h - 1)
-            cc = np.clip(cols, 0, w - 1)
-            self.templates[k, :th, :tw] = frame[rr[:, None], cc[None, :]]
-            self.support[k, :th, :tw] = sup
+            self.templates[k, :th, :tw] = frame[y0:y0 + th, x0:x0 + tw]
+            self.support[k, :th, :tw] = sup if sup.any() else True
+        tl += np.stack([c0, r0], axis=1)
         self._n_support = self.support.sum(axis=(1, 2))
         # Measured centre = initial box centre + displacement of the matched top-left.
         self._tl0 = tl
@@ -327,12 +331,16 @@ def _real(value: object) -> float:
     return x if np.isfinite(x) else float("nan")
 
 
-def _support_mask(kind: str, th: int, tw: int) -> NDArray[np.bool_]:
+def _support_mask(kind: str, th: int, tw: int, rows: tuple[int, int],
+                  cols: tuple[int, int]) -> NDArray[np.bool_]:
+    """Rows ``rows`` and columns ``cols`` ([start, stop)) of a (th, tw) box's support."""
+    (r0, r1), (c0, c1) = rows, cols
     if kind == "box":
-        return np.ones((th, tw), dtype=bool)
-    yy, xx = np.mgrid[0:th, 0:tw]
+        return np.ones((r1 - r0, c1 - c0), dtype=bool)
+    yy, xx = np.mgrid[r0:r1, c0:c1]
     u = (xx + 0.5) / tw * 2 - 1
     v = (yy + 0.5) / th * 2 - 1
     m = u * u + v * v <= 1.0
-    m[th // 2, tw // 2] = True
+    if r0 <= th // 2 < r1 and c0 <= tw // 2 < c1:
+        m[th // 2 - r0, tw // 2 - c0] = True
     return m

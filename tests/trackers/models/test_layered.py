@@ -213,3 +213,63 @@ def test_window_blur_equals_whole_frame_blur():
     )
     np.testing.assert_array_equal(a.mse, b.mse)
     np.testing.assert_array_equal(a.centres, b.centres)
+
+
+def _uncut(matcher, frame, boxes, support):
+    """``matcher`` with templates the size of the whole boxes (the matcher before its
+    templates were cut to frame 0): pixels outside frame 0 present but not in support."""
+    b = np.asarray(boxes, dtype=np.float64)
+    h, w = frame.shape[:2]
+    tl = np.round(b[:, :2]).astype(np.int64)
+    size = np.maximum(np.round(b[:, 2:]).astype(np.int64), 1)
+    tl[:, 0] = np.clip(tl[:, 0], 1 - size[:, 0], w - 1)
+    tl[:, 1] = np.clip(tl[:, 1], 1 - size[:, 1], h - 1)
+    m = len(b)
+    tpl = np.zeros((m, size[:, 1].max(), size[:, 0].max(), 3), np.uint8)
+    sup = np.zeros(tpl.shape[:3], bool)
+    for k in range(m):
+        tw, th = size[k]
+        yy, xx = np.mgrid[0:th, 0:tw]
+        s = (np.ones((th, tw), bool) if support == "box" else
+             ((xx + 0.5) / tw * 2 - 1) ** 2 + ((yy + 0.5) / th * 2 - 1) ** 2 <= 1)
+        if support != "box":
+            s[th // 2, tw // 2] = True
+        rows, cols = np.arange(tl[k, 1], tl[k, 1] + th), np.arange(tl[k, 0], tl[k, 0] + tw)
+        inside = ((rows >= 0) & (rows < h))[:, None] & ((cols >= 0) & (cols < w))[None, :]
+        s = s & inside if (s & inside).any() else inside
+        tpl[k, :th, :tw] = frame[rows.clip(0, h - 1)[:, None], cols.clip(0, w - 1)[None, :]]
+        sup[k, :th, :tw] = s
+    matcher.templates, matcher.support = tpl, sup
+    matcher.sizes = np.stack([size[:, 1], size[:, 0]], axis=1).astype(np.int64)
+    matcher._tl0, matcher._n_support = tl, sup.sum(axis=(1, 2))
+    return matcher
+
+
+@pytest.mark.parametrize("support", ["box", "ellipse"])
+@pytest.mark.parametrize("seed", range(4))
+def test_templates_cut_to_frame_zero_match_as_the_whole_boxes(seed, support):
+    rng = np.random.default_rng(seed)
+    frame = _texture(rng, 60, 80)
+    # Boxes half outside frame 0 on every side, and one inside.
+    boxes = np.array([[-9.0, 10, 20, 16], [70, 30, 18, 20], [30, -8, 16, 18],
+                      [25, 50, 22, 17], [30, 20, 14, 12]])[rng.permutation(5)[:4]]
+    kw = dict(search_radius=6, step=1, support=support, min_visible=0.2)
+    cut = LayeredMatcher(frame, boxes, **kw)
+    whole = _uncut(LayeredMatcher(frame, boxes, **kw), frame, boxes, support)
+    assert cut.templates.shape[1] <= 60 and cut.templates.shape[2] <= 80
+    nxt = np.roll(frame, (int(rng.integers(-3, 4)), int(rng.integers(-3, 4))), axis=(0, 1))
+    order = orderings(4)
+    for _ in range(5):
+        centres = boxes[:, :2] + boxes[:, 2:] / 2 + rng.uniform(-12, 12, (4, 2))
+        a, b = cut.measure(nxt, centres, order), whole.measure(nxt, centres, order)
+        assert np.array_equal(a.centres, b.centres, equal_nan=True)
+        assert np.array_equal(a.mse, b.mse, equal_nan=True)
+        assert np.array_equal(a.counts, b.counts)
+
+
+def test_a_box_far_larger_than_the_frame_takes_the_frame_s_memory():
+    frame = _texture(np.random.default_rng(0), 60, 80)
+    matcher = LayeredMatcher(frame, [[-1e6, -1e6, 3e6, 3e6]], step=1)
+    assert matcher.templates.shape == (1, 60, 80, 3)
+    meas = matcher.measure(frame, [[5e5, 5e5]], orderings(1))
+    assert meas.centres.shape == (1, 1, 2)
