@@ -148,6 +148,13 @@ def run_pair(task: BenchTask) -> dict[str, Any]:
     from scenegen.lab.run import run
 
     seq = read(Path(task.root) / task.file, task.name)
+    if seq.initial_targets().size == 0:
+        # Nothing to track (every target enters later): a record without scores, so that
+        # one such sequence does not stop the benchmark; the leaderboard skips it.
+        return _round({"key": task.key(), "tracker_seed": task.tracker_seed(), "targets": 0,
+                       "n_frames": int(seq.n_frames), "scores": dict.fromkeys(METRICS),
+                       "sequence_params": json.loads(task.sequence_params),
+                       "deterministic": True})  # fmt: skip
     done = run(seq, task.tracker, dict(task.params), task.tracker_seed(), single_thread=True)
     res = done.result
     report = evaluate(
@@ -311,11 +318,13 @@ def leaderboard(rows: list[dict[str, Any]], trackers: list[str]) -> list[dict[st
     Returns
     -------
     list of dict
-        ``rank``, ``tracker``, ``sequences`` and one mean per metric (None if undefined).
+        ``rank``, ``tracker``, ``sequences`` (those with a target at frame 0, the scored
+        ones) and one mean per metric (None if undefined).
     """
     board = []
     for t in trackers:
-        mine = [r for r in rows if r["tracker"] == t]
+        # Sequences with no target at frame 0 have no scores and are not counted.
+        mine = [r for r in rows if r["tracker"] == t and r.get("targets", 1) > 0]
         entry: dict[str, Any] = {"tracker": t, "sequences": len(mine)}
         for m in METRICS:
             entry[m] = _mean([r.get(m) for r in mine])

@@ -381,3 +381,21 @@ def test_a_named_axis_is_plotted_by_its_values(tmp_path):
     run_benchmark(data, ["kalman"], tmp_path / "b", jobs=1, on_done=ran.append)
     assert [t.index for t in ran] == [1]
     assert read_sealed_json(run)["sequence_params"]["size"] == 14
+
+
+def test_a_sequence_with_no_target_at_frame_0_is_recorded_unscored(tmp_path, capsys):
+    from scenegen.cli import main
+
+    late = {"name": "late", "base": TWO, "count": 4, "set": {"n_frames": 4},
+            "sweep": {"entities[a].appear": [0, 2], "entities[b].appear": [0, 2]}}
+    data = tmp_path / "ds"
+    build_dataset(late, data, jobs=1)
+    res = run_benchmark(data, ["kalman"], tmp_path / "b", jobs=1)
+    by_index = {r["index"]: r for r in res["scores"]}
+    assert by_index[3]["targets"] == 0  # both enter at frame 2: nothing to track
+    assert all(by_index[3][m] is None for m in ("auc", "success", "tracked", "mota"))
+    assert by_index[0]["targets"] == 2 and by_index[0]["auc"] is not None
+    (board,) = res["leaderboard"]
+    assert board["sequences"] == 3  # the scored ones
+    assert main(["validate", str(tmp_path / "b"), "--deep"]) == 0
+    assert "valid benchmark folder" in capsys.readouterr().out
