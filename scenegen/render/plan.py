@@ -305,6 +305,7 @@ class Scenario:
         # Alive and overlapping the frame.
         inside = (x0 < w) & (y0 < h) & (x0 + tw[safe] > 0) & (y0 + th[safe] > 0)
         present = (tidx >= 0) & inside
+        _drop_shapes_outside(present, templates, tidx, x0, y0, h, w)
         tidx = np.where(present, tidx, -1)
 
         dyn = np.flatnonzero(~self.in_static)
@@ -411,6 +412,25 @@ class Scenario:
 
 def _top_left(cx: float, cy: float, tw: int, th: int) -> tuple[int, int]:
     return int(np.floor(cx - tw / 2 + 0.5)), int(np.floor(cy - th / 2 + 0.5))
+
+
+def _drop_shapes_outside(present: NDArray[np.bool_], templates: list[NDArray[np.uint8]],
+                         tidx: NDArray[np.int64], x0: NDArray[np.int64],
+                         y0: NDArray[np.int64], h: int, w: int) -> None:
+    """Clear ``present`` (F, K) where only the transparent part of a template (its
+    rectangle's corners around an ellipse, say) overlaps the frame: an entity is present
+    when one of its shape's pixels (alpha > 0) is inside the frame. ``templates`` (RGBA),
+    ``tidx``, ``x0``, ``y0`` (F, K) as in :meth:`Plan.render`."""
+    th = np.array([t.shape[0] for t in templates], dtype=np.int64)
+    tw = np.array([t.shape[1] for t in templates], dtype=np.int64)
+    safe = np.maximum(tidx, 0)
+    partial = present & ((x0 < 0) | (y0 < 0) | (x0 + tw[safe] > w) | (y0 + th[safe] > h))
+    for f, k in zip(*np.nonzero(partial), strict=True):
+        i, x, y = int(tidx[f, k]), int(x0[f, k]), int(y0[f, k])
+        alpha = templates[i][max(0, -y) : min(int(th[i]), h - y),
+                             max(0, -x) : min(int(tw[i]), w - x), 3]  # fmt: skip
+        if not alpha.any():
+            present[f, k] = False
 
 
 def _pack(

@@ -80,7 +80,9 @@ def check_sequence(seq, scn: Scenario, *, pixels: bool = True) -> None:
             if scn.alive[t, k]:
                 tpl, x0, y0 = placed(scn, t, k)
                 th, tw = tpl.shape[:2]
-                inside = x0 < w and y0 < h and x0 + tw > 0 and y0 + th > 0
+                # Present: one of its shape's pixels (alpha > 0) is inside the frame.
+                part = tpl[max(0, -y0) : max(0, h - y0), max(0, -x0) : max(0, w - x0), 3]
+                inside = bool(part.any())
             else:
                 inside = False
             assert present == inside, (t, k)

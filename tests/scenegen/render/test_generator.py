@@ -391,3 +391,21 @@ def test_generate_frames_must_be_a_positive_integer(frames):
 
     with pytest.raises(ConfigError, match="frames must be an integer >= 1"):
         scenegen.generate("kams-a", seed=1, frames=frames)
+
+
+@pytest.mark.parametrize("position", [[-9, -7], [49, 37], [49, -7], [-9, 37]])
+def test_an_entity_whose_shape_is_wholly_outside_the_frame_is_not_present(position):
+    # Only a transparent corner pixel of the ellipse's template rectangle overlaps the
+    # frame, at one of its corners: it
+    # was "present" with visibility 0 and no pixel, and trackers were started on it.
+    from scenegen.config import from_dict
+    from scenegen.render.plan import generate
+
+    cfg = from_dict({"width": 40, "height": 30, "n_frames": 2, "entities": [
+        {"name": "t", "role": "target", "position": [20, 15]},
+        {"name": "b", "role": "target", "position": position, "depth": 1,
+         "appearance": {"shape": "ellipse", "size": [20, 16]}},
+    ]})  # fmt: skip
+    seq = generate(cfg, seed=0)
+    assert not seq.gt.present[:, 1].any() and np.isnan(seq.gt.box[:, 1]).all()
+    assert seq.initial_targets().tolist() == [0]
