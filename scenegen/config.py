@@ -158,7 +158,8 @@ class AR2:
     stops it at the limit with zero velocity, ``free`` lets the entity leave the frame.
     The limits keep the entity's centre at least ``margin`` pixels plus half its size inside
     the frame (for ``scale`` the limits are ``[-margin, margin]`` around the mean in log
-    units, and a margin of 0 means unbounded).
+    units, and a margin of 0 means unbounded). An entity's ``reflect``/``clamp`` axis
+    needs 2 x margin + its size <= the frame's side, else its config is refused.
     """
 
     boundary: Boundary
@@ -602,6 +603,27 @@ class SceneConfig:
                     f"{self.width + 2 * ex}x{self.height + 2 * ey} exceeds {MAX_SIDE}",
                 )
         self._check_depth_ties()
+        self._check_margins()
+
+    def _check_margins(self) -> None:
+        """A bounded (``reflect``/``clamp``) axis must leave the entity's centre room:
+        2 x margin + its size <= the frame's side (otherwise the limits cross and it would
+        move freely, out of the frame)."""
+        by_name = {e.name: e for e in self.entities}
+        for i, e in enumerate(self.entities):
+            if e.motion is None:
+                continue
+            model = by_name.get(e.mimic, e) if e.mimic is not None else e
+            w, h = model.appearance.size
+            for axis, size, side, label in (("x", w, self.width, "width"),
+                                            ("y", h, self.height, "height")):  # fmt: skip
+                ar = getattr(e.motion, axis)
+                if ar.boundary != "free" and 2 * ar.margin + size > side:
+                    _fail(
+                        f"entities[{i}].motion.{axis}.margin",
+                        f"{ar.boundary} needs 2 x margin + the entity's {label} <= the "
+                        f"frame's {label}: 2 x {_short(ar.margin)} + {size} > {side}",
+                    )
 
     def __repr__(self) -> str:
         # Short: failing hypothesis examples print it (the whole config is in to_dict).

@@ -91,6 +91,26 @@ def test_depth_tie_after_a_keyframe():
         from_dict(d)
 
 
+@pytest.mark.parametrize("boundary", ["reflect", "clamp"])
+def test_a_bounded_axis_without_room_is_refused(boundary):
+    # 2 x margin + width > the frame's width: the limits crossed and the entity moved
+    # freely out of the frame, without a word.
+    d = {"width": 40, "height": 30, "n_frames": 3, "entities": [
+        {"name": "b", "role": "target", "position": [20, 15], "appearance": {"size": [10, 10]},
+         "motion": {"x": {"boundary": boundary, "margin": 15.5},
+                    "y": {"boundary": boundary, "margin": 10.5}}}]}  # fmt: skip
+    with pytest.raises(ConfigError, match=r"^entities\[0\]\.motion\.x\.margin: "
+                       rf"{boundary} needs 2 x margin .* 2 x 15.5 \+ 10 > 40$"):
+        from_dict(d)
+    d["entities"][0]["motion"]["x"]["margin"] = 15  # exactly fits: the centre is pinned
+    with pytest.raises(ConfigError, match=r"motion\.y\.margin: .* 2 x 10.5 \+ 10 > 30$"):
+        from_dict(d)
+    d["entities"][0]["motion"]["y"]["boundary"] = "free"
+    d["entities"][0]["motion"]["y"]["margin"] = 0
+    seq = scenegen.generate(from_dict(d), seed=0)
+    assert (seq.gt.center[:, 0, 0] == 20).all()
+
+
 def test_depth_shorthand_and_defaults():
     cfg = from_dict(base())
     assert cfg.entities[0].depth == ((0, 1),)
