@@ -478,6 +478,18 @@ def _key_text(key: Any) -> str:
     return "..." if key is Ellipsis else str(key)
 
 
+def _numpy_only(key: Any) -> bool:
+    """Whether h5py cannot read ``key`` (a first-axis index) as numpy would."""
+    if isinstance(key, slice):
+        return key.step is not None and key.step < 0
+    if isinstance(key, (list, np.ndarray)):
+        a = np.asarray(key)
+        if a.dtype == bool or a.ndim != 1:
+            return True
+        return a.size > 1 and not bool(np.all(np.diff(a) > 0)) or bool((a < 0).any())
+    return False
+
+
 class LazyArray:
     """A read-only view of an HDF5 dataset that reads only what is indexed.
 
@@ -547,12 +559,28 @@ class LazyArray:
 
     def _get(self, key: Any) -> NDArray[Any]:
         try:
-            return self._ds()[key]
+            return self._read(key)
         except (OSError, RuntimeError) as err:
             raise DataError(
                 f"{self.path}: {self.dataset}[{_key_text(key)}] is unreadable "
                 f"(damaged file: {describe_read_error(err)})"
             ) from None
+
+    def _read(self, key: Any) -> NDArray[Any]:
+        """``dataset[key]`` with numpy's semantics on the first axis: h5py reads only
+        increasing positive steps and increasing, distinct index lists, so a reversed
+        slice, a boolean mask or a list in any order (repeats allowed) is read as its
+        distinct rows in increasing order and rearranged here."""
+        ds = self._ds()
+        parts = key if isinstance(key, tuple) else (key,)
+        first = parts[0] if parts else None
+        if not self.shape or not _numpy_only(first):
+            return ds[key]
+        idx = np.arange(self.shape[0])[first]  # numpy's rules and its IndexError
+        rows, inverse = np.unique(idx, return_inverse=True)
+        if rows.size == 0:
+            return ds[(slice(0, 0),) + parts[1:]][np.zeros(idx.shape, dtype=np.intp)]
+        return ds[(rows,) + parts[1:]][inverse.reshape(idx.shape)]
 
     def __getitem__(self, key: Any) -> NDArray[Any]:
         return self._get(key)

@@ -66,6 +66,20 @@ def test_lazy_read_of_a_range(tmp_path, seq):
     assert back.frames.shape == seq.frames.shape and len(back.frames) == 12
 
 
+@pytest.mark.parametrize("key", [
+    np.s_[::-1], np.s_[9:2:-3], [0, 3, 3], [5, 1], [-1, 0], [], np.s_[::-2, 5:9],
+    ([4, 2], slice(None), 7), np.array([[0, 1], [1, 0]]), np.arange(12) % 3 == 0,
+    np.s_[2:8:2], [1, 4, 6], 5, -2, np.s_[..., 0],
+])  # fmt: skip
+def test_lazy_arrays_index_as_numpy_arrays_do(tmp_path, seq, key):
+    # A reversed slice or a list out of order was h5py's ValueError / TypeError.
+    path = tmp_path / "s.h5"
+    write(path, seq)
+    back = read(path)
+    for lazy, mem in ((back.frames, seq.frames), (back.labels, seq.labels)):
+        np.testing.assert_array_equal(lazy[key], np.asarray(mem)[key])
+
+
 def test_several_sequences_need_a_name(tmp_path, seq):
     other = scenegen.generate("kams-a", seed=0, frames=3)
     path = tmp_path / "two.h5"
