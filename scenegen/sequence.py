@@ -68,7 +68,8 @@ class GroundTruth:
         Visible pixels / amodal pixels (pixels outside the frame count as not visible);
         0 where absent.
     present : ndarray of shape (T, K), bool
-        The entity exists at that frame and part of its amodal extent is inside the frame.
+        The entity exists at that frame and one pixel of its shape (its amodal mask, not
+        merely its box's rectangle) is inside the frame.
     depth : ndarray of shape (T, K), int16
         Depth rank, 0 = nearest the camera.
     path_center : ndarray of shape (T, K, 2), float32
