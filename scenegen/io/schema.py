@@ -154,8 +154,9 @@ SEQUENCE_FIELDS: tuple[Field, ...] = (
           "and read as NaN.", "px", optional=True),
     Field("gt/visibility", "float32", ("T", "K"), "Visible pixels / amodal pixels (pixels "
           "outside the frame count as not visible); 0 where absent.", "fraction"),
-    Field("gt/present", "bool", ("T", "K"), "The entity exists at that frame and part of its "
-          "amodal extent is inside the frame.", "flag"),
+    Field("gt/present", "bool", ("T", "K"), "The entity exists at that frame and one pixel "
+          "of its shape (its amodal mask, not merely its box's rectangle) is inside the "
+          "frame.", "flag"),
     Field("gt/depth", "int16", ("T", "K"), "Depth rank per frame, 0 = nearest the camera.",
           "rank"),
     Field("templates/<id>", "uint8", ("h", "w", 4), "The entity drawn alone (RGBA; alpha 0 "
