@@ -69,7 +69,7 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
         format_table,
     )
     from scenegen.io import read, read_result
-    from scenegen.io.mot import read_mot_tracker
+    from scenegen.io.mot import read_mot_tracker_rows
     from scenegen.io.validate import require_valid
 
     require_valid(args.file)  # no computing on a damaged or inconsistent file
@@ -82,8 +82,8 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
     }
     result = Path(args.result)
     if not _is_hdf5(result):
-        ids, boxes = read_mot_tracker(result, seq.n_frames)
-        report = evaluate_tracks(seq, boxes, ids, tracker=result.stem, **options)
+        ids, boxes, rank = read_mot_tracker_rows(result, seq.n_frames)
+        report = evaluate_tracks(seq, boxes, ids, tracker=result.stem, rank=rank, **options)
         print(report.to_json() if args.json else format_table(report))
         return 0
     require_valid(result)

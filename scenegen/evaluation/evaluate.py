@@ -48,6 +48,7 @@ from scenegen.evaluation.report import (
     format_table,
 )
 from scenegen.io.mot import visible_enough
+from scenegen.io.results import repeated_ids
 
 __all__ = [
     "DEFAULT_RECOVER_FRAMES",
@@ -237,6 +238,8 @@ def evaluate(
         )
     entity_ids = np.asarray(sequence.entities.id).astype(np.int64)
     target_ids_seq = entity_ids[tracked]
+    if rep := repeated_ids(ids):
+        raise DataError(f"result {rep}")
     rows = []
     for i in ids:
         hit = np.flatnonzero(entity_ids == i)
@@ -250,6 +253,7 @@ def evaluate(
         sequence, est, ids, rows, list(range(len(rows))), tracker=tracker,
         recover_frames=recover_frames, persist=persist, iou_threshold=iou_threshold,
         gt_mode=gt_mode, visibility_threshold=visibility_threshold, otb_average=otb_average,
+        rank=None,
     )  # fmt: skip
     if order_prob is None or orderings is None:
         return report
@@ -264,6 +268,11 @@ def evaluate(
     gt = np.asarray(sequence.gt.box, dtype=np.float64)[:, rows]
     acc = _finite(metrics.depth_order_accuracy(prob, orders, depth, gt))
     return replace(report, overall=replace(report.overall, depth_order_accuracy=acc))
+
+
+def _sequence_frame(index: int, scored: NDArray[np.bool_]) -> int:
+    """The sequence frame of the ``index``-th scored frame (``scored`` (T,)); -1 stays."""
+    return int(np.flatnonzero(scored)[index]) if index >= 0 else -1
 
 
 def _pair_tracks(
@@ -309,6 +318,7 @@ def evaluate_tracks(
     gt_mode: str = "amodal",
     visibility_threshold: float = 0.0,
     otb_average: str = "sequence",
+    rank: ArrayLike | None = None,
 ) -> SequenceReport:
     """Scores of any tracks (e.g. a MOTChallenge tracker file) on one sequence.
 
@@ -322,6 +332,10 @@ def evaluate_tracks(
         exports use those), else with the track the identity matching assigns it.
     tracker, recover_frames, persist, iou_threshold, gt_mode, visibility_threshold, otb_average
         As in :func:`evaluate`.
+    rank : array_like of int, shape (T, H), optional
+        Order of each frame's boxes in the tracker file
+        (:func:`scenegen.io.mot.read_mot_tracker_rows`): TrackEval's matchings take a
+        frame's boxes in file order, which breaks their ties. Default: column order.
 
     Returns
     -------
@@ -342,24 +356,27 @@ def evaluate_tracks(
         raise DataError(f"track boxes must have shape (T, {ids.shape[0]}, 4), got {est.shape}")
     if est.shape[0] != t_n:
         raise DataError(f"tracks span {est.shape[0]} frames but sequence {name!r} has {t_n}")
+    if rank is not None and np.shape(rank) != est.shape[:2]:
+        raise DataError(f"rank must have shape {est.shape[:2]}, got {np.shape(rank)}")
     idx = np.asarray(sequence.target_indices())
     idx = idx[np.asarray(sequence.gt.present)[:, idx].any(axis=0)]
-    gt = np.asarray(sequence.gt.box, dtype=np.float64)[:, idx]
-    entity_ids = np.asarray(sequence.entities.id).astype(np.int64)
-    pair = _pair_tracks(gt, est, entity_ids[idx], ids, iou_threshold)
     return _report(
-        sequence, est, ids, [int(k) for k in idx], pair, tracker=tracker,
+        sequence, est, ids, [int(k) for k in idx], None, tracker=tracker,
         recover_frames=recover_frames, persist=persist, iou_threshold=iou_threshold,
         gt_mode=gt_mode, visibility_threshold=visibility_threshold, otb_average=otb_average,
+        rank=rank,
     )  # fmt: skip
 
 
 def _report(
     sequence: Any, est: NDArray[np.float64], track_ids: NDArray[np.int64], rows: list[int],
-    pair: list[int], *, tracker: str, recover_frames: int, persist: int, iou_threshold: float,
-    gt_mode: str, visibility_threshold: float, otb_average: str,
+    pair: list[int] | None, *, tracker: str, recover_frames: int, persist: int,
+    iou_threshold: float, gt_mode: str, visibility_threshold: float, otb_average: str,
+    rank: ArrayLike | None,
 ) -> SequenceReport:  # fmt: skip
-    """The report of tracks ``est`` (T, H, 4); row ``rows[m]`` (entity index) pairs ``pair[m]``."""
+    """The report of tracks ``est`` (T, H, 4); row ``rows[m]`` (entity index) pairs ``pair[m]``
+    (None: paired by :func:`_pair_tracks` on the scored ground truth and tracks, those of
+    ``gt_mode``); ``rank`` (T, H) or None as in :func:`evaluate_tracks`."""
     gt_box = np.asarray(sequence.gt.box, dtype=np.float64)
     present = np.asarray(sequence.gt.present, dtype=bool)
     keep = present.copy()
@@ -373,12 +390,17 @@ def _report(
         # MOTChallenge preprocessing: all rows of the ground-truth file, in file order.
         cols = [k for k in range(len(roles)) if roles[k] in _MOT_ROLES]
         file_gt = np.where(present[..., None], gt_box, np.nan)[:, cols]
-        est_keep &= remove_distractor_matches(file_gt, roles[cols] == "distractor", est)
+        est_keep &= remove_distractor_matches(file_gt, roles[cols] == "distractor", est,
+                                              est_rank=rank)  # fmt: skip
     est_scored = np.where(est_keep[..., None], est, np.nan)
+    if pair is None:
+        pair = _pair_tracks(gt_all[:, rows], est_scored, entity_ids[rows], track_ids,
+                            iou_threshold)  # fmt: skip
     # Multi-object scores over every target of the sequence.
     targets_all = np.flatnonzero(roles == "target")
     overall_mot = MotSummary.from_scores(
-        score_all(mot_frames(gt_all[:, targets_all], est_scored), threshold=iou_threshold)
+        score_all(mot_frames(gt_all[:, targets_all], est_scored, est_rank=rank),
+                  threshold=iou_threshold)
     )
     nan_track = np.full((est.shape[0], 1, 4), np.nan)
     rows_gt = gt_all[:, rows]
@@ -416,10 +438,11 @@ def _report(
                 mean_centre_error=_mean(err[np.isfinite(err)]),
                 auc=_finite(curves.auc),
                 precision_20=_finite(curves.precision_20),
-                failure_frame=(
+                failure_frame=_sequence_frame(
                     metrics.failure_frame(err, float(thresholds[m]), persist=persist)
                     if ok.any()
-                    else -1
+                    else -1,
+                    ok,
                 ),
                 mot=MotSummary.from_scores(mot),
             )

@@ -122,6 +122,7 @@ def mot_frames(
     *,
     gt_keep: ArrayLike | None = None,
     est_keep: ArrayLike | None = None,
+    est_rank: ArrayLike | None = None,
 ) -> MotFrames:
     """:class:`MotFrames` from ground-truth and tracker box arrays.
 
@@ -135,13 +136,16 @@ def mot_frames(
         Ground-truth detections to score (default: every finite box).
     est_keep : array_like of bool, shape (T, H), optional
         Tracker detections to score (default: every finite box).
+    est_rank : array_like of int, shape (T, H), optional
+        Order of each frame's tracker boxes (``read_mot_tracker_rows``' rank: the rows'
+        order in the tracker file); default: column order.
 
     Returns
     -------
     MotFrames
-        Within a frame, objects and tracks keep their column order (TrackEval keeps the
-        row order of its files; ties in the matchings are broken the same way when the
-        files list boxes in column order, as scenegen's exports do).
+        Within a frame, objects keep their column order and tracks the order of
+        ``est_rank`` (TrackEval keeps the row order of its files, which breaks ties in
+        its matchings; scenegen's exports list boxes in column order).
     """
     g = np.asarray(gt, dtype=np.float64)
     e = np.asarray(est, dtype=np.float64)
@@ -156,7 +160,7 @@ def mot_frames(
     gl, el = _relabel(gp), _relabel(ep)
     gt_ids, trk_ids, sims = [], [], []
     for t in range(g.shape[0]):
-        gi, ej = np.flatnonzero(gp[t]), np.flatnonzero(ep[t])
+        gi, ej = np.flatnonzero(gp[t]), _in_order(ep[t], est_rank, t)
         gt_ids.append(gl[gi])
         trk_ids.append(el[ej])
         sims.append(box_iou(g[t, gi], e[t, ej]))
@@ -169,8 +173,16 @@ def mot_frames(
     )
 
 
+def _in_order(present: NDArray[np.bool_], rank: ArrayLike | None, t: int) -> NDArray[np.intp]:
+    """The columns where ``present`` (H,) is True, in the order of ``rank[t]`` if given."""
+    cols = np.flatnonzero(present)
+    if rank is None:
+        return cols
+    return cols[np.argsort(np.asarray(rank)[t, cols], kind="stable")]
+
+
 def remove_distractor_matches(
-    gt: ArrayLike, distractor: ArrayLike, est: ArrayLike
+    gt: ArrayLike, distractor: ArrayLike, est: ArrayLike, est_rank: ArrayLike | None = None
 ) -> NDArray[np.bool_]:
     """Tracker boxes MOTChallenge keeps: those not matched to a distractor.
 
@@ -187,6 +199,8 @@ def remove_distractor_matches(
         Rows of a distractor class.
     est : array_like of shape (T, H, 4)
         Tracker boxes.
+    est_rank : array_like of int, shape (T, H), optional
+        Order of each frame's tracker boxes in the file (as in :func:`mot_frames`).
 
     Returns
     -------
@@ -200,7 +214,7 @@ def remove_distractor_matches(
     gp = np.all(np.isfinite(g), axis=-1)
     ep = np.all(np.isfinite(e), axis=-1)
     for t in range(g.shape[0]):
-        gi, ej = np.flatnonzero(gp[t]), np.flatnonzero(ep[t])
+        gi, ej = np.flatnonzero(gp[t]), _in_order(ep[t], est_rank, t)
         if gi.size == 0 or ej.size == 0:
             continue
         score = box_iou(g[t, gi], e[t, ej])

@@ -87,7 +87,8 @@ class TargetScores:
     auc, precision_20 : float or None
         OTB success AUC and precision at 20 px.
     failure_frame : int
-        KAMS failure frame, -1 if none.
+        KAMS failure frame (a frame of the sequence, counted from 0; the persistence is
+        counted over the frames where the target is scored), -1 if none.
     mot : MotSummary
         CLEAR MOT / identity / HOTA of this target against its track alone.
     """
@@ -124,9 +125,11 @@ class OverallScores:
     Attributes
     ----------
     mean_iou : float or None
-        Mean IoU over every evaluated frame of every target (pooled).
+        Mean IoU over every evaluated frame of the targets present at frame 0 (pooled):
+        the targets a tracker is started on, whatever the tracks came from.
     auc, precision_20 : float or None
-        OTB success AUC and precision at 20 px: the mean of the per-target values
+        OTB success AUC and precision at 20 px, over the targets present at frame 0: the
+        mean of their per-target values
         (``otb_average == "sequence"``: each target is one OTB sequence, averaged as the
         OTB toolkit averages sequences) or from all frames pooled (``"frames"``).
     otb_average : str

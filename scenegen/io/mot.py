@@ -42,6 +42,7 @@ __all__ = [
     "gt_keep",
     "gt_rows",
     "read_mot_tracker",
+    "read_mot_tracker_rows",
     "write_mot_tracker",
 ]
 
@@ -162,7 +163,35 @@ def write_mot_tracker(path: str | Path, boxes: ArrayLike, track_ids: ArrayLike) 
 def read_mot_tracker(
     path: str | Path, n_frames: int
 ) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
-    """Read a MOTChallenge tracker file.
+    """Read a MOTChallenge tracker file: (track ids (M,), boxes (n_frames, M, 4)).
+
+    :func:`read_mot_tracker_rows` without the row order; see it for the parameters,
+    returns and errors.
+    """
+    ids, boxes, _ = read_mot_tracker_rows(path, n_frames)
+    return ids, boxes
+
+
+def _integer(cell: str) -> int:
+    """A frame or id cell as an exact integer: ``12``, or ``12.0`` below 2**53 (a float
+    above that may stand for several integers)."""
+    try:
+        return int(cell)
+    except ValueError:
+        pass
+    x = float(cell)  # ValueError for text
+    if not math.isfinite(x) or x != int(x):
+        raise ValueError("frame and id must be integers")
+    if abs(x) >= 2**53:
+        raise ValueError(f"{cell} is written as a float beyond 2**53, which is not exact; "
+                         "write the integer")  # fmt: skip
+    return int(x)
+
+
+def read_mot_tracker_rows(
+    path: str | Path, n_frames: int
+) -> tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.int64]]:
+    """Read a MOTChallenge tracker file, with the order of its rows in each frame.
 
     Parameters
     ----------
@@ -177,6 +206,10 @@ def read_mot_tracker(
     boxes : ndarray of shape (n_frames, M, 4)
         Boxes in scenegen's 0-based pixels (``bb_left - 1``, ``bb_top - 1``), NaN where a
         track has no row.
+    rank : ndarray of int, shape (n_frames, M)
+        Position of the track's row among the rows of its frame, in file order (0 first),
+        −1 where it has none. TrackEval matches a frame's boxes in this order, which
+        breaks ties in its matchings (``mot_frames``' ``est_rank``).
 
     Raises
     ------
@@ -201,11 +234,7 @@ def read_mot_tracker(
         try:
             if len(cells) < 6:
                 raise ValueError("fewer than 6 columns")
-            frame, ident = float(cells[0]), float(cells[1])
-            if not (np.isfinite(frame) and np.isfinite(ident)):
-                raise ValueError("frame and id must be integers")
-            if frame != int(frame) or ident != int(ident):
-                raise ValueError("frame and id must be integers")
+            frame, ident = _integer(cells[0]), _integer(cells[1])
             if abs(ident) >= MAX_TRACK_ID:
                 raise ValueError(f"id beyond ±{MAX_TRACK_ID - 1}")
             vals = [float(c) for c in cells[2:6]]
@@ -216,17 +245,21 @@ def read_mot_tracker(
         except ValueError as err:
             raise DataError(f"{p}:{n}: not a MOTChallenge row ({err}): {line[:80]!r}") from None
         if not 1 <= frame <= n_frames:
-            raise DataError(f"{p}:{n}: frame {int(frame)} is outside 1..{n_frames}")
-        rows.append((n, int(frame), int(ident), *vals))  # type: ignore[arg-type]
+            raise DataError(f"{p}:{n}: frame {frame} is outside 1..{n_frames}")
+        rows.append((n, frame, ident, *vals))  # type: ignore[arg-type]
     ids = np.array(sorted({r[2] for r in rows}), dtype=np.int64)
     col = {int(i): c for c, i in enumerate(ids)}
     boxes = np.full((n_frames, ids.shape[0], 4), np.nan)
+    rank = np.full((n_frames, ids.shape[0]), -1, dtype=np.int64)
+    seen = np.zeros(n_frames, dtype=np.int64)
     for n, frame, ident, x, y, w, h in rows:
         t, c = frame - 1, col[ident]
         if not np.isnan(boxes[t, c, 0]):
             raise DataError(f"{p}:{n}: track id {ident} appears twice in frame {frame}")
         boxes[t, c] = (x - 1.0, y - 1.0, w, h)
-    return ids, boxes
+        rank[t, c] = seen[t]
+        seen[t] += 1
+    return ids, boxes, rank
 
 
 class writable:

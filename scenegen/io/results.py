@@ -14,7 +14,7 @@ from typing import Any
 
 import h5py
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from scenegen.errors import ConfigError, DataError
 from scenegen.io import guard
@@ -71,7 +71,7 @@ class TrackerResult:
 
     def problems(self) -> list[str]:
         """What keeps this result from being written: shapes that disagree (``boxes``
-        (T, M, 4) with M ``target_ids``; ``orderings`` (L, M) of positions 0..M-1 and
+        (T, M, 4) with M distinct ``target_ids``; ``orderings`` (L, M) of positions 0..M-1 and
         ``order_prob`` (T, L), both or neither) and box rows that are neither finite with
         w, h >= 0 nor all NaN.
         Empty if none."""
@@ -82,6 +82,8 @@ class TrackerResult:
         m = ids.shape[0]
         if boxes.ndim != 3 or boxes.shape[1:] != (m, 4):
             return [f"boxes has shape {boxes.shape}, expected (T, {m}, 4)"]
+        if rep := repeated_ids(ids):
+            out.append(rep)
         if bad_box_rows(boxes).any():
             out.append(
                 "boxes has rows that are neither finite with w, h >= 0 nor all NaN "
@@ -102,6 +104,17 @@ class TrackerResult:
                 f"({boxes.shape[0]}, {orderings.shape[0]}) (T frames, L orderings)"
             )
         return out
+
+
+def repeated_ids(ids: ArrayLike) -> str:
+    """The problem with ``target_ids`` (M,) that repeat an id ("" if none does): each
+    target is tracked once, so one id twice is a damaged or wrong result."""
+    a = np.asarray(ids).reshape(-1)
+    values, counts = np.unique(a, return_counts=True)
+    if not (counts > 1).any():
+        return ""
+    return (f"target_ids repeat id {values[counts > 1][0].item()} (each target is tracked "
+            "once)")  # fmt: skip
 
 
 def write_result(path: str | Path, *results: TrackerResult) -> None:

@@ -34,7 +34,7 @@ from scenegen.io import describe_open_error, describe_read_error, describe_temp_
 from scenegen.io.guard import beat, call
 from scenegen.io.guard import timeout as guard_timeout
 from scenegen.io.integrity import ATTRS_DIGEST, DIGEST, INTEGRITY, Hasher, as_text, attrs_digest
-from scenegen.io.results import bad_box_rows
+from scenegen.io.results import bad_box_rows, repeated_ids
 from scenegen.io.schema import GT_FIELDS, RESULT_FIELDS, ROLES, SCHEMA, SEQUENCE_FIELDS
 
 __all__ = ["check_file", "require_valid"]
@@ -492,6 +492,9 @@ def _check_results(p: Path, root: h5py.Group) -> list[str]:
                     f"{where}: boxes has rows that are neither finite with w, h >= 0 nor "
                     f"all NaN at frames {_frames(np.flatnonzero(bad.any(axis=1)).tolist())}"
                 )
+        ids = data.get("target_ids")
+        if ids is not None and ids.ndim == 1 and (rep := repeated_ids(ids)):
+            problems.append(f"{where}: {rep}")
         orderings = data.get("orderings")
         if (
             orderings is not None

@@ -12,7 +12,10 @@ It writes, under ``tests/data/trackeval/``:
   trackers (``fixtures/expected/<fixture>/<tracker>.npy``) as a MOTChallenge tracker file,
   and a ``scrambled`` tracker made here from the ground truth with a fixed seed (noisy
   boxes, dropped frames, swapped and split identities, a false-positive track, and boxes
-  on distractors and occluders) so that every score has something to count.
+  on distractors and occluders) so that every score has something to count;
+* ``trackers/tied/<fixture>.txt``: two boxes tied in IoU on every target and distractor,
+  each frame's rows in a random order, so that the matchings' ties are broken by the
+  file's row order (TrackEval's rule).
 
 Then run ``tools/trackeval/make_oracle.py`` in TrackEval's side environment.
 """
@@ -81,6 +84,33 @@ def scrambled(seq, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
     return np.stack(tracks, axis=1), np.asarray(ids)
 
 
+def tied(seq, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """Tracks (T, H, 4) and ids (H,) whose boxes tie: every target and distractor gets two
+    boxes shifted by the same amount left and right of its own (equal IoU with it), so
+    which one a matching takes is decided by the order of a frame's rows in the file."""
+    box = np.asarray(seq.gt.box, dtype=np.float64)
+    present = np.asarray(seq.gt.present, dtype=bool)
+    roles = np.asarray(seq.entities.role).astype(str)
+    tracks, ids = [], []
+    for n, k in enumerate(np.flatnonzero((roles == "target") | (roles == "distractor"))):
+        for side, ident in ((-1.0, 200 + 2 * n), (1.0, 201 + 2 * n)):
+            b = box[:, k].copy()
+            b[:, 0] += side * np.maximum(1.0, np.round(0.1 * b[:, 2]))
+            b[~present[:, k] | (rng.random(len(b)) < 0.1)] = np.nan
+            tracks.append(b)
+            ids.append(ident)
+    return np.stack(tracks, axis=1), np.asarray(ids)
+
+
+def shuffle_rows(path: Path, rng: np.random.Generator) -> None:
+    """Rewrite a tracker file with each frame's rows in a random order (frames in order)."""
+    frames: dict[int, list[str]] = {}
+    for line in path.read_text().splitlines(keepends=True):
+        frames.setdefault(int(line.split(",")[0]), []).append(line)
+    path.write_text("".join(line for t in sorted(frames)
+                            for line in rng.permutation(frames[t]).tolist()))  # fmt: skip
+
+
 def main() -> None:
     shutil.rmtree(OUT / "gt", ignore_errors=True)
     shutil.rmtree(OUT / "trackers", ignore_errors=True)
@@ -107,6 +137,13 @@ def main() -> None:
         folder = OUT / "trackers" / "scrambled"
         folder.mkdir(parents=True, exist_ok=True)
         write_mot_tracker(folder / f"{name}.txt", boxes, ids)
+        # Ties broken by the rows' order in the file (TrackEval keeps it).
+        rng = np.random.default_rng(100 + i)
+        boxes, ids = tied(seq, rng)
+        folder = OUT / "trackers" / "tied"
+        folder.mkdir(parents=True, exist_ok=True)
+        write_mot_tracker(folder / f"{name}.txt", boxes, ids)
+        shuffle_rows(folder / f"{name}.txt", rng)
     print(f"wrote {OUT}")
 
 

@@ -74,11 +74,18 @@ def test_bad_tracker_files_name_file_and_line(tmp_path, capsys):
                      ("2,1,2,inf,4,5", "a box value is not a finite number"),
                      ("2,1,2,3,-4,5", "width and height must not be negative"),
                      ("inf,1,2,3,4,5", "frame and id must be integers"),
-                     ("2,1e20,2,3,4,5", "id beyond ±9223372036854775807")):  # fmt: skip
+                     ("2,99999999999999999999,2,3,4,5", "id beyond ±9223372036854775807"),
+                     ("2,1e20,2,3,4,5", "1e20 is written as a float beyond 2**53, which is "
+                                        "not exact; write the integer")):  # fmt: skip
         bad.write_text(f"1,1,2,3,4,5\n{row}\n")
         code, _, err = run(capsys, "evaluate", seq_file, bad)
         assert code == 1 and err.strip() == (f"scenegen: error: {bad}:2: not a MOTChallenge "
                                              f"row ({why}): {row!r}")  # fmt: skip
+    # Ids above 2**53 are read exactly (they were parsed as floats: two merged).
+    bad.write_text("1,9007199254740993,2,3,4,5\n1,9007199254740992,2,3,4,5\n")
+    from scenegen.io.mot import read_mot_tracker
+
+    assert read_mot_tracker(bad, 14)[0].tolist() == [9007199254740992, 9007199254740993]
     # A duplicate names its line too.
     bad.write_text("1,1,2,3,4,5\n1,1,2,3,4,5\n")
     code, _, err = run(capsys, "evaluate", seq_file, bad)

@@ -163,3 +163,61 @@ def test_tracks_with_foreign_ids_pair_by_identity_and_otb_average(seq):
         evaluate_tracks(seq, est, [70, 80], otb_average="mean")
     with pytest.raises(DataError, match="tracks span 5 frames"):
         evaluate_tracks(seq, est[:5], [70, 80])
+
+
+def test_repeated_target_ids_are_refused_everywhere(seq, tmp_path):
+    # A result naming target 1 twice was "valid" and scored target 1 twice (target 2 never).
+    import h5py
+
+    from scenegen.io.validate import check_file
+
+    est = np.asarray(seq.gt.box[:, seq.target_indices()], dtype=np.float64)
+    dup = np.array([1, 1])
+    with pytest.raises(DataError, match="target_ids repeat id 1"):
+        evaluate(seq, est, dup)
+    bad = TrackerResult("kalman", {}, 0, seq.name, dup, est.astype(np.float32))
+    assert bad.problems() == ["target_ids repeat id 1 (each target is tracked once)"]
+    path = tmp_path / "res.h5"
+    write_result(path, TrackerResult("kalman", {}, 0, seq.name, seq.target_ids(),
+                                     est.astype(np.float32)))  # fmt: skip
+    with h5py.File(path, "r+") as f:
+        f["results/kalman/target_ids"][1] = 1
+    assert any("target_ids repeat id 1" in p for p in check_file(path))
+
+
+def test_failure_frame_is_a_frame_of_the_sequence():
+    from scenegen.evaluation import evaluate_tracks
+
+    cfg = {"name": "late", "width": 80, "height": 60, "n_frames": 30,
+           "entities": [_target("a", 30, 30, 0), {**_target("b", 50, 30, 1), "appear": 4}]}
+    late = scenegen.generate(cfg, seed=1)
+    gt = np.asarray(late.gt.box[:, late.target_indices()], dtype=np.float64)
+    est = gt.copy()
+    est[:, 1] = np.nan  # target b (present from frame 4) is never tracked
+    rep = evaluate_tracks(late, est, late.target_ids())
+    assert rep.targets[1].failure_frame == 4  # its first frame, not its first scored index
+    assert rep.targets[0].failure_frame == -1
+
+
+def test_visible_mode_pairs_targets_on_the_scored_frames():
+    # Track 100 follows the walker only while it is hidden (ignored frames), track 200
+    # while it is visible: the walker pairs with 200, as the IDF1 matching does (it was
+    # paired on every frame, ignored ones included, so with 100, scoring IoU 0).
+    from scenegen.evaluation import evaluate_tracks
+    from scenegen.io.mot import visible_enough
+
+    cfg = {"name": "hide", "width": 80, "height": 40, "n_frames": 14, "entities": [
+        {"name": "walker", "role": "target", "position": [10, 20], "depth": [[0, 1]],
+         "appearance": {"shape": "rect", "size": [10, 10]},
+         "motion": {"x": {"sigma": 0, "boundary": "free"},
+                    "y": {"sigma": 0, "boundary": "free"}, "velocity": [3, 0]}},
+        {"name": "wall", "role": "occluder", "position": [44, 20], "depth": [[0, 0]],
+         "appearance": {"shape": "rect", "size": [40, 30]}}]}  # fmt: skip
+    s = scenegen.generate(cfg, seed=0)
+    gt = np.asarray(s.gt.box[:, 0], dtype=np.float64)
+    seen = visible_enough(s.gt.visibility[:, 0], 0.6)
+    assert 0 < seen.sum() < len(seen) / 2  # hidden longer than seen
+    est = np.stack([np.where(seen[:, None], gt, np.nan), np.where(seen[:, None], np.nan, gt)],
+                   axis=1)  # fmt: skip
+    rep = evaluate_tracks(s, est, [200, 100], gt_mode="visible", visibility_threshold=0.6)
+    assert rep.targets[0].track_id == 200 and rep.targets[0].mean_iou == 1.0

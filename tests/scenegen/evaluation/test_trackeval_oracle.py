@@ -2,7 +2,8 @@
 
 ``tests/data/trackeval/`` holds scenegen's MOT exports of six fixtures (ground truth in
 both modes, and the tracker files of our 12 trackers plus a ``scrambled`` one made to
-count every kind of error) and ``oracle.json``, TrackEval's numbers on them
+count every kind of error and a ``tied`` one whose matchings tie, broken by the order of
+each frame's rows in the file) and ``oracle.json``, TrackEval's numbers on them
 (``tools/trackeval/make_inputs.py`` then ``tools/trackeval/make_oracle.py`` in a side
 environment with numpy < 1.24). Tolerance 1e-9 (absolute): the numbers agree to the last
 bit today; the tolerance only allows for summation order.
@@ -18,7 +19,7 @@ import pytest
 
 from scenegen.evaluation import evaluate, evaluate_tracks
 from scenegen.io import read
-from scenegen.io.mot import gt_rows, read_mot_tracker
+from scenegen.io.mot import gt_rows, read_mot_tracker, read_mot_tracker_rows
 
 ROOT = Path(__file__).resolve().parents[3]
 DATA = ROOT / "tests" / "data" / "trackeval"
@@ -49,14 +50,15 @@ def test_committed_ground_truth_is_our_export(mode):
 @pytest.mark.parametrize("mode", ["amodal", "visible"])
 def test_scores_equal_trackeval(mode):
     table = ORACLE["modes"][mode]
-    assert len(table) == 13 and all(len(s) == 6 for s in table.values())
+    assert len(table) == 14 and all(len(s) == 6 for s in table.values())
     cache = {}
     diffs = []
     for tracker, seqs in table.items():
         for name, ref in seqs.items():
             seq = cache.setdefault(name, _seq(name))
-            ids, boxes = read_mot_tracker(DATA / "trackers" / tracker / f"{name}.txt", seq.n_frames)
-            got = evaluate_tracks(seq, boxes, ids, gt_mode=mode).overall.mot
+            path = DATA / "trackers" / tracker / f"{name}.txt"
+            ids, boxes, rank = read_mot_tracker_rows(path, seq.n_frames)
+            got = evaluate_tracks(seq, boxes, ids, gt_mode=mode, rank=rank).overall.mot
             for field, attr in FIELDS.items():
                 d = abs(float(getattr(got, attr)) - ref[field])
                 if not d <= TOL:
@@ -74,6 +76,20 @@ def test_oracle_counts_every_kind_of_error():
     assert sum(r["Frag"] for r in s.values()) >= 5
     v = ORACLE["modes"]["visible"]["scrambled"]["distractor-on-target"]
     assert v["CLR_FP"] < s["distractor-on-target"]["CLR_FP"]
+
+
+def test_the_tied_tracker_needs_the_file_s_row_order():
+    """Without the rows' order (column order instead) some tied matchings go the other
+    way, and CLEAR or HOTA differ from TrackEval's: the ``tied`` files test the order."""
+    differ = 0
+    for mode in ("amodal", "visible"):
+        for name, ref in ORACLE["modes"][mode]["tied"].items():
+            seq = _seq(name)
+            ids, boxes = read_mot_tracker(DATA / "trackers" / "tied" / f"{name}.txt",
+                                          seq.n_frames)  # fmt: skip
+            got = evaluate_tracks(seq, boxes, ids, gt_mode=mode).overall.mot
+            differ += any(abs(float(getattr(got, a)) - ref[f]) > TOL for f, a in FIELDS.items())
+    assert differ >= 3
 
 
 @pytest.mark.parametrize("name", ["shm-crossing-small", "full-occlusion", "enter-leave"])
