@@ -350,11 +350,22 @@ def _check_gt(where: str, gt: dict[str, NDArray[Any]]) -> list[str]:
     bad = np.flatnonzero(((vis < 0) | (vis > 1 + 1e-6) | np.isnan(vis)).any(axis=1))
     if bad.size:
         problems.append(f"{where}: gt/visibility is outside [0, 1] at frames {_frames(bad)}")
-    box, center = gt["box"], gt["center"]
+    box, center, vb = gt["box"], gt["center"], gt["visible_box"]
     with np.errstate(invalid="ignore"):
         size_bad = (box[..., 2:] <= 0).any(axis=-1) & present
         mid = box[..., :2] + box[..., 2:] / 2
-        off = (np.abs(center - mid) > 0.5 + 1e-3).any(axis=-1) & present
+        # The centre is the box's, exactly (float32 sums of integers and halves).
+        off = (np.abs(center - mid) > 1e-3).any(axis=-1) & present
+        # The visible part lies inside the whole (amodal) box.
+        outside = ((vb[..., 0] < box[..., 0] - 1e-3) | (vb[..., 1] < box[..., 1] - 1e-3)
+                   | (vb[..., 0] + vb[..., 2] > box[..., 0] + box[..., 2] + 1e-3)
+                   | (vb[..., 1] + vb[..., 3] > box[..., 1] + box[..., 3] + 1e-3))  # fmt: skip
+        outside &= present & ~np.isnan(vb).any(axis=-1)
+    bad = np.flatnonzero(outside.any(axis=1))
+    if bad.size:
+        problems.append(
+            f"{where}: gt/visible_box lies outside gt/box at frames {_frames(bad)}"
+        )
     bad = np.flatnonzero(size_bad.any(axis=1))
     if bad.size:
         problems.append(f"{where}: gt/box has width or height <= 0 at frames {_frames(bad)}")

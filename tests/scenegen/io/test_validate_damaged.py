@@ -180,11 +180,27 @@ def test_visible_box_disagrees_with_labels(copy):
     def damage(g, f):
         vb = g["gt/visible_box"][()]
         assert np.isfinite(vb[2, 0]).all()
-        vb[2, 0, 0] += 1
+        vb[2, 0, 2] -= 1  # narrower: still inside the box
         g["gt/visible_box"][...] = vb
 
     p = edit(copy(), damage)
     assert check_file(p) == [f"{p}: {SEQ}: gt/visible_box disagrees with labels at frames 2"]
+
+
+def test_visible_box_outside_the_box_and_centre_off_the_box(copy):
+    # Both were accepted without --deep (the centre had 0.5 px of slack).
+    def damage(g, f):
+        box, center = g["gt/box"][()], g["gt/center"][()]
+        box[2, 0, 0] += 6
+        center[2, 0, 0] += 6
+        center[4, 0, 1] += 0.5
+        g["gt/box"][...] = box
+        g["gt/center"][...] = center
+
+    p = edit(copy(), damage)
+    problems = check_file(p)
+    assert f"{p}: {SEQ}: gt/visible_box lies outside gt/box at frames 2" in problems
+    assert f"{p}: {SEQ}: gt/center is not the centre of gt/box at frames 4" in problems
 
 
 def test_visibility_disagrees_with_labels(copy):
