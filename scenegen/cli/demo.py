@@ -51,7 +51,7 @@ def generate_presets(out: Path, seed: int) -> list[Path]:
     folder = out / "presets"
     folder.mkdir(parents=True, exist_ok=True)
     written = []
-    for name in presets.names():
+    for name in presets.all_names():
         t0 = time.perf_counter()
         seq = generate(name, seed=seed)
         write(folder / f"{name}.h5", seq)

@@ -106,9 +106,9 @@ def resolve_family(family: str | Path | Family | dict[str, Any]) -> Family:
         return load_family(text)
     if text in BUILTIN:
         return family_from_dict(BUILTIN[text], source=f"family {text}")
-    if text in presets.names():
+    if text in presets.all_names():
         return family_from_dict({"name": text, "base": text}, source=f"family {text}")
     raise ConfigError(
         f"unknown family {text!r}: not a .yaml/.json file; built-in families: "
-        f"{', '.join(BUILTIN)}; or a preset: {', '.join(presets.names())}"
+        f"{', '.join(BUILTIN)}; or a preset: {', '.join(presets.all_names())}"
     )

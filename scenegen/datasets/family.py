@@ -350,10 +350,10 @@ def _load_base(value: Any, source: str, folder: Path | None) -> tuple[str, dict[
                 return "", to_dict(load_config(p))
             except ConfigError as err:
                 raise _fail(source, "base", str(err)) from None
-        if value not in presets.names():
+        if value not in presets.all_names():
             raise _fail(
                 source, "base",
-                f"unknown preset {value!r}; valid presets: {', '.join(presets.names())}",
+                f"unknown preset {value!r}; valid presets: {', '.join(presets.all_names())}",
             )  # fmt: skip
         return value, to_dict(presets.get(value))
     if isinstance(value, dict):

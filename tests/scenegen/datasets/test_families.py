@@ -56,6 +56,15 @@ def test_a_preset_name_is_a_family_of_seeds():
     assert a.params == {} and a.seed != b.seed and a.preset == "kams-c"
 
 
+@pytest.mark.parametrize("name", presets.realistic_names())
+def test_every_preset_is_a_family_and_a_base(name):
+    # The realistic presets were "unknown" to dataset (names() instead of all_names()).
+    assert resolve_family(name).draws(1)[0].preset == name
+    assert family_from_dict({"name": "b", "base": name}).draws(1)[0].preset == name
+    swept = family_from_dict({"name": "s", "sweep": {"preset": [name, "kams-a"]}})
+    assert [d.preset for d in swept.draws(2)] == [name, "kams-a"]
+
+
 def test_grid_and_draws():
     fam = family_from_dict(FAMILY)
     draws = fam.draws()
