@@ -7,7 +7,7 @@ The CLI maps :class:`ConfigError` (bad usage, bad config, bad parameter) to exit
 
 from __future__ import annotations
 
-__all__ = ["ConfigError", "DataError", "TrackerError"]
+__all__ = ["ConfigError", "DataError", "NotInFile", "TrackerError"]
 
 
 class ConfigError(ValueError):
@@ -16,6 +16,13 @@ class ConfigError(ValueError):
 
 class DataError(ValueError):
     """An invalid, damaged or mismatched data file; the message names the file and problem."""
+
+
+class NotInFile(DataError):
+    """A file holds no sequence (or tracker result) of the name asked for, or several and
+    none was named. A :class:`DataError` where the name comes from data (a manifest); the
+    CLI verbs whose ``--sequence`` / ``--tracker`` option picks it report a usage error
+    (exit 2) naming the option."""
 
 
 class TrackerError(RuntimeError):

@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from scenegen import presets
-from scenegen.cli.options import seed_arg
+from scenegen.cli.options import picked_by, seed_arg
 from scenegen.cli.progress import bar
 from scenegen.errors import ConfigError, DataError
 
@@ -280,7 +280,8 @@ def _read(path: Path, name: str | None) -> Any:
     from scenegen.io.validate import require_valid
 
     require_valid(path)  # no computing on a damaged or inconsistent file
-    return read(path, name)
+    with picked_by("--sequence"):
+        return read(path, name)
 
 
 def cmd_preview(args: argparse.Namespace) -> int:
@@ -336,7 +337,8 @@ def cmd_export(args: argparse.Namespace) -> int:
             raise ConfigError(
                 f"{args.file}: a tracker result exports only to --format mot, not {args.format}"
             )
-        res = read_result(args.file, args.tracker)
+        with picked_by("--tracker"):
+            res = read_result(args.file, args.tracker)
         n = write_mot_tracker(args.output, res.boxes, res.target_ids)
         print(f"wrote {args.output} ({n} boxes of {res.tracker!r}, MOTChallenge tracker file)")
         return 0

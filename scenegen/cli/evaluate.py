@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from scenegen.cli.options import picked_by
+
 __all__ = ["cmd_evaluate", "register"]
 
 
@@ -74,7 +76,8 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
 
     require_valid(args.file)  # no computing on a damaged or inconsistent file
     check_options(args.gt_mode, args.visibility_threshold, args.otb_average)
-    seq = read(args.file, args.sequence)
+    with picked_by("--sequence"):
+        seq = read(args.file, args.sequence)
     options = {
         "gt_mode": args.gt_mode,
         "visibility_threshold": args.visibility_threshold,
@@ -87,7 +90,8 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
         print(report.to_json() if args.json else format_table(report))
         return 0
     require_valid(result)
-    res = read_result(result, args.tracker)
+    with picked_by("--tracker"):
+        res = read_result(result, args.tracker)
     if res.sequence and res.sequence != seq.name:
         raise DataError(
             f"{args.result}: result is for sequence {res.sequence!r}, but {args.file} holds "

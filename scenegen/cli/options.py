@@ -3,10 +3,26 @@
 from __future__ import annotations
 
 import argparse
+from collections.abc import Iterator
+from contextlib import contextmanager
 
+from scenegen.errors import ConfigError, NotInFile
 from scenegen.render.plan import MAX_SEED
 
-__all__ = ["seed_arg"]
+__all__ = ["picked_by", "seed_arg"]
+
+
+@contextmanager
+def picked_by(option: str) -> Iterator[None]:
+    """Report a name the file does not hold (:class:`scenegen.errors.NotInFile`) as the
+    usage error it is when ``option`` chose it: ``ConfigError`` (exit 2) naming the option.
+
+    ``with picked_by("--sequence"): seq = read(path, args.sequence)``
+    """
+    try:
+        yield
+    except NotInFile as err:
+        raise ConfigError(f"{err} (choose with {option})") from None
 
 
 def seed_arg(text: str) -> int:

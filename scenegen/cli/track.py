@@ -8,7 +8,7 @@ import os
 from pathlib import Path
 from typing import Any
 
-from scenegen.cli.options import seed_arg
+from scenegen.cli.options import picked_by, seed_arg
 from scenegen.cli.progress import bar
 from scenegen.errors import ConfigError
 
@@ -81,7 +81,8 @@ def cmd_track(args: argparse.Namespace) -> int:
     params = parse_params(args.param)
     require_valid(args.file)  # no computing on a damaged or inconsistent file
     check_writable(args.output)
-    seq = read(args.file, args.sequence)
+    with picked_by("--sequence"):
+        seq = read(args.file, args.sequence)
     label = tracker_label(args.tracker)
     with bar(seq.n_frames - 1, f"track {label}", unit="frame") as pb:
         res = run_tracker(seq, args.tracker, params, args.seed, progress=lambda n: pb.update(1))

@@ -51,7 +51,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from scenegen.config import from_dict, to_dict
-from scenegen.errors import ConfigError, DataError
+from scenegen.errors import ConfigError, DataError, NotInFile
 from scenegen.io import guard
 from scenegen.io.atomic import (
     atomic_path,
@@ -729,10 +729,11 @@ def _read_once(p: Path, name: str | None) -> Sequence:
             raise DataError(f"{p}: holds no sequences")
         if name is None:
             if len(seqs) > 1:
-                raise DataError(f"{p}: holds {len(seqs)} sequences; name one of {', '.join(seqs)}")
+                raise NotInFile(f"{p}: holds {len(seqs)} sequences; name one of "
+                                f"{', '.join(seqs)}")  # fmt: skip
             name = seqs[0]
         if name not in seqs:
-            raise DataError(f"{p}: no sequence {name!r}; it holds {', '.join(seqs)}")
+            raise NotInFile(f"{p}: no sequence {name!r}; it holds {', '.join(seqs)}")
         try:
             g = f[f"sequences/{name}"]
             config = from_dict(json.loads(g.attrs["config"]))

@@ -16,7 +16,7 @@ import h5py
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from scenegen.errors import ConfigError, DataError
+from scenegen.errors import ConfigError, DataError, NotInFile
 from scenegen.io import guard
 from scenegen.io.atomic import atomic_path
 from scenegen.io.hdf5 import (
@@ -184,10 +184,11 @@ def read_result(path: str | Path, tracker: str | None = None) -> TrackerResult:
             raise DataError(f"{p}: holds no tracker results")
         if tracker is None:
             if len(names) > 1:
-                raise DataError(f"{p}: holds results of {', '.join(names)}; name one")
+                raise NotInFile(f"{p}: holds results of {', '.join(names)}; name one")
             tracker = names[0]
         if tracker not in names:
-            raise DataError(f"{p}: no result for tracker {tracker!r}; it holds {', '.join(names)}")
+            raise NotInFile(f"{p}: no result for tracker {tracker!r}; it holds "
+                            f"{', '.join(names)}")  # fmt: skip
         try:
             g = f[f"results/{tracker}"]
             return TrackerResult(

@@ -178,3 +178,28 @@ def test_an_mp4_preview_of_frames_the_encoder_refuses_names_their_size(tmp_path,
     err = capsys.readouterr().err
     assert code == 2 and "MP4 frames must be 2..8191 px a side, these are 1x30" in err, err
     assert not (tmp_path / "one.mp4").exists()
+
+
+def test_a_sequence_or_tracker_the_file_lacks_is_a_usage_error(tmp_path, capsys):
+    # The option picks it: exit 2 naming the option (it was exit 1, "name one of ...").
+    import scenegen
+
+    multi = tmp_path / "multi.h5"
+    scenegen.write(multi, scenegen.generate("kams-a", seed=1, frames=3),
+                   scenegen.generate(scenegen.presets.get("kams-b"), seed=2, frames=3))
+    res = tmp_path / "r.h5"
+    for argv, option in (
+        (["track", multi, "--tracker", "kalman", "-o", res], "--sequence"),
+        (["track", multi, "--sequence", "x", "--tracker", "kalman", "-o", res], "--sequence"),
+        (["preview", multi, "-o", tmp_path / "p.gif"], "--sequence"),
+        (["export", multi, "--format", "mot", "-o", tmp_path / "m"], "--sequence"),
+    ):  # fmt: skip
+        code, _, err = run(capsys, *argv)
+        assert code == 2 and err.strip().endswith(f"(choose with {option})"), err
+    assert run(capsys, "track", multi, "--sequence", "kams-a", "--tracker", "kalman",
+               "-o", res)[0] == 0  # fmt: skip
+    code, _, err = run(capsys, "evaluate", multi, res, "--sequence", "kams-a", "--tracker", "x")
+    assert code == 2 and "no result for tracker 'x'; it holds kalman (choose with --tracker)" in err
+    code, _, err = run(capsys, "export", res, "--format", "mot", "--tracker", "x",
+                       "-o", tmp_path / "r.txt")  # fmt: skip
+    assert code == 2 and err.strip().endswith("(choose with --tracker)")
