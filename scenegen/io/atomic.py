@@ -177,6 +177,12 @@ def _fsync_dir(folder: Path) -> None:
 def _target_folder(target: Path) -> Path:
     folder = target.parent if str(target.parent) else Path(".")
     if not folder.is_dir():
+        # The nearest existing ancestor says why: missing, or a file where a folder is.
+        up = folder
+        while not up.exists() and up != up.parent:
+            up = up.parent
+        if up.exists() and not up.is_dir():
+            raise ConfigError(f"{target}: {up} is a file, not a folder")
         raise ConfigError(f"{target}: folder {folder} does not exist")
     if target.is_dir():
         raise ConfigError(f"{target}: is a folder, expected a file name")

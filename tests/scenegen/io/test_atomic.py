@@ -217,6 +217,13 @@ def test_failed_write_leaves_nothing(tmp_path):
         pass
     with pytest.raises(ConfigError, match="is a folder"), atomic_path(tmp_path):
         pass
+    # A file where a folder of the path should be is named (it "did not exist").
+    afile = tmp_path / "afile"
+    afile.write_text("x")
+    for out in (afile / "x", afile / "sub" / "x"):
+        with pytest.raises(ConfigError, match=rf"^{out}: {afile} is a file, not a folder$"):
+            with atomic_path(out):
+                pass
 
 
 def test_clean_temp_files_removes_only_stale_leftovers(tmp_path):
