@@ -537,7 +537,8 @@ def run_benchmark(
     ------
     ConfigError
         As :func:`plan_benchmark`; a bad ``jobs`` or an unreachable scheduler; ``out``
-        holding a dataset (its ``manifest.json``) or that cannot be created.
+        holding a dataset (its ``manifest.json``) or an experiment's results, or that
+        cannot be created.
     DataError
         ``dataset`` is not a dataset folder, or a shard is damaged.
     """
@@ -557,6 +558,11 @@ def run_benchmark(
         what = "the dataset folder" if outp.resolve() == root.resolve() else "a dataset folder"
         raise ConfigError(f"-o {outp}: is {what} (manifest.json); write the benchmark into "
                           "another folder")  # fmt: skip
+    from scenegen.lab.experiments import holds_experiment_outputs
+
+    if holds_experiment_outputs(outp):
+        raise ConfigError(f"-o {outp}: holds the results of `scenegen experiment`; write the "
+                          "benchmark into another folder")  # fmt: skip
     make_output_folder(outp)
     meta = dataset_meta(man, root)
     listed = listed_digests(outp, meta)

@@ -128,18 +128,40 @@ def results_document(exp: Experiment, records: list[dict[str, Any]]) -> dict[str
     return _round(json.loads(json.dumps(results)))
 
 
+def holds_experiment_outputs(folder: Path) -> bool:
+    """True for a folder holding what ``scenegen experiment`` writes (even damaged): a
+    ``results.json`` naming an experiment, or run records (``runs/*.json``) beside a
+    ``table.md``. ``scenegen benchmark -o`` refuses such a folder."""
+    root = Path(folder)
+    try:
+        held = json.loads((root / "results.json").read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, ValueError):
+        held = None
+    if isinstance(held, dict) and isinstance(held.get("experiment"), str):
+        return True
+    runs = root / "runs"
+    return (root / "table.md").is_file() and runs.is_dir() and any(runs.glob("*.json"))
+
+
 def _refuse_other_outputs(out: Path, name: str) -> None:
-    """Refuse an output folder holding another experiment's results, or a report of
-    ``experiment all``: its figures and runs would be mixed with this one's.
+    """Refuse an output folder holding another experiment's results, a benchmark's
+    outputs, or a report of ``experiment all``: its figures and runs would be mixed with
+    this one's.
 
     Raises
     ------
     ConfigError
         Naming the folder and what it holds.
     """
+    from scenegen.datasets.build import holds_benchmark_outputs
+
     if (out / "experiments").is_dir() and (out / "index.html").exists():
         raise ConfigError(
             f"-o {out}: holds a report of `scenegen experiment all`; choose another folder"
+        )
+    if holds_benchmark_outputs(out):
+        raise ConfigError(
+            f"-o {out}: holds the outputs of `scenegen benchmark`; choose another folder"
         )
     try:
         held = json.loads((out / "results.json").read_text(encoding="utf-8"))

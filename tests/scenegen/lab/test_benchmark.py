@@ -351,6 +351,28 @@ def test_a_dataset_is_not_written_into_a_benchmark_folder(reference, tmp_path):
     assert files(out) == files(reference)
 
 
+def test_benchmarks_and_experiments_do_not_overwrite_each_other(dataset, reference, tmp_path,
+                                                                capsys):
+    # Each exited 0 after replacing the other's results.json (and index.html).
+    from scenegen.cli import main
+
+    bench = tmp_path / "b"
+    shutil.copytree(reference, bench)
+    assert main(["experiment", "shm-depth", "--quick", "--scenes", "1", "--method", "kalman",
+                 "-o", str(bench)]) == 2  # fmt: skip
+    assert capsys.readouterr().err.strip() == (
+        f"scenegen: error: -o {bench}: holds the outputs of `scenegen benchmark`; choose "
+        "another folder")  # fmt: skip
+    assert files(bench) == files(reference)
+    exp = tmp_path / "e"
+    (exp / "runs").mkdir(parents=True)
+    (exp / "results.json").write_text('{"experiment": "shm-depth"}')
+    before = files(exp)
+    assert main(["benchmark", str(dataset), "--tracker", "kalman", "-o", str(exp)]) == 2
+    assert "holds the results of `scenegen experiment`" in capsys.readouterr().err
+    assert files(exp) == before
+
+
 def test_a_named_axis_is_plotted_by_its_values(tmp_path):
     import csv
 
