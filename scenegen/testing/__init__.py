@@ -4,6 +4,7 @@ pytest plugin, built-in fixtures.
 Nothing here imports :mod:`trackers`: the tooling works for any tracker.
 """
 
+from scenegen.testing.checks import SceneError
 from scenegen.testing.conformance import (
     CHECKS,
     CheckResult,
@@ -17,6 +18,7 @@ __all__ = [
     "CHECKS",
     "CheckResult",
     "ConformanceReport",
+    "SceneError",
     "check_tracker",
     "checks_table",
     "parametrize_with_checks",

@@ -295,7 +295,10 @@ def test_a_scene_that_cannot_be_built_is_raised_not_blamed_on_the_tracker(monkey
     checks._scene.cache_clear()
     monkeypatch.setattr(checks, "_make_scene", broken)
     try:
-        with pytest.raises(checks.SceneError, match="cannot build the conformance scene"):
+        from scenegen.testing import SceneError  # the documented name
+
+        assert SceneError is checks.SceneError
+        with pytest.raises(SceneError, match="cannot build the conformance scene"):
             check_tracker(Still, report=True, checks=["boxes"])
     finally:
         monkeypatch.undo()
