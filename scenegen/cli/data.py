@@ -74,14 +74,26 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="frame files (default: png for mot and vot, jpg for otb and got10k)",
     )  # fmt: skip
     p.add_argument(
-        "--gt-mode", choices=["amodal", "visible"], default="amodal",
+        "--gt-mode", choices=["amodal", "visible"], default=None,
         help="mot: amodal boxes in every frame (default) or MOTChallenge's visible convention",
     )  # fmt: skip
     p.add_argument(
-        "--visibility-threshold", type=float, default=0.0,
+        "--visibility-threshold", type=float, default=None,
         help="visible mode: rows with visibility at most this get conf 0 (default 0)",
     )  # fmt: skip
     p.set_defaults(func=cmd_export)
+
+
+def _refuse_unused_options(args: argparse.Namespace, result: bool) -> None:
+    """An export option that the chosen export would ignore is refused (exit 2)."""
+    what = "a tracker result's export (a MOT tracker file)" if result else f"--format {args.format}"
+    unused = ["--image-format"] if result and args.image_format is not None else []
+    if result or args.format != "mot":
+        unused += [o for o, v in (("--gt-mode", args.gt_mode),
+                                  ("--visibility-threshold", args.visibility_threshold))
+                   if v is not None]  # fmt: skip
+    if unused:
+        raise ConfigError(f"{unused[0]} does not apply to {what}; leave it out")
 
 
 def cmd_presets(args: argparse.Namespace) -> int:
@@ -330,7 +342,10 @@ def cmd_export(args: argparse.Namespace) -> int:
     from scenegen.io.mot import write_mot_tracker
 
     _refuse_replacing_input(Path(args.file), Path(args.output))
-    if _is_result_file(args.file, args.output):
+    result = _is_result_file(args.file, args.output)
+    if not result or args.format == "mot":
+        _refuse_unused_options(args, result)
+    if result:
         from scenegen.io import read_result
 
         if args.format != "mot":
@@ -353,8 +368,8 @@ def cmd_export(args: argparse.Namespace) -> int:
 
         if args.format == "mot":
             export_mot(
-                seq, args.output, gt_mode=args.gt_mode,
-                visibility_threshold=args.visibility_threshold,
+                seq, args.output, gt_mode=args.gt_mode or "amodal",
+                visibility_threshold=args.visibility_threshold or 0.0,
                 image_format=args.image_format or "png", progress=progress,
             )  # fmt: skip
         else:

@@ -272,3 +272,23 @@ def test_an_export_never_replaces_its_input(tmp_path, capsys, where):
     code, _, err = run(capsys, "export", src, "--format", "mot", "-o", out)
     assert code == 2 and "would replace" in err and f"the input {src}" in err
     assert src.read_bytes() == (FIXTURES / "full-occlusion.h5").read_bytes()
+
+
+def test_export_options_the_export_would_ignore_are_refused(tmp_path, capsys):
+    # They were ignored without a word (exit 0).
+    src = FIXTURES / "full-occlusion.h5"
+    res = tmp_path / "res.h5"
+    assert run(capsys, "track", src, "--tracker", "kalman", "-o", res)[0] == 0
+    for argv, msg in (
+        ([src, "--format", "otb", "--gt-mode", "visible"], "--gt-mode does not apply to "
+         "--format otb"),
+        ([src, "--format", "vot", "--visibility-threshold", "0.5"], "--visibility-threshold "
+         "does not apply to --format vot"),
+        ([res, "--format", "mot", "--image-format", "jpg"], "--image-format does not apply "
+         "to a tracker result's export"),
+        ([res, "--format", "mot", "--gt-mode", "amodal"], "--gt-mode does not apply to a "
+         "tracker result's export"),
+    ):  # fmt: skip
+        out = tmp_path / "out.txt"
+        code, _, err = run(capsys, "export", *argv, "-o", out)
+        assert code == 2 and msg in err and not out.exists(), err
