@@ -72,6 +72,9 @@ METRICS: dict[str, str] = {
 }
 """Leaderboard columns and their labels, in order (absent metrics are left out)."""
 
+CI_SEED = 0
+"""Seed of the leaderboard's bootstrap intervals (the same for every tracker and metric)."""
+
 MULTI_TARGET = ("mota", "idf1", "hota")
 """Metrics reported only on sequences with several targets."""
 
@@ -319,15 +322,24 @@ def leaderboard(rows: list[dict[str, Any]], trackers: list[str]) -> list[dict[st
     -------
     list of dict
         ``rank``, ``tracker``, ``sequences`` (those with a target at frame 0, the scored
-        ones) and one mean per metric (None if undefined).
+        ones), one mean per metric (None if undefined) and its 95 % percentile bootstrap
+        interval over the sequences, ``METRIC_ci`` = [low, high] (None with fewer than
+        two values).
     """
+    from scenegen.lab.experiments.stats import LEVEL, bootstrap_mean
+
     board = []
     for t in trackers:
         # Sequences with no target at frame 0 have no scores and are not counted.
         mine = [r for r in rows if r["tracker"] == t and r.get("targets", 1) > 0]
         entry: dict[str, Any] = {"tracker": t, "sequences": len(mine)}
         for m in METRICS:
-            entry[m] = _mean([r.get(m) for r in mine])
+            vals = [float(r[m]) for r in mine if r.get(m) is not None]
+            entry[m] = _mean(vals)
+            # Percentile bootstrap over sequences; one seed for every tracker and metric,
+            # so trackers on the same sequences are resampled alike.
+            entry[f"{m}_ci"] = (list(bootstrap_mean(vals, CI_SEED, level=LEVEL))
+                                if len(vals) >= 2 else None)  # fmt: skip
         board.append(entry)
     board.sort(key=lambda e: (-(e["auc"] if e["auc"] is not None else -1.0), e["tracker"]))
     for i, e in enumerate(board):
@@ -432,6 +444,19 @@ def _fmt(v: Any) -> str:
     return str(v)
 
 
+_CI_NOTE = ("Each cell: the mean over the scored sequences [its 95 % percentile bootstrap "
+            "interval over the sequences]; a ranking between overlapping intervals is not "
+            "settled.")
+
+
+def _cell(e: dict[str, Any], metric: str) -> str:
+    """A leaderboard cell: the mean and its 95 % interval, ``0.952 [0.901, 0.980]``."""
+    ci = e.get(f"{metric}_ci")
+    if e[metric] is None or ci is None:
+        return _fmt(e[metric])
+    return f"{_fmt(e[metric])} [{_fmt(ci[0])}, {_fmt(ci[1])}]"
+
+
 def _columns(board: list[dict[str, Any]]) -> list[str]:
     return [m for m in METRICS if any(e.get(m) is not None for e in board)]
 
@@ -441,10 +466,10 @@ def _markdown(board: list[dict[str, Any]]) -> str:
     lines = ["| rank | tracker | sequences | " + " | ".join(METRICS[c] for c in cols) + " |",
              "|---:|---|---:|" + "---:|" * len(cols)]  # fmt: skip
     for e in board:
-        cells = [_fmt(e[c]) for c in cols]
+        cells = [_cell(e, c) for c in cols]
         lines.append(f"| {e['rank']} | {e['tracker']} | {e['sequences']} | " + " | ".join(cells)
                      + " |")  # fmt: skip
-    return "\n".join(lines) + "\n"
+    return "\n".join(lines) + "\n\n" + _CI_NOTE + "\n"
 
 
 def _html(meta: dict[str, Any], board: list[dict[str, Any]], figures: list[tuple[str, str]],
@@ -454,7 +479,7 @@ def _html(meta: dict[str, Any], board: list[dict[str, Any]], figures: list[tuple
     head = "".join(f"<th>{e(METRICS[c])}</th>" for c in cols)
     body = ""
     for r in board:
-        cells = "".join(f"<td>{_fmt(r[c])}</td>" for c in cols)
+        cells = "".join(f"<td>{_cell(r, c)}</td>" for c in cols)
         body += f"<tr><td>{r['rank']}</td><td>{e(r['tracker'])}</td><td>{r['sequences']}</td>"
         body += cells + "</tr>\n"
     figs = "\n".join(
@@ -464,7 +489,7 @@ def _html(meta: dict[str, Any], board: list[dict[str, Any]], figures: list[tuple
     tp = "".join(f"<li>{e(t)}: {e(json.dumps(p, sort_keys=True))}</li>" for t, p in params.items())
     axes = ", ".join(e(a) for a in meta["axes"]) or "none"
     multi = [m for m in MULTI_TARGET if m in cols]
-    note = (
+    note = f"<p>{e(_CI_NOTE)}</p>" + (
         f"<p>{', '.join(METRICS[m] for m in multi)}: means over the sequences with several "
         "targets only.</p>" if multi else
         "<p>No multi-target metric: every sequence has one target (or none was computed).</p>"

@@ -141,6 +141,21 @@ MODULES: dict[str, Module] = {
          "depth_order_accuracy"),
         ("tests/scenegen/evaluation",),
     ),
+    # CLEAR MOT, identity and HOTA as TrackEval computes them, the frames they score and
+    # MOTChallenge's distractor preprocessing (check_threshold is argument checking).
+    # Every test file of tests/scenegen/evaluation reaches the module (metrics.clear_mot
+    # and idf1 call it, evaluate builds its reports from it); the fast ones run first.
+    "mot": Module(
+        "scenegen/evaluation/mot.py",
+        ("box_iou", "MotFrames.n_gt_dets", "MotFrames.n_tracker_dets", "_relabel",
+         "mot_frames", "_in_order", "remove_distractor_matches", "_clear_final", "clear",
+         "_identity_final", "identity", "_hota_final", "hota", "score_all"),
+        ("tests/scenegen/evaluation/test_mot.py",
+         "tests/scenegen/evaluation/test_metrics.py",
+         "tests/scenegen/evaluation/test_metrics_oracle.py",
+         "tests/scenegen/evaluation/test_trackeval_oracle.py",
+         "tests/scenegen/evaluation/test_evaluate.py"),
+    ),
     "stats": Module(
         "scenegen/lab/experiments/stats.py",
         ("norm_sf", "norm_ppf", "wilson", "newcombe_diff", "newcombe_paired_diff",

@@ -281,6 +281,9 @@ def _rng(seed: int | np.random.Generator) -> np.random.Generator:
     return seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
 
 
+_BLOCK = 1 << 22  # values drawn per block of bootstrap resamples
+
+
 def bootstrap_mean(values: ArrayLike, rng: int | np.random.Generator, *,
                    n_boot: int = N_BOOT, level: float = LEVEL) -> tuple[float, float]:
     """Percentile bootstrap interval of the mean of ``values`` (shape (n,), NaN dropped).
@@ -291,8 +294,14 @@ def bootstrap_mean(values: ArrayLike, rng: int | np.random.Generator, *,
     v = v[np.isfinite(v)]
     if v.size == 0:
         return (float("nan"), float("nan"))
-    idx = _rng(rng).integers(0, v.size, size=(n_boot, v.size))
-    means = v[idx].mean(axis=1)
+    # Drawn in blocks of rows (the same draws as one (n_boot, n) call, memory bounded
+    # for long value lists such as a benchmark's thousands of sequences).
+    gen = _rng(rng)
+    block = max(1, _BLOCK // v.size)
+    means = np.concatenate([
+        v[gen.integers(0, v.size, size=(min(block, n_boot - i), v.size))].mean(axis=1)
+        for i in range(0, n_boot, block)
+    ])  # fmt: skip
     a = (1.0 - level) / 2.0
     return (float(np.quantile(means, a)), float(np.quantile(means, 1.0 - a)))
 

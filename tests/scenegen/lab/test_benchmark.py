@@ -95,6 +95,21 @@ def test_leaderboard_means_skip_undefined():
     assert board[0]["mota"] is None and board[0]["rank"] == 1
 
 
+def test_leaderboard_intervals_cover_the_mean_as_a_bootstrap_should():
+    import numpy as np
+
+    vals = np.random.default_rng(3).normal(0.6, 0.1, 60)
+    rows = [{"tracker": "x", "auc": float(v)} for v in vals] + [{"tracker": "y", "auc": 0.4}]
+    x, y = leaderboard(rows, ["x", "y"])
+    lo, hi = x["auc_ci"]
+    assert lo < x["auc"] < hi and vals.min() < lo and hi < vals.max()
+    # The interval of a mean: about ± 1.96 sd / sqrt(n).
+    half = 1.96 * vals.std(ddof=1) / np.sqrt(vals.size)
+    assert (hi - lo) / 2 == pytest.approx(half, rel=0.15)
+    assert y["auc_ci"] is None and y["mota_ci"] is None  # one value, no metric
+    assert leaderboard(rows, ["x", "y"]) == [x, y]  # seeded
+
+
 @pytest.mark.slow  # the Dask path of the shared executor is in the fast dataset tests
 def test_same_results_on_a_dask_cluster(dataset, reference, tmp_path):
     distributed = pytest.importorskip("distributed")

@@ -330,3 +330,16 @@ def test_newcombe_paired_interval_and_the_correlation_of_the_outcomes():
     assert stats.newcombe_paired_diff(0, 1, 1, 0) == pytest.approx(with_phi(0, 1, 1, 0, -1.0))
     # one case is a case
     assert all(math.isfinite(x) for x in stats.newcombe_paired_diff(1, 0, 0, 0))
+
+
+@pytest.mark.parametrize("n", [1, 7, 500])
+def test_bootstrap_mean_in_blocks_draws_as_one_array(monkeypatch, n):
+    # Memory is bounded by drawing resamples in blocks; the interval is that of one
+    # (n_boot, n) draw, whatever the block.
+    v = np.random.default_rng(n).normal(size=n)
+    idx = np.random.default_rng(9).integers(0, n, size=(stats.N_BOOT, n))
+    means = v[idx].mean(axis=1)
+    want = (float(np.quantile(means, 0.025)), float(np.quantile(means, 0.975)))
+    for block in (1, 3 * n + 1, 1 << 22):
+        monkeypatch.setattr(stats, "_BLOCK", block)
+        assert stats.bootstrap_mean(v, 9) == want
