@@ -259,7 +259,10 @@ def quantize_hsv(
     V = max / 255, S = (max − min) / max, H in [0, 1) of the colour circle; a bin is
     floor(x · bins), with the top value in the last bin, computed exactly (integer floors) in
     one compiled pass (no 8-bit rounding of H and S as in ``cv2.cvtColor``). ``s_min`` is
-    applied with a resolution of 2**-20.
+    applied with a resolution of 2**-20, rounded down: S >= floor(s_min 2**20) / 2**20,
+    so a pixel whose S is exactly ``s_min`` (S = 1/10 with the default 0.1, which no
+    binary fraction represents) is coloured; no 8-bit S lies in the 2**-20 below a
+    threshold of a few decimals.
 
     Parameters
     ----------
@@ -287,7 +290,7 @@ def quantize_hsv(
     for name, val in (("s_min", s_min), ("v_min", v_min)):
         if not 0.0 <= val <= 1.0:
             raise ValueError(f"{name} must lie in [0, 1], got {val!r}")
-    s_thr = int(np.ceil(s_min * 2**20))
+    s_thr = int(np.floor(s_min * 2**20))
     v_thr = int(np.ceil(v_min * 255 - 1e-9))
     return _quantize_hsv(_check_frame(frame), np.int32(h_bins), np.int32(s_bins),
                          np.int32(v_bins), np.int32(s_thr), np.int32(v_thr))

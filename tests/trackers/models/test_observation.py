@@ -189,7 +189,12 @@ def _reference_hsv(frame, hb, sb, vb, s_min, v_min):
     hbin = np.minimum(h6 * hb // np.maximum(6 * d, 1), hb - 1)
     sbin = np.minimum(d * sb // np.maximum(mx, 1), sb - 1)
     vbin = np.minimum(mx * vb // 255, vb - 1)
-    coloured = (d > 0) & (d * 2**20 >= np.ceil(s_min * 2**20) * mx) & (mx >= v_min * 255 - 1e-9)
+    # The documented rule, in exact rationals: S >= floor(s_min 2**20) / 2**20.
+    from fractions import Fraction
+
+    s_thr = Fraction(int(np.floor(s_min * 2**20)), 2**20)
+    sat_ok = np.vectorize(lambda dd, m: Fraction(int(dd), max(int(m), 1)) >= s_thr)(d, mx)
+    coloured = (d > 0) & sat_ok & (mx >= v_min * 255 - 1e-9)
     return np.where(coloured, hbin * sb + sbin, hb * sb + vbin)
 
 
@@ -360,3 +365,15 @@ def test_prepared_distances_equal_region_distances_and_check_their_input():
     model = ColourModel("hsv")
     with pytest.raises(ValueError, match=r"references must have shape \(K, 220\)"):
         model.references = refs[:, :100]
+
+
+def test_a_saturation_of_exactly_s_min_is_coloured():
+    # S = 1/10 exactly (60, 54, 54) and (100, 90, 90) went to the value-only bins: the
+    # threshold was rounded up, past 1/10. 25/251 < 1/10 stays out; so with s_min 0.3.
+    from trackers.kernels.histogram import quantize_hsv
+
+    px = np.array([[[60, 54, 54], [100, 90, 90], [251, 226, 226], [61, 54, 54]]], np.uint8)
+    assert quantize_hsv(px).tolist() == [[1, 1, 100 + 9, 1]]  # value-only bin 9 of V 251
+    px3 = np.array([[[100, 70, 70], [250, 176, 176]]], np.uint8)  # S = 3/10, 74/250
+    q = quantize_hsv(px3, s_min=0.3).tolist()[0]
+    assert q[0] < 100 and q[1] >= 100
