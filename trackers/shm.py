@@ -357,7 +357,9 @@ min_visible, support, blur, p_stay, lam, mse_rate, mse_floor, evidence
         valid = np.isfinite(meas.mse)  # (L, M)
         q = self.order_prob[:, None] * valid
         mass = q.sum(axis=0)  # (M,)
-        seen = mass >= 0.5
+        # At least half the probability (1e-9 allows for the rounding of the sum: 12 of
+        # 24 equal probabilities add up to 0.49999999999999994).
+        seen = mass >= 0.5 - 1e-9
         q = q / np.where(mass > 0, mass, 1.0)
         y = np.nan_to_num(meas.centres - self._origin[None])  # (L, M, 2)
         r = measurement_cov(meas.mse, self.params.r_gain, self.params.r_floor)  # (L, M, 2, 2)

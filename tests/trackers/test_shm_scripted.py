@@ -117,6 +117,30 @@ def test_fast_shm_uses_an_object_measured_under_at_least_half_the_probability(
     np.testing.assert_allclose(kf.P[1], p, atol=1e-9)
 
 
+def test_fast_shm_uses_a_measurement_of_half_the_probability_whatever_its_rounding():
+    # Four objects, equal evidence for the 24 orderings, object 3 missed under the 12
+    # that put object 0 in front of it: measured under half the probability, so used.
+    # The sum of 12 probabilities of 1/24 is 0.49999999999999994: it was dropped.
+    from trackers.models.layered import orderings
+
+    boxes = np.array([[10.0, 10, 20, 20], [60.0, 10, 20, 20], [110.0, 10, 20, 20],
+                      [30.0, 60, 20, 20]])  # fmt: skip
+    c0 = boxes[:, :2] + boxes[:, 2:] / 2
+    order = orderings(4)
+    hidden = np.argsort(order, axis=1)[:, 0] < np.argsort(order, axis=1)[:, 3]
+    assert hidden.sum() == 12
+    centres = np.repeat((c0 + 6.0)[None], len(order), axis=0)
+    mse = np.full((len(order), 4), 20.0)
+    centres[hidden, 3], mse[hidden, 3] = np.nan, np.nan
+    counts = np.where(np.isnan(mse), 0, 300).astype(np.int64)
+    tracker = trackers.make("shm-fast")
+    tracker.init(np.zeros((H, W, 3), np.uint8), boxes)
+    tracker.matcher = Script([LayeredMeasurement(centres, mse, counts, 4)])
+    est = tracker.step(np.zeros((H, W, 3), np.uint8))
+    shift = est.boxes[:, :2] + boxes[:, 2:] / 2 - c0
+    assert np.allclose(shift[3], shift[0]) and shift[0, 0] > 5  # object 3 moved as the others
+
+
 def test_shm_collapses_each_ordering_s_predictions_by_moment_matching():
     # Frame 1: object 0 measured at +4 / -4 px under the two orderings, so the two
     # Gaussians part. Frame 2: nothing measured (both objects hidden under both
