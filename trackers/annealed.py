@@ -363,7 +363,7 @@ def _layer_sigmas(sigma: float | Sequence[float], decay: float,
     if np.ndim(sigma) != 0:
         if sigmas.shape != (n_layers,):
             raise ValueError(f"sigma must be a number or {n_layers} numbers (one per layer), "
-                             f"got {list(np.ravel(sigma))}")
+                             f"got {np.ravel(sigma).tolist()}")
     if not np.all(np.isfinite(sigmas) & (sigmas >= 0.0)):
         raise ValueError(f"sigma must be finite and >= 0, got {sigma!r}")
     return sigmas
