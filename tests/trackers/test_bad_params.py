@@ -18,7 +18,7 @@ import trackers
         ("meanshift", {"eps": "abc"}, "eps must be a finite number >= 0"),
         ("meanshift", {"kernel": [1]}, "unknown kernel [1]"),  # was "unhashable type"
         ("annealed", {"sigma": "abc"}, "sigma must be a number or"),
-        ("annealed", {"sigma": np.array([30, 15])}, "(one per layer), got [30, 15]"),  # np.int64(30)
+        ("annealed", {"sigma": np.array([30, 15])}, "(one per layer), got [30, 15]"),  # np.int64
         ("kams", {"n_layers": 10**8}, "n_layers must be an integer in [1, 1000]"),  # 23 s, 1.6 GB
         ("condensation", {"n_parts": 10**12}, "n_parts must be an integer in [1, 1000000]"),
         ("condensation", {"rng": -1}, "rng must be a numpy Generator, a non-negative int"),
