@@ -432,7 +432,14 @@ def _check_labels(
         same = np.all((expect == got) | (np.isnan(expect) & np.isnan(got)), axis=1)
         if not same.all():
             box_bad.append(t)
-        if np.any(seen & ~present[t]) or np.any((vis[t] > 0) != seen):
+        # visibility = visible / amodal pixels, and the amodal pixels fit in the box.
+        box = gt.get("box")
+        area = (box[t, :, 2].astype(np.float64) * box[t, :, 3] if box is not None
+                else np.full(ids.size, np.inf))  # fmt: skip
+        with np.errstate(invalid="ignore", divide="ignore"):
+            low = counts[ids] / area
+        if (np.any(seen & ~present[t]) or np.any((vis[t] > 0) != seen)
+                or np.any(seen & (vis[t] < low - 1e-6))):  # fmt: skip
             vis_bad.append(t)
     out = []
     if unreadable:

@@ -203,6 +203,20 @@ def test_visible_box_outside_the_box_and_centre_off_the_box(copy):
     assert f"{p}: {SEQ}: gt/center is not the centre of gt/box at frames 4" in problems
 
 
+def test_visibility_below_what_the_labels_show(copy):
+    # Visible pixels / box area bounds the visibility from below (amodal pixels fit in the
+    # box): a twentieth where the labels show most of the object was accepted.
+    def damage(g, f):
+        vis = g["gt/visibility"][()]
+        assert vis[5, 0] > 0.5
+        vis[5, 0] = 0.05
+        g["gt/visibility"][...] = vis
+
+    p = edit(copy(), damage)
+    assert check_file(p) == [
+        f"{p}: {SEQ}: gt/visibility or gt/present disagree with labels at frames 5"]
+
+
 def test_visibility_disagrees_with_labels(copy):
     def damage(g, f):
         vis = g["gt/visibility"][()]
