@@ -667,3 +667,112 @@ EQUIVALENT["hybrid"] = [  # noqa: F821
      "the noise is a zero-mean normal draw: its negative has the same law (another "
      "sample of the same filter, as another seed would give)"),
 ]
+
+# CLEAR MOT, identity and HOTA as TrackEval computes them (every mutant). A MotFrames
+# holds ids 0..n-1 that each appear in some frame (mot_frames relabels the columns
+# present; the class documents n_gt_ids / n_tracker_ids as the distinct ids), so every
+# id's frame count is >= 1, and past the early returns both sides have detections.
+_ANNOTATION = "an annotation: never evaluated (from __future__ import annotations)"
+_EVERY_ID = ("every id of a MotFrames appears in some frame: its count is >= 1, so the "
+             "mask keeps every id and the guard never reaches 0")
+_EMPTY_LSA = ("the shortcut only skips an empty assignment: linear_sum_assignment of an "
+              "(n, 0) or (0, m) matrix matches nothing, and the counts come out the same")
+_SHORTCUT = ("an early return that is a shortcut: with no detections on that side the "
+             "loops give the same scores (TrackEval's values) field for field")
+_BONUS = ("any continuity bonus above 2 gives the same matchings: forcing an object's "
+          "previous track (IoU >= threshold) into a matching removes at most two other "
+          "pairs of IoU <= 1 and no other continuing pair (the previous tracks are one to "
+          "one), so every best matching holds all continuing pairs for 999, 1000 or 1001")
+_FORBIDDEN = ("the 1e10 cost only forbids an assignment; a full assignment avoiding it "
+              "always exists at a cost of at most the detection count, far below 1e10 +- 1")
+EQUIVALENT["mot"] = [  # noqa: F821
+    *[(f"b{i} = np.array({x}, dtype=np.float64).reshape(-1, 4)",
+       f"b{i} = np.array({x}, dtype=np.float64).reshape(- 2, 4)",
+       "numpy reads any negative size in reshape as the one unknown dimension")
+      for i, x in ((1, "a"), (2, "b"))],
+    ("inter[union <= _EPS] = 0", "inter[union < _EPS] = 0",
+     "a union <= eps needs both areas <= eps (else it exceeds the larger area): the area "
+     "guards have already zeroed that intersection"),
+    ("union[union <= _EPS] = 1", "union[union < _EPS] = 1",
+     "a union of exactly eps has both areas <= eps, so its intersection is already 0: "
+     "0 / eps and 0 / 1 are both 0"),
+    ("union[union <= _EPS] = 1", "union[union <= _EPS] = 2",
+     "the replaced unions only divide intersections already set to 0: 0 / 2 is 0 / 1"),
+    ("label = np.full(present.shape[1], -1, dtype=np.intp)",
+     "label = np.full(present.shape[1], - 2, dtype=np.intp)",
+     "the labels of columns never present are never read but by the max, taken with "
+     "initial=-1: any negative fill gives the same count"),
+    *[(f"{arg}: ArrayLike | None = None,", f"{arg}: ArrayLike & None = None,", _ANNOTATION)
+      for arg in ("gt_keep", "est_keep", "est_rank")],
+    ("def _in_order(present: NDArray[np.bool_], rank: ArrayLike | None, t: int) -> NDArray[np.intp]:",
+     "def _in_order(present: NDArray[np.bool_], rank: ArrayLike & None, t: int) -> NDArray[np.intp]:",
+     _ANNOTATION),
+    ("gt: ArrayLike, distractor: ArrayLike, est: ArrayLike, est_rank: ArrayLike | None = None",
+     "gt: ArrayLike, distractor: ArrayLike, est: ArrayLike, est_rank: ArrayLike & None = None",
+     _ANNOTATION),
+    *[("if gi.size == 0 or ej.size == 0:", f"if {m}:", _EMPTY_LSA)
+      for m in ("gi.size == -1 or ej.size == 0", "gi.size == 0 and ej.size == 0",
+                "gi.size == 0 or ej.size == -1")],
+    ("ok = score[rows, cols] > _EPS", "ok = score[rows, cols] >= _EPS",
+     "(remove_distractor_matches) a score is 0 or >= 0.5 - eps, never eps: the test "
+     "decides the same (CLEAR's copy of the line is not equivalent: its scores can be eps)"),
+    ("n = max(1.0, tp + fn)", "n = max( 0.0, tp + fn)",
+     "tp + fn is the number of ground-truth detections, >= 1 past clear's early returns"),
+    ("if data.n_tracker_dets == 0:", "if data.n_tracker_dets == -1:", _SHORTCUT),
+    ("score = 1000.0 * (trk_ids[None, :] == prev_step_id[gt_ids[:, None]]) + sim",
+     "score = 1001.0 * (trk_ids[None, :] == prev_step_id[gt_ids[:, None]]) + sim", _BONUS),
+    ("score = 1000.0 * (trk_ids[None, :] == prev_step_id[gt_ids[:, None]]) + sim",
+     "score = 999.0 * (trk_ids[None, :] == prev_step_id[gt_ids[:, None]]) + sim", _BONUS),
+    *[("ratio = matched_count[id_count > 0] / id_count[id_count > 0]",
+       f"ratio = {m}", _EVERY_ID)
+      for m in ("matched_count[id_count > -1] / id_count[id_count > 0]",
+                "matched_count[id_count >= 0] / id_count[id_count > 0]",
+                "matched_count[id_count > 0] / id_count[id_count > -1]",
+                "matched_count[id_count > 0] / id_count[id_count >= 0]")],
+    ("frag = int(np.sum(frag_count[frag_count > 0] - 1))",
+     "frag = int(np.sum(frag_count[frag_count > 1] - 1))",
+     "an object whose track started once adds 1 - 1 = 0 either way"),
+    ("idf1=idtp / max(1.0, idtp + 0.5 * idfp + 0.5 * idfn),",
+     "idf1=idtp / max( 0.0, idtp + 0.5 * idfp + 0.5 * idfn),",
+     "idtp + (idfp + idfn) / 2 is half of all detections, >= 1 past identity's early "
+     "returns (both sides have some)"),
+    ("idp=idtp / max(1.0, idtp + idfp),", "idp=idtp / max( 0.0, idtp + idfp),",
+     "idtp + idfp is the number of tracker detections, >= 1 past the early returns"),
+    ("idr=idtp / max(1.0, idtp + idfn),", "idr=idtp / max( 0.0, idtp + idfn),",
+     "idtp + idfn is the number of ground-truth detections, >= 1 past the early returns"),
+    ("if data.n_tracker_dets == 0:", "if data.n_tracker_dets == -1:", _SHORTCUT),
+    ("if data.n_gt_dets == 0:", "if data.n_gt_dets == -1:", _SHORTCUT),
+    *[(f"{m} = 1e10", f"{m} = {v}", _FORBIDDEN)
+      for m in ("fp_mat[ng:, :nt]", "fn_mat[:ng, nt:]")
+      for v in ("10000000001.0", "9999999999.0")],
+    ("detre = tp / np.maximum(1, tp + fn)", "detre = tp / np.maximum( 0, tp + fn)",
+     "tp + fn is the number of ground-truth detections at every alpha, >= 1 past hota's "
+     "early return"),
+    ("detpr = tp / np.maximum(1, tp + fp)", "detpr = tp / np.maximum( 0, tp + fp)",
+     "tp + fp is the number of tracker detections at every alpha, >= 1 past hota's early "
+     "return"),
+    ("deta = tp / np.maximum(1, tp + fn + fp)", "deta = tp / np.maximum( 0, tp + fn + fp)",
+     "tp + fn + fp >= the number of ground-truth detections, >= 1 past hota's early return"),
+    *[("if data.n_tracker_dets == 0 or data.n_gt_dets == 0:", f"if {m}:", _SHORTCUT)
+      for m in ("data.n_tracker_dets == -1 or data.n_gt_dets == 0",
+                "data.n_tracker_dets == 0 and data.n_gt_dets == 0",
+                "data.n_tracker_dets == 0 or data.n_gt_dets == -1")],
+    ("for gt_ids, trk_ids, sim in zip(data.gt_ids, data.tracker_ids, data.similarity, strict=True):",
+     "for gt_ids, trk_ids, sim in zip(data.gt_ids, data.tracker_ids, data.similarity, strict=False):",
+     "(hota only; clear's and identity's are killed) hota zips the same three tuples in "
+     "two loops: the one left strict still raises on unequal lengths"),
+    ("trk_count[0, trk_ids] += 1", "trk_count[ -1, trk_ids] += 1",
+     "trk_count has one row: [-1] is [0]"),
+    ("if len(gt_ids) == 0:", "if len(gt_ids) == -1:", "(hota) " + _EMPTY_LSA),
+    ("if len(trk_ids) == 0:", "if len(trk_ids) == -1:", "(hota) " + _EMPTY_LSA),
+    ("ass_a = mc / np.maximum(1, gt_count + trk_count - mc)",
+     "ass_a = mc / np.maximum( 0, gt_count + trk_count - mc)",
+     "mc <= min(gt_count, trk_count), so the denominator is >= max(gt_count, trk_count) "
+     ">= 1 (" + _EVERY_ID + ")"),
+    ("assre[a] = np.sum(mc * (mc / np.maximum(1, gt_count))) / np.maximum(1, tp[a])",
+     "assre[a] = np.sum(mc * (mc / np.maximum( 0, gt_count))) / np.maximum(1, tp[a])",
+     _EVERY_ID),
+    ("asspr[a] = np.sum(mc * (mc / np.maximum(1, trk_count))) / np.maximum(1, tp[a])",
+     "asspr[a] = np.sum(mc * (mc / np.maximum( 0, trk_count))) / np.maximum(1, tp[a])",
+     _EVERY_ID),
+]

@@ -151,6 +151,7 @@ MODULES: dict[str, Module] = {
          "mot_frames", "_in_order", "remove_distractor_matches", "_clear_final", "clear",
          "_identity_final", "identity", "_hota_final", "hota", "score_all"),
         ("tests/scenegen/evaluation/test_mot.py",
+         "tests/scenegen/evaluation/test_mot_mutants.py",
          "tests/scenegen/evaluation/test_metrics.py",
          "tests/scenegen/evaluation/test_metrics_oracle.py",
          "tests/scenegen/evaluation/test_trackeval_oracle.py",
