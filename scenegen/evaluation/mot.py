@@ -147,10 +147,7 @@ def mot_frames(
         ``est_rank`` (TrackEval keeps the row order of its files, which breaks ties in
         its matchings; scenegen's exports list boxes in column order).
     """
-    g = np.asarray(gt, dtype=np.float64)
-    e = np.asarray(est, dtype=np.float64)
-    if g.ndim != 3 or e.ndim != 3 or g.shape[0] != e.shape[0] or g.shape[2:] != (4,):
-        raise ValueError(f"gt (T, K, 4) and est (T, H, 4) disagree: {g.shape}, {e.shape}")
+    g, e = _frames_of_boxes(gt, est)
     gp = np.all(np.isfinite(g), axis=-1)
     ep = np.all(np.isfinite(e), axis=-1)
     if gt_keep is not None:
@@ -181,6 +178,24 @@ def _in_order(present: NDArray[np.bool_], rank: ArrayLike | None, t: int) -> NDA
     return cols[np.argsort(np.asarray(rank)[t, cols], kind="stable")]
 
 
+def _frames_of_boxes(
+    gt: ArrayLike, est: ArrayLike
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Ground truth (T, K, 4) and tracker boxes (T, H, 4) as float arrays of the same T.
+
+    Raises
+    ------
+    ValueError
+        If either is not of shape (T, ·, 4) or their frame counts differ.
+    """
+    g = np.asarray(gt, dtype=np.float64)
+    e = np.asarray(est, dtype=np.float64)
+    if (g.ndim != 3 or e.ndim != 3 or g.shape[0] != e.shape[0]
+            or g.shape[2:] != (4,) or e.shape[2:] != (4,)):
+        raise ValueError(f"gt (T, K, 4) and est (T, H, 4) disagree: {g.shape}, {e.shape}")
+    return g, e
+
+
 def remove_distractor_matches(
     gt: ArrayLike, distractor: ArrayLike, est: ArrayLike, est_rank: ArrayLike | None = None
 ) -> NDArray[np.bool_]:
@@ -207,8 +222,7 @@ def remove_distractor_matches(
     ndarray of bool, shape (T, H)
         True for the tracker boxes to keep (and for absent ones).
     """
-    g = np.asarray(gt, dtype=np.float64)
-    e = np.asarray(est, dtype=np.float64)
+    g, e = _frames_of_boxes(gt, est)
     dis = np.broadcast_to(np.asarray(distractor, dtype=bool), g.shape[:2])
     keep = np.ones(e.shape[:2], dtype=bool)
     gp = np.all(np.isfinite(g), axis=-1)

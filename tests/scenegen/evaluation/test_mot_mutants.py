@@ -421,9 +421,12 @@ def test_mot_frames_without_tracks_or_objects():
 def test_mot_frames_rejects_arrays_that_disagree():
     ok = np.zeros((2, 1, 4))
     for gt, est in ((np.zeros((2, 4)), ok), (ok, np.zeros((2, 4))), (ok, np.zeros((3, 1, 4))),
-                    (np.zeros((2, 1, 5)), ok), (np.zeros((2, 1, 4, 1)), ok)):
+                    (np.zeros((2, 1, 5)), ok), (ok, np.zeros((2, 1, 5))),
+                    (np.zeros((2, 1, 4, 1)), ok)):
         with pytest.raises(ValueError, match="disagree"):
             mot_frames(gt, est)
+        with pytest.raises(ValueError, match="disagree"):
+            remove_distractor_matches(gt, np.zeros(1, dtype=bool), est)
     d = mot_frames(ok, np.zeros((2, 3, 4)))  # boxes of zero area are detections (IoU 0)
     assert (d.n_tracker_ids, d.n_tracker_dets) == (3, 6) and not np.any(d.similarity)
 
