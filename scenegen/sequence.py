@@ -53,29 +53,29 @@ class Entities:
 
 @dataclass
 class GroundTruth:
-    """Per-frame ground truth: the ``gt/*`` datasets of the file layout (``docs/format.md``,
-    :mod:`scenegen.io.schema`). Boxes are [x, y, w, h] with x = column, in pixels.
+    """Per-frame ground truth: the ``gt/*`` datasets of the file layout.
+
+    Each attribute is the dataset ``gt/<attribute>``; what its values mean is defined once,
+    in :data:`scenegen.io.schema.SEQUENCE_FIELDS` (rendered in ``docs/format.md``). Boxes
+    are [x, y, w, h] with x = column, in pixels; NaN (or 0, False) where absent.
 
     Attributes
     ----------
     box : ndarray of shape (T, K, 4), float32
-        Amodal box [x, y, w, h] of the whole entity as drawn; NaN where absent.
+        Amodal box (``gt/box``).
     visible_box : ndarray of shape (T, K, 4), float32
-        Box of the entity's pixels in ``labels``; NaN where none is visible.
+        Box of the entity's pixels in ``labels`` (``gt/visible_box``).
     center : ndarray of shape (T, K, 2), float32
-        Amodal centre (x, y); NaN where absent.
+        Amodal centre (``gt/center``).
     visibility : ndarray of shape (T, K), float32
-        Visible pixels / amodal pixels (pixels outside the frame count as not visible);
-        0 where absent.
+        Visible fraction (``gt/visibility``).
     present : ndarray of shape (T, K), bool
-        The entity exists at that frame and one pixel of its shape (its amodal mask, not
-        merely its box's rectangle) is inside the frame.
+        Present at that frame (``gt/present``).
     depth : ndarray of shape (T, K), int16
-        Depth rank, 0 = nearest the camera.
+        Depth rank, 0 = nearest the camera (``gt/depth``).
     path_center : ndarray of shape (T, K, 2), float32
-        Centre (x, y) of the noise-free motion path (before the per-frame position noise,
-        not rounded to pixels); NaN where absent. NaN everywhere when read from a file
-        written before this field existed.
+        Centre of the noise-free motion path (``gt/path_center``); NaN everywhere when
+        read from a file written before this field existed.
     """
 
     box: NDArray[np.float32]

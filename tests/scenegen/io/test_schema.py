@@ -138,3 +138,23 @@ def test_streamed_writer_uses_the_schema_too(tmp_path):
     back = read(tmp_path / "s.h5")
     whole = scenegen.generate(d.config, seed=d.seed)
     np.testing.assert_array_equal(back.gt.path_center, whole.gt.path_center)
+
+
+def test_ground_truth_docstring_lists_the_layout_s_gt_fields():
+    """GroundTruth documents exactly the schema's gt/* datasets, with their dtype and shape."""
+    import re
+
+    from scenegen.sequence import GroundTruth
+
+    doc = GroundTruth.__doc__ or ""
+    lines = re.findall(r"^    (\w+) : ndarray of shape (\([^)]*\)), (\w+)$", doc, re.M)
+    listed = {name for name, _, _ in lines}
+    want = {}
+    for f in SEQUENCE_FIELDS:
+        if f.path.startswith("gt/"):
+            shape = "(" + ", ".join(str(d) for d in f.shape) + ")"
+            want[f.path[3:]] = shape
+            assert f"``{f.path}``" in doc
+    assert listed == set(want)
+    for name, shape, dtype in lines:
+        assert shape == want[name] and dtype == field(f"gt/{name}").dtype
