@@ -74,11 +74,13 @@ def check_writable(path: str | Path) -> None:
 
 
 def cmd_track(args: argparse.Namespace) -> int:
+    from scenegen.cli.data import _refuse_replacing_input
     from scenegen.io import read, write_result
     from scenegen.io.validate import require_valid
     from scenegen.lab.run import run_tracker, tracker_label
 
     params = parse_params(args.param)
+    _refuse_replacing_input(Path(args.file), Path(args.output))  # the result would replace it
     require_valid(args.file)  # no computing on a damaged or inconsistent file
     check_writable(args.output)
     with picked_by("--sequence"):

@@ -41,26 +41,47 @@ def annotate(
         if (role == "clutter" and not clutter) or not gt.present[t, k]:
             continue
         color = _ROLE_COLORS.get(role, (255, 255, 0))
-        x, y, w, h = gt.box[t, k]
-        cv2.rectangle(img, (int(x), int(y)), (int(x + w) - 1, int(y + h) - 1), color, 1)
+        box = gt.box[t, k]
+        p0, p1 = _corners(box, img.shape)
+        cv2.rectangle(img, p0, p1, color, 1)
         vb = gt.visible_box[t, k]
         if np.all(np.isfinite(vb)):
-            vx, vy, vw, vh = vb
-            cv2.rectangle(img, (int(vx), int(vy)), (int(vx + vw) - 1, int(vy + vh) - 1), color, 2)
+            cv2.rectangle(img, *_corners(vb, img.shape), color, 2)
         label = f"{int(seq.entities.id[k])}:{int(gt.depth[t, k])}"
-        cv2.putText(img, label, (int(x), max(int(y) - 3, 8)), cv2.FONT_HERSHEY_SIMPLEX, 0.35,
+        lx, ly = (int(np.clip(v, -_LABEL_REACH, _LABEL_REACH)) for v in box[:2])
+        cv2.putText(img, label, (lx, max(ly - 3, 8)), cv2.FONT_HERSHEY_SIMPLEX, 0.35,
                     color, 1, cv2.LINE_AA)  # fmt: skip
     if boxes is not None:
-        for x, y, w, h in np.asarray(boxes, dtype=np.float64):
-            if not np.all(np.isfinite([x, y, w, h])):
+        for box in np.asarray(boxes, dtype=np.float64):
+            if not np.all(np.isfinite(box)):
                 continue
-            p0, p1 = (int(x), int(y)), (int(x + w) - 1, int(y + h) - 1)
+            p0, p1 = _corners(box, img.shape)
             cv2.rectangle(img, p0, p1, (0, 0, 0), 3)
             cv2.rectangle(img, p0, p1, (255, 255, 255), 1)
     cv2.putText(img, f"t={t}", (4, 12), cv2.FONT_HERSHEY_SIMPLEX, 0.4, (0, 0, 0), 3, cv2.LINE_AA)
     cv2.putText(img, f"t={t}", (4, 12), cv2.FONT_HERSHEY_SIMPLEX, 0.4, (255, 255, 0), 1,
                 cv2.LINE_AA)  # fmt: skip
     return img
+
+
+#: Pixels a corner may lie outside the image after clipping: more than half the thickest
+#: line, so that an edge off the image stays off it.
+_CLIP_MARGIN = 8
+#: Where a label's origin is clipped to, pixels: far beyond any image a label could reach.
+_LABEL_REACH = 1 << 20
+
+
+def _corners(box: NDArray[Any], shape: tuple[int, ...]) -> tuple[tuple[int, int], tuple[int, int]]:
+    """The corners ``(x0, y0), (x1, y1)`` (inclusive) of a finite ``box`` [x, y, w, h] for
+    ``cv2.rectangle``, clipped to ``_CLIP_MARGIN`` pixels around an image of ``shape``:
+    OpenCV takes C ``int`` points, so a box far off the image (1e30) is drawn as the same
+    clipped rectangle rather than failing."""
+    x, y, w, h = (float(v) for v in box)
+    with np.errstate(over="ignore"):  # x + w may overflow to inf, clipped all the same
+        corners = np.trunc([[x, y], [x + w, y + h]]) - [[0, 0], [1, 1]]
+    hi = [shape[1] + _CLIP_MARGIN, shape[0] + _CLIP_MARGIN]
+    c = np.clip(corners, -_CLIP_MARGIN, hi).astype(int)
+    return (int(c[0, 0]), int(c[0, 1])), (int(c[1, 0]), int(c[1, 1]))
 
 
 def contact_sheet(

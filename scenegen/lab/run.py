@@ -88,9 +88,9 @@ def resolve_factory(spec: str) -> Callable[..., Any]:
             if "" not in sys.path and str(Path.cwd()) not in sys.path:
                 sys.path.insert(0, str(Path.cwd()))
             module = importlib.import_module(module_name)
-    except ConfigError:
+    except (ConfigError, KeyboardInterrupt, GeneratorExit):
         raise
-    except Exception as err:  # a user's module may raise anything on import
+    except BaseException as err:  # a user's module may raise anything on import, even exit
         text = str(err).strip().splitlines()
         raise ConfigError(
             f"tracker {spec!r}: cannot import {module_name}: {type(err).__name__}: "
@@ -169,7 +169,9 @@ def make_tracker(tracker: TrackerSpec, params: dict[str, Any], seed: int) -> Any
         obj = factory(**kwargs)
     except (TypeError, ValueError) as err:
         raise ConfigError(f"tracker {label!r}: {err}") from None
-    except Exception as err:  # the user's factory failed for its own reasons
+    except (KeyboardInterrupt, GeneratorExit):
+        raise
+    except BaseException as err:  # the user's factory failed for its own reasons (or exited)
         raise TrackerError(
             f"tracker {label!r} failed while being built: {type(err).__name__}: "
             f"{_first_line(err)} (rerun with --debug for its traceback)"
@@ -249,7 +251,9 @@ def run(
         if ours:
             raise ConfigError(str(err)) from None  # ours rejects its parameters or the scene
         raise _failed(name, seq, done[0], err) from err
-    except Exception as err:
+    except (KeyboardInterrupt, GeneratorExit):
+        raise
+    except BaseException as err:  # a user's SystemExit too: its failure, not a clean exit
         if ours:
             raise  # ours: a bug to report, with its traceback
         raise _failed(name, seq, done[0], err) from err
@@ -281,7 +285,8 @@ def _result(
     Raises
     ------
     TrackerError
-        If a tracker's ``orderings`` or ``order_prob`` are not what a result file holds.
+        If a tracker's boxes (beyond the float32 range), ``orderings`` or ``order_prob``
+        are not what a result file holds.
     """
     targets = seq.initial_targets(0)
     label = tracker_label(name)
@@ -303,19 +308,42 @@ def _result(
             f"tracker {label!r}: orderings and order_prob must be numeric arrays: "
             f"{_first_line(err)}"
         ) from None
+    target_ids = seq.entities.id[targets]
     result = TrackerResult(
         tracker=label,
         params=params,
         seed=seed,
         sequence=seq.name,
-        target_ids=seq.entities.id[targets],
-        boxes=out.boxes.astype(np.float32),
+        target_ids=target_ids,
+        boxes=_float32_boxes(label, out.boxes, target_ids),
         orderings=orderings,
         order_prob=order_prob,
     )
     if bad := result.problems():
         raise TrackerError(f"tracker {label!r}: its depth-order output cannot be stored: {bad[0]}")
     return result
+
+
+def _float32_boxes(label: str, boxes: NDArray[Any], target_ids: NDArray[Any]) -> NDArray[Any]:
+    """``boxes`` (T, M, 4) as the float32 a result file holds.
+
+    Raises
+    ------
+    TrackerError
+        Naming the frame, the target and the box, if a finite value is beyond the float32
+        range (it would become inf).
+    """
+    with np.errstate(over="ignore"):
+        out = np.asarray(boxes).astype(np.float32)
+    over = np.isfinite(boxes) & ~np.isfinite(out)
+    if over.any():
+        t, m, _ = (int(i[0]) for i in np.nonzero(over))
+        raise TrackerError(
+            f"tracker {label!r}: its box at frame {t} for target {target_ids[m].item()} is "
+            f"{np.asarray(boxes)[t, m].tolist()}, out of the range a result file holds "
+            f"(|value| <= {float(np.finfo(np.float32).max):.4g}, float32)"
+        )
+    return out
 
 
 def run_tracker(

@@ -11,6 +11,8 @@ The runner uses only ``init`` and ``step`` (the library never imports ``trackers
 from __future__ import annotations
 
 import inspect
+import numbers
+import operator
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import cache, partial
@@ -75,8 +77,13 @@ class Options:
     def __post_init__(self) -> None:
         if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)):
             raise ValueError(f"seed must be an integer, got {self.seed!r}")
-        if isinstance(self.repeats, bool) or not isinstance(self.repeats, int) or self.repeats < 1:
+        if (
+            isinstance(self.repeats, (bool, np.bool_))
+            or not isinstance(self.repeats, numbers.Integral)
+            or self.repeats < 1
+        ):
             raise ValueError(f"repeats must be an integer >= 1, got {self.repeats!r}")
+        object.__setattr__(self, "repeats", operator.index(self.repeats))  # a numpy int too
         for name in ("deterministic", "handles_occlusion"):
             value = getattr(self, name)
             if value is not None and not isinstance(value, (bool, np.bool_)):
@@ -164,13 +171,17 @@ def _run(tracker: Any, frames: NDArray[np.uint8], init: NDArray[np.float64]) -> 
     run = _Run()
     try:
         tracker.init(frames[0], init.copy())
-    except Exception as err:
+    except (KeyboardInterrupt, GeneratorExit):
+        raise
+    except BaseException as err:  # a SystemExit too: the tracker failing, not a pass
         run.error = f"init raised {type(err).__name__}: {first_line(err)}"
         return run
     for t in range(1, len(frames)):
         try:
             est = tracker.step(frames[t])
-        except Exception as err:
+        except (KeyboardInterrupt, GeneratorExit):
+            raise
+        except BaseException as err:
             run.error = f"step at frame {t} raised {type(err).__name__}: {first_line(err)}"
             return run
         boxes = getattr(est, "boxes", None)
@@ -374,7 +385,9 @@ def check_protocol(factory: Callable[..., Any], opts: Options) -> str:
     """The object has callable ``init`` and ``step``."""
     try:
         tracker = _build(factory, opts.seed)
-    except Exception as err:
+    except (KeyboardInterrupt, GeneratorExit):
+        raise
+    except BaseException as err:
         raise AssertionError(
             f"the factory raised {type(err).__name__}: {first_line(err)}"
         ) from None

@@ -137,7 +137,9 @@ def _run_check(name: str, factory: Callable[..., Any], opts: Options) -> CheckRe
         return CheckResult(name, "skipped", str(why))
     except AssertionError as err:
         return CheckResult(name, "failed", str(err))
-    except Exception as err:  # the tracker's own errors are failures of the check
+    except (KeyboardInterrupt, GeneratorExit):
+        raise
+    except BaseException as err:  # the tracker's own errors (a SystemExit too) fail the check
         return CheckResult(name, "failed", f"{type(err).__name__}: {first_line(err)}")
 
 

@@ -74,6 +74,49 @@ def test_an_opencv_tracker_that_cannot_start_is_one_line(monkeypatch):
     assert "\n" not in str(info.value)
 
 
+def test_an_opencv_failure_at_init_names_the_params_given(monkeypatch):
+    # MIL with samplerInitMaxNegNum=1 failed at init naming no parameter, and the cv2 path
+    # pushed the reason past the 200 characters a tracker's failure line keeps.
+    import cv2
+
+    from trackers.adapters import opencv
+
+    class Refuses:
+        def init(self, frame, box):
+            raise cv2.error("OpenCV(5.0.0) /io/opencv/modules/video/src/tracking/tracker_mil"
+                            ".cpp:81: error: (-215:Assertion failed) !negSamples.empty() in "
+                            "function 'init'\n")  # fmt: skip
+
+    t = opencv("MIL", rng=0, samplerInitMaxNegNum=1)
+    monkeypatch.setattr(t, "_make", lambda: Refuses())
+    with pytest.raises(ValueError) as info:
+        t.init(np.zeros((60, 80, 3), np.uint8), [[30, 20, 20, 20]])
+    assert str(info.value) == (
+        "cv2.TrackerMIL with params samplerInitMaxNegNum=1 could not start on box "
+        "(30, 20, 20, 20): (-215:Assertion failed) !negSamples.empty() in function 'init'"
+    )
+
+
+def test_an_opencv_failure_at_construction_names_the_params_given(monkeypatch):
+    import importlib
+
+    import cv2
+
+    module = importlib.import_module("trackers.adapters.opencv")
+
+    class Refuses:
+        @staticmethod
+        def create(params=None):
+            raise cv2.error("OpenCV(5.0.0) x.cpp:1: error: (-2:Unspecified error) no model")
+
+    monkeypatch.setattr(module, "_lookup", lambda name: (Refuses, cv2.TrackerMIL_Params))
+    with pytest.raises(ValueError) as info:
+        module.opencv("MIL", samplerSearchWinSize=30.0)
+    assert str(info.value) == (
+        "cv2.TrackerMIL with params samplerSearchWinSize=30.0: (-2:Unspecified error) no model"
+    )
+
+
 @pytest.mark.parametrize("dtype", [np.uint16, np.float32, bool])
 def test_frames_that_are_not_uint8_are_refused_not_converted(dtype):
     # A 16-bit frame was clipped to 0/255, a float one rescaled by its own maximum.

@@ -16,6 +16,9 @@ OpenCV boxes are integers: an initial box is rounded outward to whole pixels and
 to the frame, and grown about its centre to at least :data:`MIN_SIDE` pixels a side
 (``cv2.TrackerMIL`` never returns from ``update`` on a box under 5 px, measured with
 cv2 5.0); a grown box is reported with its initial size, centred where OpenCV puts it.
+A cv2 error at construction or ``init`` is a ``ValueError`` naming the parameters given
+(MIL's ``samplerInitMaxNegNum`` is the mean of a random count of negative samples: under
+about 5, ``init`` may draw none and fail, depending on the seed).
 When a cv2 tracker reports failure its target's box is NaN for that frame
 (``extras["ok"]`` says which succeeded); it keeps updating and may find the target again.
 OpenCV's trackers draw from OpenCV's global random state: ``rng`` becomes a C ``int``
@@ -25,6 +28,7 @@ reproducible across runs even so, hence ``deterministic = False``.
 
 from __future__ import annotations
 
+import re
 from typing import Any
 
 import numpy as np
@@ -130,7 +134,16 @@ class OpenCVTracker:
         try:
             return self._cls.create(p)
         except cv2.error as err:
-            raise ValueError(f"cv2.Tracker{self.name}: {_cv2_message(err)}") from None
+            raise ValueError(
+                f"cv2.Tracker{self.name}{self._given()}: {_cv2_message(err)}"
+            ) from None
+
+    def _given(self) -> str:
+        """`` with params a=1, b=2`` naming the parameters given ("" if none): OpenCV's
+        own message does not say which one it could not work with."""
+        if not self.params:
+            return ""
+        return " with params " + ", ".join(f"{k}={v!r}" for k, v in self.params.items())
 
     def init(self, frame: Any, boxes: Any) -> None:
         """Start one cv2 tracker per box on ``frame`` (H, W, 3) RGB; ``boxes`` (K, 4)."""
@@ -150,7 +163,8 @@ class OpenCVTracker:
                 t.init(bgr, px)
             except cv2.error as err:
                 raise ValueError(
-                    f"cv2.Tracker{self.name} could not start on box {px}: {_cv2_message(err)}"
+                    f"cv2.Tracker{self.name}{self._given()} could not start on box {px}: "
+                    f"{_cv2_message(err)}"
                 ) from None
             self._trackers.append(t)
             grown = px[2] > np.ceil(box[2]) or px[3] > np.ceil(box[3])
@@ -181,8 +195,12 @@ class OpenCVTracker:
 
 
 def _cv2_message(err: Exception) -> str:
+    """The last line of a ``cv2.error``, without its ``OpenCV(5.0.0) path/file.cpp:81:
+    error:`` prefix (which would push the reason off a one-line message)."""
     lines = [s.strip() for s in str(err).strip().splitlines() if s.strip()]
-    return lines[-1] if lines else type(err).__name__
+    if not lines:
+        return type(err).__name__
+    return re.sub(r"^OpenCV\([^)]*\)\s+\S*:\s*error:\s*", "", lines[-1]) or lines[-1]
 
 
 def _pixel_box(box: NDArray[np.float64], shape: tuple[int, ...]) -> tuple[int, int, int, int]:

@@ -56,3 +56,15 @@ def test_track_bad_usage_exits_2(crossing, tmp_path, capsys, args, needle):
     err = capsys.readouterr().err
     assert code == 2 and needle in err and len(err.strip().splitlines()) == 1
     assert not out.exists()
+
+
+def test_track_refuses_to_replace_its_input(crossing, tmp_path, capsys):
+    # -o naming the input replaced the sequence with the result.
+    seq = tmp_path / "in.h5"
+    seq.write_bytes(crossing.read_bytes())
+    for out in (seq, tmp_path / "." / "in.h5"):
+        code = main(["track", str(seq), "--tracker", "kalman", "-o", str(out)])
+        err = capsys.readouterr().err
+        assert code == 2 and len(err.strip().splitlines()) == 1, err
+        assert "would replace the input" in err
+    assert seq.read_bytes() == crossing.read_bytes()

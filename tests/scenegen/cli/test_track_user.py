@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import textwrap
+import warnings
 
 import numpy as np
 import pytest
@@ -74,6 +75,24 @@ USER_MODULE = textwrap.dedent(
             out = super().step(frame)
             out.extras = {"order_prob": np.array([0.3, 0.3, 0.4])}
             return out
+
+    class Huge(Still):
+        def step(self, frame):
+            out = super().step(frame)
+            out.boxes = out.boxes.copy()
+            out.boxes[0, 0] = 1e39  # finite, beyond float32
+            return out
+
+    class Exits(Still):
+        def step(self, frame):
+            raise SystemExit(0)
+
+    class ExitsAtInit(Still):
+        def init(self, frame, boxes):
+            raise SystemExit(0)
+
+    def exits_when_built():
+        raise SystemExit(0)
 
     class Reuse(Still):
         orderings = [[0], [0]]
@@ -189,11 +208,19 @@ def test_a_users_tracker_that_raises_is_one_line_naming_it(user_dir, monkeypatch
         # Depth-order outputs a result file cannot hold were written, then called invalid.
         ("usertrk:BadOrderings", "its depth-order output cannot be stored: orderings name "
                                  "positions outside 0..0"),
+        # A box beyond float32 warned of an overflow, then blamed the depth-order output.
+        ("usertrk:Huge", "its box at frame 1 for target 1 is [1e+39, "),
+        # A SystemExit of the user's tracker was a clean exit 0 with no result.
+        ("usertrk:Exits", "after 0 of 3 steps: SystemExit: 0"),
+        ("usertrk:ExitsAtInit", "after 0 of 3 steps: SystemExit: 0"),
+        ("usertrk:exits_when_built", "failed while being built: SystemExit: 0"),
     ],
 )
 def test_a_users_tracker_failing_is_exit_1_naming_it(user_dir, monkeypatch, capsys, spec, needle):
     monkeypatch.chdir(user_dir)
-    code = main(["track", "seq.h5", "--tracker", spec, "-o", "f.h5"])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        code = main(["track", "seq.h5", "--tracker", spec, "-o", "f.h5"])
     err = capsys.readouterr().err
     assert code == 1 and len(err.strip().splitlines()) == 1, err
     assert err.startswith(f"scenegen: error: tracker '{spec}'") and needle in err, err

@@ -83,6 +83,28 @@ def test_exceptions_name_the_fixture_and_frame():
     )
 
 
+@pytest.mark.parametrize("where", ["init", "step", "factory"])
+def test_a_tracker_that_exits_fails_instead_of_ending_the_run(where):
+    # A SystemExit from init or step ended check_tracker (and a pytest run) with status 0.
+    class Exits(Still):
+        def __init__(self):
+            if where == "factory":
+                raise SystemExit(0)
+
+        def init(self, frame, boxes):
+            if where == "init":
+                raise SystemExit(0)
+            super().init(frame, boxes)
+
+        def step(self, frame):
+            raise SystemExit(0)
+
+    report = check_tracker(Exits, report=True, checks=["protocol", "edge_fixtures"])
+    expected = {"init": "init raised SystemExit: 0", "factory": "the factory raised SystemExit: 0",
+                "step": "step at frame 1 raised SystemExit: 0"}[where]  # fmt: skip
+    assert not report.passed and expected in str(report), str(report)
+
+
 def test_writing_into_the_frames_fails():
     class Scribbler(Still):
         def step(self, frame):
@@ -195,6 +217,15 @@ def test_bad_options_are_named(kw, needle):
     with pytest.raises(ValueError) as info:
         check_tracker(Still, **kw)
     assert needle in str(info.value)
+
+
+def test_repeats_may_be_a_numpy_integer_but_not_a_bool():
+    # np.int64(2) was refused as "not an integer".
+    report = check_tracker(Still, report=True, checks=["deterministic"], repeats=np.int64(2))
+    assert report.passed
+    for bad in (True, np.True_, 2.0, np.int64(0)):
+        with pytest.raises(ValueError, match="repeats must be an integer >= 1"):
+            check_tracker(Still, checks=["deterministic"], repeats=bad)
 
 
 @parametrize_with_checks([Still, (Follower, {"handles_occlusion": False})])
