@@ -159,7 +159,13 @@ class AR2:
     The limits keep the entity's centre at least ``margin`` pixels plus half its size inside
     the frame (for ``scale`` the limits are ``[-margin, margin]`` around the mean in log
     units, and a margin of 0 means unbounded). An entity's ``reflect``/``clamp`` axis
-    needs 2 x margin + its size <= the frame's side, else its config is refused.
+    needs 2 x margin + its size <= the frame's side, else its config is refused. The
+    limits hold from frame 1 on: a ``position`` outside them (nearer the border than
+    ``margin`` plus half the size) is taken as given at frame 0, and at frame 1
+    ``reflect`` mirrors it about the limit (a jump of twice its distance outside) and
+    ``clamp`` puts it on the limit. Such starts are allowed (an entity may enter from
+    outside the frame); give one inside ``[margin + size / 2, side - margin - size / 2]``
+    for a path without that jump.
     """
 
     boundary: Boundary

@@ -51,6 +51,7 @@ from scenegen import presets
 from scenegen.config import from_dict, load_config, load_data, to_dict
 from scenegen.datasets.paths import canonical_path, leaf_type, set_path
 from scenegen.errors import ConfigError
+from scenegen.render.plan import MAX_SEED
 
 __all__ = [
     "DISTRIBUTIONS",
@@ -233,9 +234,11 @@ class Family:
         """
         for p in overrides:
             for where, q in _setters(self.axes, [d.path for d in self.distributions]):
-                if _same_field(self.bases, self.overrides, str(p), q):
+                rel = _overlap(self.bases, self.overrides, str(p), q)
+                if rel:
+                    what = f"a field of {p}" if rel == "holds" else str(p)
                     raise _fail(self.source, f"{where}.{q}",
-                                f"sets {p} per sequence; it cannot be overridden")  # fmt: skip
+                                f"sets {what} per sequence; it cannot be overridden")  # fmt: skip
         spec = copy.deepcopy(self.spec)
         spec["set"] = {**dict(self.overrides), **overrides}
         spec.setdefault("count", self.count)
@@ -327,7 +330,10 @@ class Family:
 
 
 def _short(v: Any) -> str:
-    text = _json(v)
+    try:
+        text = _json(v)
+    except (TypeError, ValueError):  # not JSON, or an integer too long to print
+        text = f"an integer of {v.bit_length()} bits" if isinstance(v, int) else repr(v)
     return text if len(text) <= 30 else text[:27] + "..."
 
 
@@ -339,8 +345,10 @@ def _fail(source: str, where: str, msg: str) -> ConfigError:
     return ConfigError(f"{source}: {where}: {msg}" if where else f"{source}: {msg}")
 
 
-def _load_base(value: Any, source: str, folder: Path | None) -> tuple[str, dict[str, Any]]:
-    """(preset name or "", full config data) of a ``base`` entry."""
+def _load_base(
+    value: Any, source: str, folder: Path | None, where: str = "base"
+) -> tuple[str, dict[str, Any]]:
+    """(preset name or "", full config data) of a ``base`` entry (errors name ``where``)."""
     if isinstance(value, str):
         if value.lower().endswith((".yaml", ".yml", ".json")):
             p = Path(value)
@@ -349,10 +357,10 @@ def _load_base(value: Any, source: str, folder: Path | None) -> tuple[str, dict[
             try:
                 return "", to_dict(load_config(p))
             except ConfigError as err:
-                raise _fail(source, "base", str(err)) from None
+                raise _fail(source, where, str(err)) from None
         if value not in presets.all_names():
             raise _fail(
-                source, "base",
+                source, where,
                 f"unknown preset {value!r}; valid presets: {', '.join(presets.all_names())}",
             )  # fmt: skip
         return value, to_dict(presets.get(value))
@@ -360,8 +368,8 @@ def _load_base(value: Any, source: str, folder: Path | None) -> tuple[str, dict[
         try:
             return "", to_dict(from_dict(value))
         except ConfigError as err:
-            raise _fail(source, "base", str(err)) from None
-    raise _fail(source, "base", f"must be a preset name, a config file or a mapping, got {value!r}")
+            raise _fail(source, where, str(err)) from None
+    raise _fail(source, where, f"must be a preset name, a config file or a mapping, got {value!r}")
 
 
 def _check_path(source: str, section: str, bases: dict[str, dict[str, Any]], path: str) -> Any:
@@ -474,22 +482,35 @@ def _setters(axes: Any, vary: list[str]) -> list[tuple[str, str]]:
     return out + [("vary", p) for p in vary]
 
 
-def _same_field(bases: dict[str, dict[str, Any]], overrides: Any, a: str, b: str) -> bool:
-    """Whether paths ``a`` and ``b`` name the same field (``clutter[clutter].count`` and
-    ``clutter[0].count``) in one of the bases with ``overrides`` ((path, value) pairs) set."""
+def _inside(a: str, b: str) -> bool:
+    """Whether path ``a`` lies inside path ``b`` (``b`` is a prefix of it by whole
+    components: ``entities[0].motion.x`` is inside ``entities[0].motion``, not
+    ``clutter[10]`` inside ``clutter[1]``)."""
+    return len(a) > len(b) and a.startswith(b) and a[len(b)] in ".["
+
+
+def _relation(a: str, b: str) -> str:
+    return "same" if a == b else "inside" if _inside(a, b) else "holds" if _inside(b, a) else ""
+
+
+def _overlap(bases: dict[str, dict[str, Any]], overrides: Any, a: str, b: str) -> str:
+    """How paths ``a`` and ``b`` overlap in one of the bases with ``overrides`` ((path,
+    value) pairs) set: ``"same"`` field (``clutter[clutter].count`` and
+    ``clutter[0].count``), ``a`` ``"inside"`` the sub-config ``b`` (``entities[0].motion.x``
+    and ``entities[target].motion``), ``a`` ``"holds"`` ``b``, or ``""`` (apart)."""
     if a == b:
-        return True
+        return "same"
     for data in bases.values():
         if overrides:
             data = copy.deepcopy(data)
             for p, v in overrides:
                 set_path(data, p, copy.deepcopy(v))
         try:
-            if canonical_path(data, a) == canonical_path(data, b):
-                return True
+            if rel := _relation(canonical_path(data, a), canonical_path(data, b)):
+                return rel
         except ConfigError:  # a path this base lacks (reported where it is checked)
             continue
-    return False
+    return ""
 
 
 def family_from_dict(data: Any, *, source: str = "family", folder: Path | None = None) -> Family:
@@ -532,13 +553,16 @@ def family_from_dict(data: Any, *, source: str = "family", folder: Path | None =
     bases: dict[str, dict[str, Any]] = {}
     base = ""
     if preset_axes:
-        for vals in preset_axes[0].values:
-            p = vals[preset_axes[0].paths.index("preset")]
+        axis = preset_axes[0]
+        where = "sweep.preset" if axis.name == "preset" else f"sweep.{axis.name}.preset"
+        for vals in axis.values:
+            p = vals[axis.paths.index("preset")]
             if not isinstance(p, str):
-                raise _fail(source, "sweep.preset", f"values must be preset names, got {p!r}")
-            key, cfg = _load_base(p, source, folder)
-            if not key:
-                raise _fail(source, "sweep.preset", f"values must be preset names, got {p!r}")
+                raise _fail(source, where, f"values must be preset names, got {_short(p)}")
+            if p not in presets.all_names():  # not a config file either: names only
+                raise _fail(source, where, f"unknown preset {p!r}; valid presets: "
+                            f"{', '.join(presets.all_names())}")  # fmt: skip
+            key, cfg = _load_base(p, source, folder, where)
             bases[key] = cfg
         if len(preset_axes) > 1:
             raise _fail(source, "sweep", "only one axis may sweep the preset")
@@ -571,9 +595,11 @@ def family_from_dict(data: Any, *, source: str = "family", folder: Path | None =
     setters = _setters(axes, [str(p) for p in vary])
     for k, (where, p) in enumerate(setters):
         for other, q in setters[:k]:
-            if _same_field(checked, (), p, q):
-                raise _fail(source, f"{where}.{p}",
-                            f"set by two axes or distributions (also by {other}.{q})")  # fmt: skip
+            rel = _overlap(checked, (), p, q)
+            if rel:
+                how = {"same": "", "inside": ", which holds it", "holds": ", a field inside it"}
+                raise _fail(source, f"{where}.{p}", "set by two axes or distributions "
+                            f"(also by {other}.{q}{how[rel]})")  # fmt: skip
     fam = Family(
         name=name,
         description=description,
@@ -593,8 +619,8 @@ def family_from_dict(data: Any, *, source: str = "family", folder: Path | None =
     if isinstance(count, bool) or not isinstance(count, int) or count < 1:
         raise _fail(source, "count", f"must be an integer >= 1, got {count!r}")
     seed = data.get("seed", 0)
-    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
-        raise _fail(source, "seed", f"must be a non-negative integer, got {seed!r}")
+    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed <= MAX_SEED:
+        raise _fail(source, "seed", f"must be an integer in [0, 2**64 - 1], got {_short(seed)}")
     fam = dataclasses.replace(fam, count=count, seed=seed)
     # Every grid point with the distributions at their base values must be a valid config.
     for point in itertools.product(*(range(len(a)) for a in axes)):

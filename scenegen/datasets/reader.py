@@ -35,19 +35,47 @@ def _short_key(name: str) -> str:
     return re.sub(r"\[[^\]]*\]", "", name).rsplit(".", 1)[-1]
 
 
-def _matches(value: Any, want: Any) -> bool:
+def _shown(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+def _is_number(value: Any) -> bool:
+    return isinstance(value, (int, float, np.number)) and not isinstance(value, (bool, np.bool_))
+
+
+def _plain(value: Any) -> Any:
+    """``value`` with tuples as lists (a manifest holds JSON lists), recursively."""
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, dict):
+        return {k: _plain(v) for k, v in value.items()}
+    return value
+
+
+def _equal(value: Any, want: Any) -> bool:
+    try:
+        return bool(_plain(value) == _plain(want))
+    except (TypeError, ValueError):  # e.g. an array, whose == is not one truth value
+        return False
+
+
+def _matches(name: str, value: Any, want: Any) -> bool:
     if callable(want):
         return bool(want(value))
+    if isinstance(want, set | frozenset):
+        return any(_equal(value, w) for w in want)
     if isinstance(want, tuple) and len(want) == 2 and not isinstance(value, (list, tuple)):
         lo, hi = want
-        if value is None or isinstance(value, str):
+        if not all(b is None or _is_number(b) for b in want):
+            raise ConfigError(
+                f"select: {name}={_shown(want)}: a range (low, high) takes numbers or None; "
+                "give a set for several accepted values"
+            )
+        if not _is_number(value):
             return False
         return (lo is None or value >= lo) and (hi is None or value <= hi)
-    if isinstance(want, set | frozenset):
-        return value in want
-    if isinstance(want, list) and isinstance(value, list):
-        return value == want
-    return bool(value == want)
+    return _equal(value, want)
 
 
 class Dataset:
@@ -127,20 +155,29 @@ class Dataset:
             Conditions keyed by full parameter name (``{"clutter[0].count": 300}``).
         **params
             Conditions keyed by name or by the last field of a path (``count=300``,
-            ``position_noise=(4, 8)``). A value matches by equality; a 2-tuple
-            ``(low, high)`` is an inclusive range (None: open); a set lists the accepted
-            values; a callable is a predicate. Every condition must hold, also two on the
-            same parameter (one in ``where``, one here).
+            ``position_noise=(4, 8)``). A value matches by equality (a list or a dict
+            matches a parameter of that value, such as a swept size ``[44, 44]``; tuples
+            and lists compare alike); a 2-tuple ``(low, high)`` of numbers or None is an
+            inclusive range (None: open) for a numeric parameter; a set lists the
+            accepted values; a callable is a predicate. Every condition must hold, also
+            two on the same parameter (one in ``where``, one here).
 
         Raises
         ------
         ConfigError
-            For a parameter the dataset does not record.
+            For a parameter the dataset does not record, a ``where`` that is not a
+            mapping, or a range whose bounds are not numbers (one line naming the
+            parameter and the value).
         """
+        if where is not None and not isinstance(where, dict):
+            raise ConfigError(
+                f"select: where must be a dict of parameter names to conditions, got "
+                f"{_shown(where)}"
+            )
         conds = [(self._param_key(k), v) for k, v in [*(where or {}).items(), *params.items()]]
         keep = [
             e for e in self.entries
-            if all(_matches(e["params"].get(k), v) for k, v in conds)
+            if all(_matches(k, e["params"].get(k), v) for k, v in conds)
         ]  # fmt: skip
         return Dataset(self.root, self.manifest, keep)
 
@@ -177,6 +214,12 @@ class Samples:
     frames : ndarray of shape (L, H, W, 3), uint8
     boxes : ndarray of shape (L, M, 4), float32
         The boxes [x, y, w, h] of the sequence's M targets; NaN where absent.
+
+    Raises
+    ------
+    ConfigError
+        If ``clip`` or ``stride`` is not an integer >= 1 (or None), or ``gt`` is not one
+        of the two names (one line naming the parameter and the value).
     """
 
     _CACHE = 4
@@ -189,12 +232,15 @@ class Samples:
         stride: int | None = None,
         gt: str = "box",
     ) -> None:
-        if gt not in ("box", "visible_box"):
-            raise ConfigError(f"gt must be 'box' or 'visible_box', got {gt!r}")
-        if clip is not None and clip < 1:
-            raise ConfigError(f"clip must be >= 1, got {clip}")
-        if stride is not None and stride < 1:
-            raise ConfigError(f"stride must be >= 1, got {stride}")
+        if not isinstance(gt, str) or gt not in ("box", "visible_box"):
+            raise ConfigError(f"gt must be 'box' or 'visible_box', got {_shown(gt)}")
+        for label, value in (("clip", clip), ("stride", stride)):
+            if value is not None and not (
+                isinstance(value, (int, np.integer)) and not isinstance(value, bool) and value >= 1
+            ):
+                raise ConfigError(f"{label} must be an integer >= 1 or None, got {_shown(value)}")
+        clip = None if clip is None else int(clip)
+        stride = None if stride is None else int(stride)
         self.dataset = dataset
         self.clip = clip
         self.gt = gt

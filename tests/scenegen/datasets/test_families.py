@@ -97,6 +97,8 @@ def test_family_file(tmp_path):
     assert load_family(y).grid_size == 2
 
 
+MOTION = to_dict(presets.get("kams-a"))["entities"][0]["motion"]
+
 BAD = [
     ({"sweep": {"clutter[0].cnt": [1]}}, "sweep.clutter[0].cnt: unknown field 'cnt'"),
     ({"vary": {"entities[0].motion.z": {"uniform": [0, 1]}}},
@@ -136,6 +138,23 @@ BAD = [
                 "entities[0].appearance.size[0]": [5, 6]}},
      "f.yaml: sweep.entities[0].appearance.size[0]: set by two axes or distributions (also "
      "by sweep.w.entities[target].appearance.size[0])"),
+    # A sub-config and a field inside it (by whole components, by index or by name).
+    ({"sweep": {"entities[0].motion": [MOTION]},
+      "vary": {"entities[0].motion.x.margin": {"uniform": [1, 2]}}},
+     "f.yaml: vary.entities[0].motion.x.margin: set by two axes or distributions (also by "
+     "sweep.entities[0].motion, which holds it)"),
+    ({"sweep": {"entities[0].motion.x.margin": [1, 2]},
+      "vary": {"entities[target].motion": {"choice": [MOTION]}}},
+     "f.yaml: vary.entities[target].motion: set by two axes or distributions (also by "
+     "sweep.entities[0].motion.x.margin, a field inside it)"),
+    ({"sweep": {"w": {"entities[0].motion.x.sigma": [1, 2], "entities": [[], []]}}},
+     "f.yaml: sweep.w.entities: set by two axes or distributions (also by "
+     "sweep.w.entities[0].motion.x.sigma, a field inside it)"),
+    ({"seed": 2**64}, "f.yaml: seed: must be an integer in [0, 2**64 - 1], got "
+     "18446744073709551616"),
+    ({"seed": -1}, "f.yaml: seed: must be an integer in [0, 2**64 - 1], got -1"),
+    ({"seed": 10**5000}, "f.yaml: seed: must be an integer in [0, 2**64 - 1], got an integer "
+     "of 16610 bits"),
 ]  # fmt: skip
 
 
@@ -147,6 +166,39 @@ def test_bad_family_is_one_line_naming_the_field(change, message):
     text = str(info.value)
     assert message in text
     assert text.startswith("f.yaml: ") and "\n" not in text
+
+
+def test_paths_overlap_by_whole_components_only():
+    from scenegen.datasets.family import _inside
+
+    assert _inside("entities[0].motion.x", "entities[0].motion")
+    assert _inside("entities[0].motion", "entities")
+    assert not _inside("clutter[10].count", "clutter[1]")
+    assert not _inside("entities[0].motion", "entities[0].motion")
+    assert not _inside("sensor_noise_x", "sensor_noise")
+    # Two fields of one sub-config do not overlap.
+    fam = family_from_dict({
+        "name": "t", "base": "kams-a", "sweep": {"entities[0].motion.x.sigma": [1, 2]},
+        "vary": {"entities[target].motion.y.sigma": {"uniform": [1, 2]}},
+    })  # fmt: skip
+    assert fam.draws(2)[1].config["entities"][0]["motion"]["x"]["sigma"] == 2
+
+
+@pytest.mark.parametrize("sweep", [{"preset": ["kams-a", "kams-zz"]},
+                                   {"lvl": {"preset": ["kams-a", "kams-zz"], "n_frames": [3, 4]}},
+                                   {"preset": ["kams-a", "kams-zz.yaml"]}])  # fmt: skip
+def test_an_unknown_preset_in_a_preset_axis_names_the_axis(sweep):
+    where = "sweep.lvl.preset" if "lvl" in sweep else "sweep.preset"
+    name = sweep["preset"][1] if "preset" in sweep else "kams-zz"
+    with pytest.raises(ConfigError) as info:
+        family_from_dict({"name": "t", "sweep": sweep}, source="f.yaml")
+    assert str(info.value).startswith(f"f.yaml: {where}: unknown preset {name!r}; valid presets: ")
+    assert "kams-a" in str(info.value) and "\n" not in str(info.value)
+
+
+def test_the_largest_seed_is_accepted():
+    fam = family_from_dict({"name": "t", "base": "kams-a", "seed": 2**64 - 1})
+    assert fam.seed == 2**64 - 1 and fam.draws(1)[0].seed >= 0
 
 
 def test_unknown_family_name_lists_the_valid_ones():
@@ -162,6 +214,15 @@ def test_overrides_keep_the_family_as_given_and_refuse_swept_fields():
     with pytest.raises(ConfigError, match=r"^family: sweep.clutter\[0\].count: sets "
                        r"clutter\[clutter\].count per sequence; it cannot be overridden$"):
         fam.with_overrides({"clutter[clutter].count": 3})
+    # A sub-config holding a swept field, or a field inside a swept sub-config.
+    with pytest.raises(ConfigError, match=r"^family: sweep.clutter\[0\].count: sets a field "
+                       r"of clutter\[clutter\] per sequence; it cannot be overridden$"):
+        fam.with_overrides({"clutter[clutter]": to_dict(presets.get("kams-a"))["clutter"][0]})
+    sub = family_from_dict({"name": "s", "base": "kams-a",
+                            "sweep": {"entities[0].motion": [MOTION]}})  # fmt: skip
+    with pytest.raises(ConfigError, match=r"^family: sweep.entities\[0\].motion: sets "
+                       r"entities\[0\].motion.x.sigma per sequence; it cannot be overridden$"):
+        sub.with_overrides({"entities[0].motion.x.sigma": 3.0})
 
 
 @pytest.mark.parametrize(

@@ -411,3 +411,17 @@ def test_an_entity_whose_shape_is_wholly_outside_the_frame_is_not_present(positi
     seq = generate(cfg, seed=0)
     assert not seq.gt.present[:, 1].any() and np.isnan(seq.gt.box[:, 1]).all()
     assert seq.initial_targets().tolist() == [0]
+
+
+@pytest.mark.parametrize(("boundary", "frame1"), [("reflect", 63.0), ("clamp", 35.0)])
+def test_a_start_outside_a_bounded_axis_is_brought_inside_at_frame_1(boundary, frame1):
+    # Documented in AR2's docstring and the README: the limits [margin + w/2,
+    # width - margin - w/2] apply from frame 1; an explicit start outside them is kept
+    # at frame 0 (an entity may enter from outside, as the testing strategies draw).
+    ar = AR2(boundary=boundary, a1=2.0, a2=-1.0, sigma=0.0, margin=20)
+    motion = Motion(x=ar, y=ar, velocity=(2.0, 0.0))
+    e = EntitySpec(name="t", role="target", appearance=Appearance(size=(30, 30)),
+                   position=(5.0, 60.0), motion=motion)  # fmt: skip
+    cfg = SceneConfig(width=320, height=120, n_frames=3, entities=(e,))
+    path = scenegen.generate(cfg, seed=0).gt.path_center[:, 0, 0]
+    assert path[0] == 5.0 and path[1] == frame1 and 35.0 <= path[2] <= 285.0
