@@ -47,7 +47,7 @@ def cmd_benchmark(args: argparse.Namespace) -> int:
         DIR is not a dataset folder, or a shard is damaged.
     """
     from scenegen.cli.track import parse_params
-    from scenegen.lab.benchmark import run_benchmark
+    from scenegen.lab.benchmark import NONE_SCORED, run_benchmark, scored
 
     res = run_benchmark(
         args.dataset,
@@ -58,9 +58,13 @@ def cmd_benchmark(args: argparse.Namespace) -> int:
         scheduler=args.scheduler,
         progress=sys.stderr.isatty(),
     )
-    best = res["leaderboard"][0] if res["leaderboard"] else None
-    if best is not None:
-        print(f"benchmark: {len(res['scores'])} runs; best AUC {best['tracker']} "
-              f"({best['auc']})", file=sys.stderr)  # fmt: skip
+    board = res["leaderboard"]
+    if not scored(board):
+        print(f"benchmark: {len(res['scores'])} runs; {NONE_SCORED}", file=sys.stderr)
+    elif board[0]["auc"] is None:
+        print(f"benchmark: {len(res['scores'])} runs; no AUC was computed", file=sys.stderr)
+    else:
+        print(f"benchmark: {len(res['scores'])} runs; best AUC {board[0]['tracker']} "
+              f"({board[0]['auc']})", file=sys.stderr)  # fmt: skip
     print(str((args.output / "index.html").resolve()))
     return 0

@@ -64,11 +64,12 @@ def generate_presets(out: Path, seed: int) -> list[Path]:
 
 def cmd_demo(args: argparse.Namespace) -> int:
     from scenegen.errors import ConfigError
-    from scenegen.lab.report import build_report, run_demo_experiments
+    from scenegen.lab.report import build_report, check_report_folder, run_demo_experiments
 
     if args.jobs < 1:
         raise ConfigError(f"--jobs must be >= 1, got {args.jobs}")
     out: Path = args.output
+    check_report_folder(out)  # before any preset is written into it
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     _say(f"[1/3] generating every preset into {out / 'presets'}")

@@ -33,6 +33,7 @@ from scenegen.datasets.builtin import resolve_family
 from scenegen.datasets.executor import check_executor, probe, run_tasks
 from scenegen.datasets.family import Axis, Draw, Family
 from scenegen.errors import ConfigError, DataError
+from scenegen.render.plan import MAX_SEED
 
 __all__ = [
     "DEFAULT_SHARD_SIZE",
@@ -41,6 +42,8 @@ __all__ = [
     "ShardTask",
     "build_dataset",
     "holds_benchmark_outputs",
+    "holds_experiment_outputs",
+    "holds_report",
     "make_output_folder",
     "make_shard",
     "manifest_axes",
@@ -418,8 +421,8 @@ def manifest_family(manifest: dict[str, Any], path: Path) -> Family:
     from scenegen.datasets.family import Distribution, family_from_dict
 
     res, seed = manifest.get("resolved"), manifest.get("seed")
-    if not (_is(seed, int) and seed >= 0):
-        raise DataError(f"{path}: seed must be a non-negative integer")
+    if not (_is(seed, int) and 0 <= seed <= MAX_SEED):
+        raise DataError(f"{path}: seed must be a non-negative integer below 2**64")
     try:
         if isinstance(res, dict):
             fam = Family(
@@ -466,6 +469,43 @@ def holds_benchmark_outputs(folder: Path) -> bool:
         return True
     runs = root / "runs"
     return runs.is_dir() and any(p.is_dir() for p in runs.iterdir())
+
+
+def _results_json(folder: Path) -> Any:
+    """The parsed ``folder/results.json``, or None (missing, unreadable or not JSON)."""
+    try:
+        return json.loads((Path(folder) / "results.json").read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, ValueError):
+        return None
+
+
+def holds_report(folder: Path) -> bool:
+    """True for the report folder of ``scenegen experiment all`` or ``scenegen demo`` (even
+    damaged): a ``results.json`` holding ``{"experiments": ...}``, or ``experiments/``
+    beside an ``index.html``."""
+    root = Path(folder)
+    held = _results_json(root)
+    if isinstance(held, dict) and "experiments" in held:
+        return True
+    return (root / "experiments").is_dir() and (root / "index.html").exists()
+
+
+def holds_experiment_outputs(folder: Path) -> bool:
+    """True for a folder holding what ``scenegen experiment`` writes (even damaged): a
+    ``results.json`` naming an experiment, or run records (``runs/*.json``) beside a
+    ``table.md``; or the report of ``scenegen experiment all`` (:func:`holds_report`).
+
+    Defined here, below the lab, so that no dataset is written into one;
+    ``scenegen benchmark -o`` refuses such a folder too.
+    """
+    root = Path(folder)
+    held = _results_json(root)
+    if isinstance(held, dict) and isinstance(held.get("experiment"), str):
+        return True
+    if holds_report(root):
+        return True
+    runs = root / "runs"
+    return (root / "table.md").is_file() and runs.is_dir() and any(runs.glob("*.json"))
 
 
 def make_output_folder(folder: Path) -> None:
@@ -535,7 +575,8 @@ def build_dataset(
     ConfigError
         For a bad family, count, seed, executor or compression; a ``frames`` the family
         sweeps or draws; an ``out`` that cannot be created, holds another dataset, a
-        damaged manifest or a benchmark's outputs.
+        damaged manifest, a benchmark's outputs, an experiment's results or a report of
+        ``scenegen experiment all``.
     """
     from tqdm import tqdm
 
@@ -555,8 +596,9 @@ def build_dataset(
     s = fam.seed if seed is None else seed
     if isinstance(n, bool) or not isinstance(n, int) or n < 1:
         raise ConfigError(f"--count must be >= 1, got {n}")
-    if isinstance(s, bool) or not isinstance(s, int) or s < 0:
-        raise ConfigError(f"--seed must be a non-negative integer, got {s}")
+    if isinstance(s, bool) or not isinstance(s, int) or not 0 <= s <= MAX_SEED:
+        shown = s if not isinstance(s, int) or s.bit_length() < 128 else f"{s.bit_length()} bits"
+        raise ConfigError(f"--seed must be an integer in [0, 2**64 - 1], got {shown}")
     if shard_size < 1:
         raise ConfigError(f"--shard-size must be >= 1, got {shard_size}")
     root = Path(out)
@@ -565,6 +607,10 @@ def build_dataset(
     if root.is_dir() and holds_benchmark_outputs(root):
         raise ConfigError(f"-o {root}: is a benchmark output folder (scenegen benchmark); "
                           "write the dataset into another folder")  # fmt: skip
+    if root.is_dir() and holds_experiment_outputs(root):
+        what = ("a report of `scenegen experiment all`" if holds_report(root)
+                else "the results of `scenegen experiment`")  # fmt: skip
+        raise ConfigError(f"-o {root}: holds {what}; write the dataset into another folder")
     draws = fam.draws(n, s)  # validates every sequence's config before any work
     if scheduler is not None:
         probe(scheduler)  # an unreachable scheduler fails before anything is written

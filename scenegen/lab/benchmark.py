@@ -45,6 +45,7 @@ from scenegen.lab.experiments.runner import _round, derive_seed
 
 __all__ = [
     "METRICS",
+    "NONE_SCORED",
     "BenchTask",
     "curves",
     "dataset_meta",
@@ -55,6 +56,7 @@ __all__ = [
     "run_benchmark",
     "run_file",
     "run_pair",
+    "scored",
     "texts",
     "write_outputs",
 ]
@@ -258,7 +260,7 @@ def plan_benchmark(
     DataError
         If ``root`` is not a dataset folder.
     """
-    from scenegen.datasets.build import manifest_axes, read_manifest
+    from scenegen.datasets.build import read_manifest
 
     if not trackers:
         raise ConfigError("give at least one --tracker")
@@ -279,11 +281,25 @@ def plan_benchmark(
     man = read_manifest(root)
     if not man.get("complete"):
         raise ConfigError(f"{root}: the dataset is incomplete; finish it with scenegen dataset")
+    return man, _tasks(root, man, per)
+
+
+def _tasks(root: Path, man: dict[str, Any], per: dict[str, dict[str, Any]]) -> list[BenchTask]:
+    """Every task of the trackers of ``per`` (tracker -> its parameters, in order) on the
+    sequences of the dataset at ``root`` (its manifest ``man``): trackers x sequences.
+
+    Raises
+    ------
+    DataError
+        A manifest whose axes cannot be read.
+    """
+    from scenegen.datasets.build import manifest_axes
+
     # A named axis (several fields moved together) is recorded by its grid position in the
     # manifest (what ds.select takes); the records, scores and curves take its value.
     named = [a for a in manifest_axes(man, root / "manifest.json") if len(a.paths) > 1]
     tasks = []
-    for t in trackers:
+    for t in per:
         p = tuple(sorted(per[t].items()))
         for e in sorted(man["sequences"], key=lambda e: e["index"]):
             fd = str((e.get("digests") or {}).get("frames", ""))
@@ -297,7 +313,7 @@ def plan_benchmark(
                 BenchTask(str(root), int(e["index"]), e["name"], e["file"], int(e["seed"]),
                           fd, t, p, sp)
             )  # fmt: skip
-    return man, tasks
+    return tasks
 
 
 # --------------------------------------------------------------------------------------
@@ -447,6 +463,21 @@ def _fmt(v: Any) -> str:
 _CI_NOTE = ("Each cell: the mean over the scored sequences [its 95 % percentile bootstrap "
             "interval over the sequences]; a ranking between overlapping intervals is not "
             "settled.")
+NONE_SCORED = "no sequence was scored (none has a target at frame 0)"
+"""What the report says when no sequence of the dataset has a target at frame 0."""
+_NONE_SCORED_NOTE = (f"{NONE_SCORED[0].upper()}{NONE_SCORED[1:]}: no tracker has a score, "
+                     "and the ranks are only the order of the trackers' names.")
+
+
+def scored(board: list[dict[str, Any]]) -> bool:
+    """True when some tracker of the leaderboard ``board`` was scored on some sequence."""
+    return any(e["sequences"] > 0 for e in board)
+
+
+def _md_text(text: str) -> str:
+    """``text`` in a markdown table cell: ``|`` escaped and line breaks made spaces, so that
+    a tracker's name (a user's factory may hold either) keeps to its cell."""
+    return " ".join(str(text).splitlines()).replace("|", "\\|")
 
 
 def _cell(e: dict[str, Any], metric: str) -> str:
@@ -463,13 +494,17 @@ def _columns(board: list[dict[str, Any]]) -> list[str]:
 
 def _markdown(board: list[dict[str, Any]]) -> str:
     cols = _columns(board)
-    lines = ["| rank | tracker | sequences | " + " | ".join(METRICS[c] for c in cols) + " |",
+
+    def row(cells: list[str]) -> str:
+        return "| " + " | ".join(cells) + " |"
+
+    lines = [row(["rank", "tracker", "sequences", *(METRICS[c] for c in cols)]),
              "|---:|---|---:|" + "---:|" * len(cols)]  # fmt: skip
     for e in board:
-        cells = [_cell(e, c) for c in cols]
-        lines.append(f"| {e['rank']} | {e['tracker']} | {e['sequences']} | " + " | ".join(cells)
-                     + " |")  # fmt: skip
-    return "\n".join(lines) + "\n\n" + _CI_NOTE + "\n"
+        lines.append(row([str(e["rank"]), _md_text(e["tracker"]), str(e["sequences"]),
+                          *(_cell(e, c) for c in cols)]))  # fmt: skip
+    note = _CI_NOTE if scored(board) else _NONE_SCORED_NOTE
+    return "\n".join(lines) + "\n\n" + note + "\n"
 
 
 def _html(meta: dict[str, Any], board: list[dict[str, Any]], figures: list[tuple[str, str]],
@@ -494,6 +529,12 @@ def _html(meta: dict[str, Any], board: list[dict[str, Any]], figures: list[tuple
         "targets only.</p>" if multi else
         "<p>No multi-target metric: every sequence has one target (or none was computed).</p>"
     )  # fmt: skip
+    if not scored(board):
+        note = f"<p>{e(_NONE_SCORED_NOTE)}</p>"
+    if not figs:  # say why there is none
+        figs = ("<p>No swept or drawn axis with more than one value.</p>" if not meta["axes"]
+                else f"<p>No figure: {e(NONE_SCORED)}.</p>" if not scored(board)
+                else "<p>No figure: no metric has a value along the difficulty axes.</p>")
     return f"""<!doctype html>
 <html><head><meta charset="utf-8"><title>Benchmark: {e(str(meta["family"]))}</title>
 <style>body{{font-family:sans-serif;max-width:1100px;margin:2em auto}}
@@ -512,7 +553,7 @@ difficulty axes: {axes}. Dataset folder {e(str(meta["path"]))}, family digest
 <p>Per-sequence scores: <a href="scores.csv">scores.csv</a>; everything:
 <a href="results.json">results.json</a>.</p>
 <h2>Metrics against the difficulty axes</h2>
-{figs or "<p>No swept or drawn axis with more than one value.</p>"}
+{figs}
 </body></html>
 """
 
@@ -562,8 +603,8 @@ def run_benchmark(
     ------
     ConfigError
         As :func:`plan_benchmark`; a bad ``jobs`` or an unreachable scheduler; ``out``
-        holding a dataset (its ``manifest.json``) or an experiment's results, or that
-        cannot be created.
+        holding a dataset (its ``manifest.json``), an experiment's results or a report of
+        ``scenegen experiment all``, or that cannot be created.
     DataError
         ``dataset`` is not a dataset folder, or a shard is damaged.
     """
@@ -583,11 +624,13 @@ def run_benchmark(
         what = "the dataset folder" if outp.resolve() == root.resolve() else "a dataset folder"
         raise ConfigError(f"-o {outp}: is {what} (manifest.json); write the benchmark into "
                           "another folder")  # fmt: skip
-    from scenegen.lab.experiments import holds_experiment_outputs
+    from scenegen.datasets.build import holds_experiment_outputs, holds_report
 
     if holds_experiment_outputs(outp):
-        raise ConfigError(f"-o {outp}: holds the results of `scenegen experiment`; write the "
-                          "benchmark into another folder")  # fmt: skip
+        what = ("a report of `scenegen experiment all`" if holds_report(outp)
+                else "the results of `scenegen experiment`")  # fmt: skip
+        raise ConfigError(f"-o {outp}: holds {what}; write the benchmark into another "
+                          "folder")  # fmt: skip
     make_output_folder(outp)
     meta = dataset_meta(man, root)
     listed = listed_digests(outp, meta)
@@ -691,6 +734,14 @@ def figure_list(results: dict[str, Any]) -> list[tuple[str, str, dict[str, Any]]
     return out
 
 
+def _csv_cell(value: Any) -> Any:
+    """A sequence parameter in ``scores.csv``: a list, dict or bool as JSON (``[2, 3]``,
+    ``{"a": 1}``, ``true``), None as an empty cell, anything else as is."""
+    if isinstance(value, (bool, dict, list)):
+        return json.dumps(value, sort_keys=True)
+    return value
+
+
 def texts(results: dict[str, Any]) -> dict[str, str]:
     """``scores.csv``, ``leaderboard.md`` and ``index.html`` of ``results``, by file name."""
     meta, board, rows = results["dataset"], results["leaderboard"], results["scores"]
@@ -701,8 +752,7 @@ def texts(results: dict[str, Any]) -> dict[str, str]:
     w.writerow(["tracker", "index", "name", "targets", *pnames, *metric_cols])
     for r in rows:
         w.writerow([r["tracker"], r["index"], r["name"], r["targets"],
-                    *[json.dumps(r["params"].get(p)) if isinstance(r["params"].get(p), list)
-                      else r["params"].get(p) for p in pnames],
+                    *[_csv_cell(r["params"].get(p)) for p in pnames],
                     *["" if r.get(m) is None else r[m] for m in metric_cols]])  # fmt: skip
     figures = [(name, cap) for name, cap, _ in figure_list(results)]
     return {"scores.csv": buf.getvalue(), "leaderboard.md": _markdown(board),

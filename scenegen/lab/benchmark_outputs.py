@@ -15,10 +15,12 @@ every run file it was computed from with that file's digest, as an experiment's 
 - :func:`check_benchmark` (``scenegen validate OUT``) checks everything but the pixels of
   the figures: each listed record reads, matches its digest, its listed digest and its
   file name, and has a record's fields; ``results.json`` equals the results recomputed
-  from those records and its own dataset description; ``scores.csv``, ``leaderboard.md``
-  and ``index.html`` are the texts of ``results.json``; every figure it names is a PNG
-  file. With ``deep``, every run is computed again from the dataset (found at the path
-  ``results.json`` names) and compared with its record.
+  from those records and its own dataset description; the records are one run of each
+  listed tracker on each of the dataset's sequences, in order, a built-in tracker's runs
+  deterministic; ``scores.csv``, ``leaderboard.md`` and ``index.html`` are the texts of
+  ``results.json``; every figure it names is a PNG file. With ``deep``, every record's
+  key is checked against the manifest of the dataset (found at the path ``results.json``
+  names) and its run computed again from it and compared with the record.
 """
 
 from __future__ import annotations
@@ -222,10 +224,12 @@ def check_benchmark(folder: str | Path, *, deep: bool = False,
     folder : str or Path
         A folder written by ``scenegen benchmark DIR ... -o OUT``.
     deep : bool
-        Also run every listed run again on the dataset at the path ``results.json`` names
-        (same seeds) and compare it with its record: finds a record edited with every
-        digest recomputed. Runs of a tracker that is not deterministic (its record says
-        so) are not run again.
+        Also check every record's key and sequence parameters against the manifest of the
+        dataset at the path ``results.json`` names (a record moved to another sequence),
+        and run every listed run again on it (same seeds) and compare it with its record:
+        finds a record edited with every digest recomputed. Runs of a user's tracker that
+        is not deterministic (its record says so; a built-in tracker's record may not) are
+        not run again.
     skipped : list, optional
         With ``deep``, receives the file of every run not run again for that reason.
 
@@ -273,6 +277,11 @@ def check_benchmark(folder: str | Path, *, deep: bool = False,
         verb = "differs" if len(changed) == 1 else "differ"
         return [f"{res_path}: {', '.join(changed)} {verb} from the results of its runs "
                 f"(edited, or written by another version of scenegen: {_RERUN})"]  # fmt: skip
+    # Sound and consistent, yet perhaps forged: runs dropped, listed twice or out of order, a
+    # built-in tracker's runs said to be not deterministic (so that --deep skips them).
+    problems = _pair_problems(root, results, records)
+    if problems:
+        return _more(problems)
     for name, text in texts(results).items():
         path = root / name
         try:
@@ -300,11 +309,63 @@ def check_benchmark(folder: str | Path, *, deep: bool = False,
     return _more(problems)
 
 
+def _pair_problems(root: Path, results: dict[str, Any], records: list[dict[str, Any]]
+                   ) -> list[str]:  # fmt: skip
+    """The records against what ``results`` says was run: every tracker it lists on every
+    one of the dataset's ``count`` sequences, once each, in that order (trackers x
+    sequences), all runs of a tracker with the same parameters; and a built-in
+    tracker's runs deterministic (a record saying otherwise would be skipped by ``--deep``).
+    One line per problem (at most one per kind for the missing runs and the order)."""
+    res_path = root / RESULTS
+    trackers: list[str] = results["trackers"]
+    count: int = results["dataset"]["count"]
+    params: dict[str, Any] = {}  # per tracker, the parameters of its first run
+    problems: list[str] = []
+    seen: set[tuple[str, int]] = set()
+    order: list[tuple[str, int]] = []
+    for rec in records:
+        key = rec["key"]
+        tracker, index = key["tracker"], key["index"]
+        path = root / _run_file(key)
+        if tracker not in trackers:
+            problems.append(f"{path}: a run of {tracker!r}, which is not a tracker "
+                            f"{RESULTS} lists")  # fmt: skip
+            continue
+        if not 0 <= index < count:
+            problems.append(f"{path}: a run on sequence {index}, which is not one of the "
+                            f"dataset's {count}")  # fmt: skip
+            continue
+        if (tracker, index) in seen:
+            problems.append(f"{res_path}: lists the run {_run_file(key)} twice")
+            continue
+        seen.add((tracker, index))
+        order.append((tracker, index))
+        if ":" not in tracker and rec["deterministic"] is not True:
+            problems.append(f"{path}: says the built-in tracker {tracker!r} is not "
+                            "deterministic (every built-in tracker is)")  # fmt: skip
+        if params.setdefault(tracker, key["params"]) != key["params"]:
+            problems.append(f"{path}: a run of {tracker!r} with other parameters than its "
+                            "other runs")  # fmt: skip
+    missing = len(trackers) * count - len(seen)
+    if missing > 0:
+        first = next((t, i) for t in trackers for i in range(count) if (t, i) not in seen)
+        problems.append(f"{res_path}: lists no run of {first[0]!r} on sequence {first[1]}"
+                        + (f" (nor {missing - 1} more runs)" if missing > 1 else "")
+                        + f"; each tracker runs once on each of the dataset's {count} "
+                        "sequences")  # fmt: skip
+    elif not problems and order != sorted(order, key=lambda p: (trackers.index(p[0]), p[1])):
+        problems.append(f"{res_path}: lists the runs out of their order (trackers as listed, "
+                        "then sequences)")  # fmt: skip
+    return problems
+
+
 def _check_deep(root: Path, results: dict[str, Any], records: list[dict[str, Any]],
                 skipped: list[str]) -> list[str]:  # fmt: skip
-    """Every record against its run computed again on the dataset ``results`` names."""
+    """Every record against the dataset ``results`` names: its key and sequence
+    parameters those of the manifest's sequence (with the tracker's parameters), and its
+    run computed again on that sequence."""
     from scenegen.datasets import read_manifest
-    from scenegen.lab.benchmark import BenchTask, run_pair
+    from scenegen.lab.benchmark import _tasks, run_pair
 
     meta = results["dataset"]
     data = Path(str(meta["path"]))
@@ -313,21 +374,37 @@ def _check_deep(root: Path, results: dict[str, Any], records: list[dict[str, Any
     except Exception as err:  # noqa: BLE001 - any failure to read it is one line
         return [f"{root / RESULTS}: --deep needs the dataset it was computed on, at {data} "
                 f"({str(err)[:120]})"]  # fmt: skip
-    if man.get("family_digest") != meta["family_digest"] or man.get("seed") != meta["seed"]:
+    if any(man.get(k) != meta[k] for k in ("family_digest", "seed", "count")):
         return [f"{data}: is not the dataset {root / RESULTS} was computed on (another "
-                "family or seed)"]  # fmt: skip
+                "family, seed or count)"]  # fmt: skip
+    try:
+        tasks = _tasks(data, man, {t: results["params"][t] for t in results["trackers"]})
+    except Exception as err:  # noqa: BLE001 - any failure to read it is one line
+        return [f"{data / 'manifest.json'}: cannot list the runs of {root / RESULTS} "
+                f"({str(err)[:120]})"]  # fmt: skip
+    expected = {(t.tracker, t.index): t for t in tasks}
     problems = []
     for rec in records:
+        path = root / _run_file(rec["key"])
+        task = expected.get((rec["key"]["tracker"], rec["key"]["index"]))
+        if task is None:  # not one of the manifest's sequences (found by _pair_problems)
+            problems.append(f"{path}: a run on no sequence of {data}")
+            continue
+        want = json.loads(json.dumps(task.key(), sort_keys=True))
+        wrong = sorted(k for k in set(want) | set(rec["key"])
+                       if want.get(k) != rec["key"].get(k))  # fmt: skip
+        if wrong:
+            problems.append(f"{path}: its key is not the run of {task.tracker!r} on sequence "
+                            f"{task.index} of {data} ({', '.join(wrong)} differ)")  # fmt: skip
+            continue
+        if rec["sequence_params"] != _round(json.loads(task.sequence_params)):
+            problems.append(f"{path}: its sequence_params are not those of sequence "
+                            f"{task.index} in {data / 'manifest.json'}")  # fmt: skip
+            continue
         if not rec["deterministic"]:
             skipped.append(_run_file(rec["key"]))
             continue
-        key = dict(rec["key"])
-        params = tuple(sorted(key.pop("params").items()))
-        task = BenchTask(str(data), params=params,
-                         sequence_params=json.dumps(rec["sequence_params"], sort_keys=True),
-                         **key)  # fmt: skip
         again = json.loads(json.dumps(run_pair(task), sort_keys=True))
         if again != rec:
-            problems.append(f"{root / _run_file(rec['key'])}: differs from the run computed "
-                            "again")  # fmt: skip
+            problems.append(f"{path}: differs from the run computed again")
     return problems

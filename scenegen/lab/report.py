@@ -20,8 +20,8 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from scenegen.datasets.build import make_output_folder
-from scenegen.errors import DataError
+from scenegen.datasets.build import holds_report, make_output_folder
+from scenegen.errors import ConfigError, DataError
 from scenegen.io.sealed import write_sealed_json
 from scenegen.lab.experiments import get, names, run_experiment, verdict_counts
 from scenegen.lab.experiments.definitions import DEMO_PLAN
@@ -34,11 +34,35 @@ from scenegen.lab.experiments.outputs import (
 from scenegen.lab.experiments.tables import render_table
 from scenegen.lab.experiments.why import WHY
 
-__all__ = ["DEMO_PLAN", "FULL_COMMAND", "build_report", "index_problem", "markdown_to_html",
-           "render_report", "run_all", "run_demo_experiments"]
+__all__ = ["DEMO_PLAN", "FULL_COMMAND", "build_report", "check_report_folder", "index_problem",
+           "markdown_to_html", "render_report", "run_all", "run_demo_experiments"]
 
 FULL_COMMAND = "scenegen experiment all -o out/"
 """The command of the full reproduction (every experiment at its default S x R)."""
+
+
+def check_report_folder(out_dir: str | Path) -> None:
+    """Refuse a report folder (``scenegen experiment all -o``, ``scenegen demo -o``) that
+    holds what another verb wrote: a dataset, a benchmark's outputs or one experiment's
+    results, whose ``results.json`` and ``index.html`` the report would replace.
+
+    Raises
+    ------
+    ConfigError
+        One line naming the folder and what it holds.
+    """
+    from scenegen.datasets.build import holds_benchmark_outputs, holds_experiment_outputs
+
+    out = Path(out_dir)
+    if (out / "manifest.json").exists():
+        what = "is a dataset folder (manifest.json)"
+    elif holds_benchmark_outputs(out):
+        what = "holds the outputs of `scenegen benchmark`"
+    elif holds_experiment_outputs(out) and not holds_report(out):
+        what = "holds the results of `scenegen experiment`"
+    else:
+        return
+    raise ConfigError(f"-o {out}: {what}; write the report into another folder")
 
 
 def run_all(
@@ -74,9 +98,16 @@ def run_all(
     -------
     Path
         The ``index.html`` written.
+
+    Raises
+    ------
+    ConfigError
+        As :func:`scenegen.lab.experiments.run_experiment`; ``out_dir`` holding a dataset,
+        a benchmark's outputs or one experiment's results (:func:`check_report_folder`).
     """
     from scenegen.lab.experiments.runner import plan_tasks, workers
 
+    check_report_folder(out_dir)
     out = Path(out_dir) / "experiments"
     # One set of workers for every experiment, given every experiment's tasks at once: they
     # run the next experiment's tasks while this process summarises the previous one.

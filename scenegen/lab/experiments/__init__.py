@@ -35,7 +35,12 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
-from scenegen.datasets.build import make_output_folder
+from scenegen.datasets.build import (
+    holds_benchmark_outputs,
+    holds_experiment_outputs,
+    holds_report,
+    make_output_folder,
+)
 from scenegen.errors import ConfigError
 from scenegen.lab.experiments.definitions import EXPERIMENTS, PAPER, Experiment, Method, get, names
 from scenegen.lab.experiments.outputs import (
@@ -66,6 +71,7 @@ __all__ = [
     "Task",
     "derive_seed",
     "get",
+    "holds_experiment_outputs",
     "names",
     "results_document",
     "run_experiment",
@@ -128,34 +134,19 @@ def results_document(exp: Experiment, records: list[dict[str, Any]]) -> dict[str
     return _round(json.loads(json.dumps(results)))
 
 
-def holds_experiment_outputs(folder: Path) -> bool:
-    """True for a folder holding what ``scenegen experiment`` writes (even damaged): a
-    ``results.json`` naming an experiment, or run records (``runs/*.json``) beside a
-    ``table.md``. ``scenegen benchmark -o`` refuses such a folder."""
-    root = Path(folder)
-    try:
-        held = json.loads((root / "results.json").read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, ValueError):
-        held = None
-    if isinstance(held, dict) and isinstance(held.get("experiment"), str):
-        return True
-    runs = root / "runs"
-    return (root / "table.md").is_file() and runs.is_dir() and any(runs.glob("*.json"))
-
-
 def _refuse_other_outputs(out: Path, name: str) -> None:
-    """Refuse an output folder holding another experiment's results, a benchmark's
-    outputs, or a report of ``experiment all``: its figures and runs would be mixed with
-    this one's.
+    """Refuse an output folder holding a dataset, another experiment's results, a
+    benchmark's outputs, or a report of ``experiment all``: its figures and runs would be
+    mixed with this one's.
 
     Raises
     ------
     ConfigError
         Naming the folder and what it holds.
     """
-    from scenegen.datasets.build import holds_benchmark_outputs
-
-    if (out / "experiments").is_dir() and (out / "index.html").exists():
+    if (out / "manifest.json").exists():
+        raise ConfigError(f"-o {out}: is a dataset folder (manifest.json); choose another folder")
+    if holds_report(out):
         raise ConfigError(
             f"-o {out}: holds a report of `scenegen experiment all`; choose another folder"
         )
@@ -235,7 +226,9 @@ def run_experiment(
     ------
     ConfigError
         Unknown experiment or method (listing the valid ones), bad runs/scenes/jobs/seed, an
-        override a chosen method does not accept, or an unreachable scheduler.
+        override a chosen method does not accept, an unreachable scheduler, or an
+        ``out_dir`` holding a dataset, a benchmark's outputs, another experiment's results
+        or a report of ``scenegen experiment all``.
     """
     exp = get(name)
     if jobs is not None and jobs < 1:

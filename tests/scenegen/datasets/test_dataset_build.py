@@ -265,6 +265,7 @@ def test_validate_draws_every_entry_again(reference, tmp_path):
         (lambda m: m["axes"][0]["values"].append([9]), "does not have its family_digest"),
         (lambda m: m["resolved"]["set"].pop(), "does not have its family_digest"),
         (lambda m: m.update(seed="1"), "seed must be a non-negative integer"),
+        (lambda m: m.update(seed=2**64), "seed must be a non-negative integer below 2**64"),
     ],
 )
 def test_validate_checks_the_header_against_its_family(reference, tmp_path, edit, needle):
@@ -351,6 +352,69 @@ def test_select_keeps_both_conditions_on_one_parameter(reference):
     assert ds.select({"clutter[0].count": 0}, count=6).entries == []
     both = ds.select({"clutter[0].count": (0, 6)}, count=6)
     assert [e["index"] for e in both.entries] == [1, 3, 5]
+
+
+def _fake_dataset():
+    from scenegen.datasets.reader import Dataset
+
+    params = ["size", "count", "kind", "motion"]
+    entries = [
+        {"index": i, "n_frames": 4,
+         "params": {"size": [10 + i, 10 + i], "count": i, "kind": ["uniform", "noise"][i % 2],
+                    "motion": {"x": i}}}
+        for i in range(3)
+    ]  # fmt: skip
+    return Dataset(Path("nowhere"), {"params": params}, entries)
+
+
+def test_select_takes_lists_dicts_and_sets_of_them():
+    # Sets of list values and ranges against dicts raised raw TypeErrors.
+    ds = _fake_dataset()
+
+    def idx(d):
+        return [e["index"] for e in d.entries]
+
+    assert idx(ds.select(size=[11, 11])) == [1] == idx(ds.select(size=(11, 11)))
+    assert idx(ds.select(size={(10, 10), (12, 12)})) == [0, 2]
+    assert idx(ds.select(motion={"x": 2})) == [2]
+    assert idx(ds.select(count=(1, None), kind={"uniform"})) == [2]
+    assert idx(ds.select(motion=(0, 5))) == []  # a dict is not in a range
+    assert idx(ds.select(count=[1])) == []  # a list is a value, not a set of values
+
+
+@pytest.mark.parametrize(
+    ("call", "message"),
+    [
+        (lambda ds: ds.select(count=("a", 3)), "select: count=('a', 3): a range (low, high) "
+         "takes numbers or None; give a set for several accepted values"),
+        (lambda ds: ds.select(kind=([1], None)), "select: kind=([1], None): a range"),
+        (lambda ds: ds.select(["count"]), "select: where must be a dict of parameter names"),
+        (lambda ds: ds.samples(clip=2.5), "clip must be an integer >= 1 or None, got 2.5"),
+        (lambda ds: ds.samples(clip="3"), "clip must be an integer >= 1 or None, got '3'"),
+        (lambda ds: ds.samples(clip=True), "clip must be an integer >= 1 or None, got True"),
+        (lambda ds: ds.samples(clip=2, stride=1.5), "stride must be an integer >= 1 or None"),
+        (lambda ds: ds.samples(clip=0), "clip must be an integer >= 1 or None, got 0"),
+        (lambda ds: ds.samples(gt=["box"]), "gt must be 'box' or 'visible_box', got ['box']"),
+    ],
+)  # fmt: skip
+def test_bad_select_or_samples_arguments_are_one_line(call, message):
+    with pytest.raises(ConfigError) as info:
+        call(_fake_dataset())
+    assert str(info.value).startswith(message) and "\n" not in str(info.value)
+
+
+def test_samples_take_numpy_integers():
+    import numpy as np
+
+    samples = _fake_dataset().samples(clip=np.int64(2), stride=np.int32(1))
+    assert len(samples) == 3 * 3 and samples.clip == 2 and type(samples.clip) is int
+
+
+def test_a_seed_beyond_64_bits_is_refused_before_any_work(tmp_path):
+    with pytest.raises(ConfigError, match=r"^--seed must be an integer in \[0, 2\*\*64 - 1\], "
+                       r"got 18446744073709551616$"):  # fmt: skip
+        build_dataset(TINY, tmp_path / "ds", jobs=1, seed=2**64)
+    assert not (tmp_path / "ds").exists()
 
 
 def test_a_scheduler_without_workers_is_one_line_not_a_hang(monkeypatch):

@@ -436,3 +436,175 @@ def test_a_sequence_with_no_target_at_frame_0_is_recorded_unscored(tmp_path, cap
     assert board["sequences"] == 3  # the scored ones
     assert main(["validate", str(tmp_path / "b"), "--deep"]) == 0
     assert "valid benchmark folder" in capsys.readouterr().out
+
+
+def _forged(reference, out, forge):
+    """A copy of ``reference`` at ``out`` whose records ``forge`` changes (given the list of
+    records, it edits them or returns another list), every record resealed and every output
+    written again from them: sound digests and consistent pages."""
+    from scenegen.io.sealed import read_sealed_json, write_sealed_json
+    from scenegen.lab.benchmark import run_file, write_outputs
+    from scenegen.lab.benchmark_outputs import read_record
+
+    shutil.copytree(reference, out)
+    res = read_sealed_json(out / "results.json")
+    recs = [read_record(out / e.split(" ")[0]) for e in res["records"]]
+    recs = forge(recs) or recs
+    for rec in recs:
+        write_sealed_json(out / run_file(rec["key"]["tracker"], rec["key"]["index"]), rec)
+    write_outputs(out, res["dataset"], res["trackers"], recs)
+    return out
+
+
+def test_a_forged_benchmark_folder_is_invalid(dataset, reference, tmp_path, capsys):
+    # Each was "valid benchmark folder", even with --deep: the records were trusted for
+    # their own keys. They are checked against results.json's trackers and the dataset's
+    # count (and with --deep, against the manifest), and a built-in tracker is deterministic.
+    from scenegen.cli import main
+    from scenegen.lab.benchmark_outputs import check_benchmark
+
+    def swap(recs):  # sok's runs on sequences 0 and 1 exchanged, each kept at its index
+        a, b = recs[0], recs[1]
+        for k in ("name", "file", "seed", "frames_digest"):
+            a["key"][k], b["key"][k] = b["key"][k], a["key"][k]
+        for k in ("scores", "sequence_params", "tracker_seed", "targets", "n_frames"):
+            a[k], b[k] = b[k], a[k]
+
+    def nondeterministic(recs):  # --deep would skip the edited run
+        recs[5]["deterministic"] = False
+        recs[5]["scores"]["auc"] = 0.999
+
+    out = _forged(reference, tmp_path / "swap", swap)
+    assert check_benchmark(out) == []  # needs the manifest
+    assert main(["validate", str(out), "--deep"]) == 1
+    assert capsys.readouterr().err.splitlines() == [
+        f"{out / 'runs' / 'sok' / f'0000{i}.json'}: its key is not the run of 'sok' on "
+        f"sequence {i} of {dataset.resolve()} (frames_digest, name, seed differ)"
+        for i in (0, 1)
+    ]  # fmt: skip
+    out = _forged(reference, tmp_path / "drop", lambda recs: recs[:-1])
+    assert main(["validate", str(out), "--deep"]) == 1
+    assert capsys.readouterr().err.strip() == (
+        f"{out / 'results.json'}: lists no run of 'annealed' on sequence 3; each tracker "
+        "runs once on each of the dataset's 4 sequences")  # fmt: skip
+    out = _forged(reference, tmp_path / "nondet", nondeterministic)
+    assert main(["validate", str(out), "--deep"]) == 1
+    assert capsys.readouterr().err.strip() == (
+        f"{out / 'runs/annealed/00001.json'}: says the built-in tracker 'annealed' is not "
+        "deterministic (every built-in tracker is)")  # fmt: skip
+    out = _forged(reference, tmp_path / "twice", lambda recs: [*recs, recs[0]])
+    assert check_benchmark(out) == [f"{out / 'results.json'}: lists the run "
+                                    "runs/sok/00000.json twice"]  # fmt: skip
+    out = _forged(reference, tmp_path / "order", lambda recs: [recs[1], recs[0], *recs[2:]])
+    assert check_benchmark(out) == [f"{out / 'results.json'}: lists the runs out of their "
+                                    "order (trackers as listed, then sequences)"]  # fmt: skip
+
+
+def test_an_experiment_all_report_and_a_benchmark_do_not_overwrite_each_other(
+        dataset, reference, tmp_path, capsys, monkeypatch):  # fmt: skip
+    # Each exited 0 after replacing the other's results.json and index.html.
+    from scenegen.cli import main
+    from scenegen.lab import report
+
+    monkeypatch.setattr(report, "names", lambda: [])  # `experiment all` of no experiment
+    rep = tmp_path / "rep"
+    report.build_report(rep)  # what `experiment all` leaves: results.json {"experiments"}
+    before = files(rep)
+    assert main(["benchmark", str(dataset), "--tracker", "kalman", "-o", str(rep)]) == 2
+    assert capsys.readouterr().err.strip() == (
+        f"scenegen: error: -o {rep}: holds a report of `scenegen experiment all`; write the "
+        "benchmark into another folder")  # fmt: skip
+    assert files(rep) == before
+    bench = tmp_path / "b"
+    shutil.copytree(reference, bench)
+    assert main(["experiment", "all", "-o", str(bench)]) == 2
+    assert capsys.readouterr().err.strip() == (
+        f"scenegen: error: -o {bench}: holds the outputs of `scenegen benchmark`; write the "
+        "report into another folder")  # fmt: skip
+    assert files(bench) == files(reference)
+    assert main(["experiment", "all", "-o", str(rep)]) == 0  # its own folder: rewritten
+
+
+def test_datasets_and_experiments_are_not_written_into_each_other(dataset, tmp_path, capsys,
+                                                                   monkeypatch):  # fmt: skip
+    from scenegen.cli import main
+    from scenegen.errors import ConfigError
+    from scenegen.lab import report
+
+    exp = tmp_path / "e"
+    (exp / "runs").mkdir(parents=True)
+    (exp / "results.json").write_text('{"experiment": "shm-depth"}')
+    (exp / "table.md").write_text("| a |\n")
+    monkeypatch.setattr(report, "names", lambda: [])
+    rep = tmp_path / "rep"
+    report.build_report(rep)
+    for folder, what in [(exp, "the results of `scenegen experiment`"),
+                         (rep, "a report of `scenegen experiment all`")]:  # fmt: skip
+        before = files(folder)
+        with pytest.raises(ConfigError, match=rf"^-o {folder}: holds {what}; write the "
+                           "dataset into another folder$"):  # fmt: skip
+            build_dataset(FAMILY, folder, jobs=1)
+        assert files(folder) == before
+    data = tmp_path / "ds"
+    shutil.copytree(dataset, data)
+    before = files(data)
+    assert main(["experiment", "shm-depth", "--quick", "--scenes", "1", "--runs", "1",
+                 "--method", "kalman", "-o", str(data)]) == 2  # fmt: skip
+    assert capsys.readouterr().err.strip() == (
+        f"scenegen: error: -o {data}: is a dataset folder (manifest.json); choose another "
+        "folder")  # fmt: skip
+    assert main(["experiment", "all", "-o", str(data)]) == 2
+    assert capsys.readouterr().err.strip() == (
+        f"scenegen: error: -o {data}: is a dataset folder (manifest.json); write the report "
+        "into another folder")  # fmt: skip
+    assert main(["experiment", "all", "-o", str(exp)]) == 2
+    assert "holds the results of `scenegen experiment`; write the report" in (
+        capsys.readouterr().err)  # fmt: skip
+    assert files(data) == before
+
+
+def test_a_benchmark_where_no_sequence_is_scored_says_so(tmp_path, capsys):
+    # It said "best AUC kalman (None)", leaderboard.md had a header row of one empty column,
+    # and index.html said there was no swept axis (there is one).
+    from scenegen.cli import main
+
+    late = {"name": "late", "base": TWO, "count": 2,
+            "set": {"n_frames": 3, "entities[b].appear": 2},
+            "sweep": {"entities[a].appear": [1, 2]}}  # fmt: skip
+    data, out = tmp_path / "ds", tmp_path / "b"
+    build_dataset(late, data, jobs=1)
+    assert main(["benchmark", str(data), "--tracker", "kalman", "--tracker", "sok",
+                 "--jobs", "1", "-o", str(out)]) == 0  # fmt: skip
+    assert capsys.readouterr().err.strip() == (
+        "benchmark: 4 runs; no sequence was scored (none has a target at frame 0)")
+    assert (out / "leaderboard.md").read_text() == (
+        "| rank | tracker | sequences |\n"
+        "|---:|---|---:|\n"
+        "| 1 | kalman | 0 |\n"
+        "| 2 | sok | 0 |\n\n"
+        "No sequence was scored (none has a target at frame 0): no tracker has a score, and "
+        "the ranks are only the order of the trackers' names.\n")  # fmt: skip
+    page = (out / "index.html").read_text()
+    assert "<p>No figure: no sequence was scored (none has a target at frame 0).</p>" in page
+    assert "No swept or drawn axis" not in page and "Each cell: the mean" not in page
+    assert main(["validate", str(out)]) == 0
+
+
+def test_pages_write_json_cells_and_escape_a_pipe_in_a_trackers_name(reference):
+    import csv
+    import io
+
+    from scenegen.io.sealed import read_sealed_json
+    from scenegen.lab.benchmark import texts
+
+    res = read_sealed_json(reference / "results.json")
+    res["dataset"]["sequence_params"] = ["d", "t", "l", "n", "s"]
+    res["scores"][0]["params"] = {"d": {"b": 2, "a": 1}, "t": True, "l": [1, 2], "n": None,
+                                  "s": "x"}  # fmt: skip
+    res["leaderboard"][0]["tracker"] = "my|t.py:make"
+    got = texts(res)
+    row = next(csv.DictReader(io.StringIO(got["scores.csv"])))  # was Python's repr
+    assert [row[k] for k in "dtlns"] == ['{"a": 1, "b": 2}', "true", "[1, 2]", "", "x"]
+    table = [ln for ln in got["leaderboard.md"].splitlines() if ln.startswith("|")]
+    assert "| my\\|t.py:make |" in table[2]
+    assert len({ln.replace("\\|", "").count("|") for ln in table}) == 1  # one column count
