@@ -96,6 +96,12 @@ class Axis:
     def __len__(self) -> int:
         return len(self.values)
 
+    @property
+    def named(self) -> bool:
+        """A named axis (a mapping in ``sweep``, one field or several): each sequence records
+        its grid position under ``name``, besides its fields' values."""
+        return self.paths != (self.name,)
+
     def level(self, j: int) -> Any:
         """The axis's value at grid position ``j``: that of its field, the one all its
         fields share (``occluder_width``: 36, 44, ...), or the list of its fields' values."""
@@ -288,7 +294,7 @@ class Family:
         sets: list[tuple[str, Any]] = []
         base = self.base
         for axis, j in zip(self.axes, self.grid_point(index), strict=True):
-            if len(axis.paths) > 1:
+            if axis.named:
                 params[axis.name] = j
             for p, v in zip(axis.paths, axis.values[j], strict=True):
                 params[p] = v
@@ -477,7 +483,7 @@ def _kind_name(tp: Any) -> str:
 
 def _setters(axes: Any, vary: list[str]) -> list[tuple[str, str]]:
     """(section, path) of every field path the sweep and vary sections set, in order."""
-    out = [(f"sweep.{a.name}" if len(a.paths) > 1 else "sweep", p)
+    out = [(f"sweep.{a.name}" if a.named else "sweep", p)
            for a in axes for p in a.paths if p != "preset"]  # fmt: skip
     return out + [("vary", p) for p in vary]
 
@@ -585,7 +591,7 @@ def family_from_dict(data: Any, *, source: str = "family", folder: Path | None =
     for a in axes:
         for p in a.paths:
             if p != "preset":
-                _check_path(source, f"sweep.{a.name}" if len(a.paths) > 1 else "sweep", checked, p)
+                _check_path(source, f"sweep.{a.name}" if a.named else "sweep", checked, p)
     dists = []
     for p, spec in vary.items():
         if p == "preset":

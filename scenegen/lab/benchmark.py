@@ -295,9 +295,9 @@ def _tasks(root: Path, man: dict[str, Any], per: dict[str, dict[str, Any]]) -> l
     """
     from scenegen.datasets.build import manifest_axes
 
-    # A named axis (several fields moved together) is recorded by its grid position in the
-    # manifest (what ds.select takes); the records, scores and curves take its value.
-    named = [a for a in manifest_axes(man, root / "manifest.json") if len(a.paths) > 1]
+    # A named axis (a mapping in sweep) is recorded by its grid position in the manifest
+    # (what ds.select takes); the records, scores and curves take its value.
+    named = [a for a in manifest_axes(man, root / "manifest.json") if a.named]
     tasks = []
     for t in per:
         p = tuple(sorted(per[t].items()))

@@ -431,3 +431,32 @@ def test_a_scheduler_without_workers_is_one_line_not_a_hang(monkeypatch):
         from scenegen.datasets.executor import worker_timeout
 
         worker_timeout()
+
+
+def test_a_named_axis_of_one_field_records_its_grid_position(tmp_path):
+    """``sweep: {sz: {path: [...]}}`` is a named axis like one of several fields: each entry
+    records its grid position under ``sz`` (what ``select(sz=...)`` takes). Entries written
+    before round 17 lack it and stay valid."""
+    fam = {**TINY, "sweep": {"sz": {"entities[0].appearance.size": [[10, 10], [12, 12]]}}}
+    out = tmp_path / "ds"
+    build_dataset(fam, out, jobs=1, shard_size=SHARD, count=3)
+    ds = open_dataset(out)
+    assert [e["params"]["sz"] for e in ds.entries] == [0, 1, 0]
+    assert [e["name"] for e in ds.select(sz=1).entries] == ["tiny-00001"]
+    assert validate_dataset(out, deep=True) == []
+
+    def older(man):
+        for e in man["sequences"]:
+            del e["params"]["sz"]
+
+    _edit_manifest(out, older)
+    assert validate_dataset(out, deep=True) == []
+
+    def forged(man):
+        man["sequences"][0]["params"]["entities[0].appearance.size"] = [12, 12]
+
+    path = _edit_manifest(out, forged)
+    assert validate_dataset(out, deep=True) == [
+        f"{path}: entry of tiny-00000: params differs from its sequence "
+        "(params['entities[0].appearance.size']: [12, 12] in the manifest, [10, 10] drawn)"
+    ]
