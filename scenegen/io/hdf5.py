@@ -204,13 +204,16 @@ def _dataset(g: h5py.Group, f: Field, *, name: str | None = None, **kwargs: Any)
     for key, value in dataset_attrs(f).items():
         put_text(ds, key, value)
     if data is not None:
-        _digest(ds, digest(data))
+        _digest(ds, digest(data), f)
     return ds
 
 
-def _digest(ds: h5py.Dataset, hexdigest: str) -> None:
+def _digest(ds: h5py.Dataset, hexdigest: str, f: Field | None = None) -> None:
+    """Store the values' digest and the attributes' digest of a dataset made by
+    :func:`_dataset`; given its field ``f``, the attributes' digest is computed from
+    ``dataset_attrs(f)`` (what :func:`_dataset` wrote), not read back."""
     put_text(ds, DIGEST, hexdigest)
-    put_attrs_digest(ds)
+    put_attrs_digest(ds, None if f is None else dataset_attrs(f))
 
 
 def _hashers(*datasets: h5py.Dataset) -> dict[str, Hasher]:
@@ -280,16 +283,14 @@ def _write_gt(g: h5py.Group, gt: dict[str, NDArray[Any]]) -> None:
         arr = np.asarray(gt[key], dtype=GT_FIELDS[key])
         if ds.size:
             ds[...] = arr
-        _digest(ds, digest(arr.astype(ds.dtype)))
+        _digest(ds, digest(arr.astype(ds.dtype)), field(f"gt/{key}"))
 
 
 def _write_templates(g: h5py.Group, templates: dict[int, NDArray[np.uint8]]) -> None:
-    g.create_group("templates")
+    group = g.create_group("templates")
     f = field("templates/<id>")
     for eid, tpl in templates.items():
-        arr = np.asarray(tpl, dtype=np.uint8)
-        name = f"templates/{int(eid)}"
-        _dataset(g, f, name=name, data=arr)
+        _dataset(group, f, name=str(int(eid)), data=np.asarray(tpl, dtype=np.uint8))
 
 
 def _meta(seq: Sequence) -> dict[str, Any]:

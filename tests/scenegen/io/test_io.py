@@ -9,7 +9,7 @@ import pytest
 import scenegen
 from scenegen.errors import DataError
 from scenegen.io import LazyArray, TrackerResult, read, read_result, write, write_result
-from scenegen.io.integrity import as_text
+from scenegen.io.integrity import as_text, attrs_digest, put_attrs_digest, put_text
 from scenegen.io.validate import check_file
 
 
@@ -118,3 +118,23 @@ def test_result_round_trip(tmp_path):
         g = f["results/shm"]
         assert g["boxes"].dtype == np.float32 and g["orderings"].dtype == np.int16
         assert g["order_prob"].shape == (4, 2)
+
+
+@pytest.mark.parametrize("value", ["", "plain", "é ∑ 漢字", "x" * 5000])
+def test_put_text_is_the_attribute_h5py_makes_and_replaces(tmp_path, value):
+    """put_text's low-level path stores what ``attrs.create`` with the fixed-length UTF-8
+    dtype stores (type, value, read-back), replaces an existing attribute, and the
+    attributes' digest computed from the texts equals the one read back."""
+    raw = value.encode("utf-8")
+    with h5py.File(tmp_path / "a.h5", "w") as f:
+        ref = f.create_dataset("ref", data=np.zeros(2))
+        ours = f.create_dataset("ours", data=np.zeros(2))
+        ref.attrs.create("k", np.bytes_(raw), dtype=h5py.string_dtype("utf-8", max(1, len(raw))))
+        put_text(ours, "k", "old value, replaced")
+        put_text(ours, "k", value)
+        assert list(ours.attrs) == ["k"]
+        assert ours.attrs.get_id("k").get_type() == ref.attrs.get_id("k").get_type()
+        assert as_text(ours.attrs["k"]) == value
+        assert repr(ours.attrs["k"]) == repr(ref.attrs["k"])
+        put_attrs_digest(ours, {"k": value})
+        assert as_text(ours.attrs["attrs_sha256"]) == attrs_digest(ref.attrs)
