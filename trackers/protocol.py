@@ -41,7 +41,9 @@ class EstimateLike(Protocol):
 class Tracker(Protocol):
     """A tracker: ``init(frame, boxes)`` on the first frame, then ``step(frame)``.
 
-    ``isinstance(obj, trackers.Tracker)`` is True for any object with both methods.
+    ``isinstance(obj, trackers.Tracker)`` is True for any object with both methods (a
+    tracker *class* too: ``trackers.track`` and ``scenegen track`` refuse a class, naming
+    it).
     """
 
     def init(self, frame: Any, boxes: Any) -> None:

@@ -137,8 +137,13 @@ def track(
         If ``frames`` is empty, ``init_boxes`` is not (K, 4), or an estimate breaks the
         protocol (naming the frame).
     TypeError
-        If ``tracker`` lacks ``init`` or ``step``.
+        If ``tracker`` lacks ``init`` or ``step``, or is a class rather than an instance.
     """
+    if isinstance(tracker, type):  # a class has init and step too, unbound
+        raise TypeError(
+            f"{tracker.__name__} is a class, not a tracker: pass an instance, "
+            f"{tracker.__name__}(...)"
+        )
     if not isinstance(tracker, Tracker):
         missing = [m for m in ("init", "step") if not callable(getattr(tracker, m, None))]
         raise TypeError(

@@ -219,11 +219,11 @@ def regen(
     import trackers
 
     root = default_dir() if folder is None else Path(folder)
-    make_output_folder(root)
-    reg = load_registry(root, missing_ok=True)
     defs = definitions()
     names = select_names(fixtures, "fixture", defs)
     tnames = select_names(tracker_names, "tracker", trackers.names())
+    make_output_folder(root)  # only once the names are known good: no empty folder left
+    reg = load_registry(root, missing_ok=True)
     held = reg.get("fixtures", {})
     # A damaged registry is rebuilt: its entries are only what the files are checked by.
     entries: dict[str, Any] = {

@@ -176,6 +176,11 @@ def make_tracker(tracker: TrackerSpec, params: dict[str, Any], seed: int) -> Any
             f"tracker {label!r} failed while being built: {type(err).__name__}: "
             f"{_first_line(err)} (rerun with --debug for its traceback)"
         ) from err
+    if isinstance(obj, type):  # a class has init and step too, unbound
+        raise ConfigError(
+            f"tracker {label!r} returned the class {obj.__name__}, not a tracker "
+            f"(return an instance, {obj.__name__}(...))"
+        )
     if not isinstance(obj, trackers.Tracker):
         missing = [m for m in ("init", "step") if not callable(getattr(obj, m, None))]
         raise ConfigError(

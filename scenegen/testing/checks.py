@@ -49,7 +49,8 @@ class Options:
     Attributes
     ----------
     seed : int
-        First seed given to the factory (``rng=seed``) when it accepts ``rng``.
+        First seed (>= 0, a seed of ``numpy.random.default_rng``) given to the factory
+        (``rng=seed``) when it accepts ``rng``.
     deterministic, handles_occlusion : bool or None
         The tracker's claims; None: read the tracker's attribute of that name (defaults
         True and False).
@@ -75,8 +76,12 @@ class Options:
     checks: tuple[str, ...] | None = None
 
     def __post_init__(self) -> None:
-        if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)):
-            raise ValueError(f"seed must be an integer, got {self.seed!r}")
+        if (
+            isinstance(self.seed, bool)
+            or not isinstance(self.seed, (int, np.integer))
+            or self.seed < 0
+        ):
+            raise ValueError(f"seed must be an integer >= 0, got {self.seed!r}")
         if (
             isinstance(self.repeats, (bool, np.bool_))
             or not isinstance(self.repeats, numbers.Integral)
@@ -175,6 +180,7 @@ def _run(tracker: Any, frames: NDArray[np.uint8], init: NDArray[np.float64]) -> 
         raise
     except BaseException as err:  # a SystemExit too: the tracker failing, not a pass
         run.error = f"init raised {type(err).__name__}: {first_line(err)}"
+        run.error += _writes_hint(lambda f: tracker.init(f, init.copy()), frames[0])
         return run
     for t in range(1, len(frames)):
         try:
@@ -183,6 +189,7 @@ def _run(tracker: Any, frames: NDArray[np.uint8], init: NDArray[np.float64]) -> 
             raise
         except BaseException as err:
             run.error = f"step at frame {t} raised {type(err).__name__}: {first_line(err)}"
+            run.error += _writes_hint(tracker.step, frames[t])
             return run
         boxes = getattr(est, "boxes", None)
         if boxes is None:
@@ -208,6 +215,25 @@ def _run(tracker: Any, frames: NDArray[np.uint8], init: NDArray[np.float64]) -> 
         out[t] = arr
     run.boxes = out
     return run
+
+
+def _writes_hint(call: Callable[[Any], Any], frame: NDArray[np.uint8]) -> str:
+    """After ``call(frame)`` raised on a read-only frame: a hint if the call, repeated on
+    a writable copy, writes into it (OpenCV's error for a read-only array does not say
+    so), else ``""``."""
+    copy = np.array(frame, copy=True)
+    try:
+        call(copy)
+    except (KeyboardInterrupt, GeneratorExit):
+        raise
+    except BaseException:
+        pass
+    if np.array_equal(copy, frame):
+        return ""
+    return (
+        " (it writes into its input frame, which is read-only here: frames are shared, "
+        "copy one before drawing on it)"
+    )
 
 
 def first_line(err: BaseException) -> str:
@@ -391,6 +417,11 @@ def check_protocol(factory: Callable[..., Any], opts: Options) -> str:
         raise AssertionError(
             f"the factory raised {type(err).__name__}: {first_line(err)}"
         ) from None
+    if isinstance(tracker, type):  # a class has init and step too, unbound
+        raise AssertionError(
+            f"the factory returned the class {tracker.__name__}, not a tracker (return an "
+            f"instance, {tracker.__name__}(...))"
+        )
     missing = [m for m in ("init", "step") if not callable(getattr(tracker, m, None))]
     if missing:
         raise AssertionError(
@@ -475,6 +506,8 @@ def _judge(opts: Options, name: str, one: Callable[[int], str | None]) -> str:
         if len(seeds) == 1:
             raise AssertionError(failures[0][1])
         detail = "; ".join(f"seed {s}: {why}" for s, why in failures[:3])
+        if len(failures) > 3:
+            detail += f"; and {len(failures) - 3} more failing runs"
         raise AssertionError(
             f"passed {len(seeds) - len(failures)} of {len(seeds)} runs, "
             f"below the required rate {opts.min_pass_rate:g}: {detail}"
@@ -516,6 +549,32 @@ def check_translation_equivariance(factory: Callable[..., Any], opts: Options) -
     return _judge(opts, f"equivariant within {opts.equivariance_tol:g} px", one)
 
 
+#: Box conventions a tracker may return by mistake, and their [x, y, w, h] boxes.
+_CONVENTIONS: dict[str, Callable[[NDArray[np.float64]], NDArray[np.float64]]] = {
+    "[cx, cy, w, h] (centre)": lambda b: np.concatenate(
+        [b[..., :2] - b[..., 2:] / 2, b[..., 2:]], axis=-1
+    ),
+    "[x0, y0, x1, y1] (corners)": lambda b: np.concatenate(
+        [b[..., :2], b[..., 2:] - b[..., :2]], axis=-1
+    ),
+    "[y, x, h, w] (row first)": lambda b: b[..., [1, 0, 3, 2]],
+}
+
+
+def _convention_hint(
+    boxes: NDArray[np.float64], gt: NDArray[np.float64], threshold: float
+) -> str:
+    """If ``boxes`` (T, K, 4), read in another convention, keep IoU >= ``threshold``
+    with ``gt`` every frame: a phrase naming that convention, else ``""``."""
+    for name, convert in _CONVENTIONS.items():
+        if _iou(convert(boxes), gt).min() >= threshold:
+            return (
+                f"; read as {name} the boxes would match: a box is [x, y, w, h], "
+                "(x, y) its top-left corner"
+            )
+    return ""
+
+
 def _iou_check(
     factory: Callable[..., Any], opts: Options, scene: str, frames_from: int, what: str
 ) -> str:
@@ -531,7 +590,7 @@ def _iou_check(
             return (
                 f"IoU fell to {float(iou.min()):.2f} (first below {opts.iou_threshold:g} "
                 f"at frame {t} of {len(frames)})"
-            )
+            ) + _convention_hint(run.boxes[frames_from:], gt[frames_from:], opts.iou_threshold)
         return None
 
     return _judge(opts, what, one)

@@ -12,7 +12,8 @@ runs the named checks of :data:`CHECKS` on small generated scenes:
     It runs without exception on every edge-case built-in fixture (``single-frame``,
     ``one-pixel``, ``enter-leave``, ``full-occlusion``, ``distractor-on-target``),
     started from the ground-truth boxes of the targets present at frame 0. Frames are
-    passed read-only, so a tracker writing into its input fails here.
+    passed read-only, so a tracker writing into its input fails here (and the message
+    says so, whatever error the write raised).
 ``boxes``
     On those runs, and on a scene of two targets (K = 2), every estimate's ``boxes`` has
     shape (K, 4) and each row is either finite or all NaN (a lost target).
@@ -30,11 +31,16 @@ runs the named checks of :data:`CHECKS` on small generated scenes:
     ``iou_threshold`` in each of the last 4 frames (only if the tracker claims it:
     ``handles_occlusion`` attribute, default False, or the ``handles_occlusion`` option).
 
+When boxes that fail ``keeps_lone_target`` or ``recovers_after_occlusion`` would pass
+read as [cx, cy, w, h], [x0, y0, x1, y1] or [y, x, h, w], the message names that
+convention.
+
 A stochastic tracker is judged over ``repeats`` runs (seeds ``seed``, ``seed + 1``, ...):
 the behavioural checks (equivariance, lone target, occlusion) pass when at least
-``min_pass_rate`` of the runs pass, and their messages give the rate and each failing
-run. ``check_tracker(..., report=True)`` returns a :class:`ConformanceReport` instead of
-raising; :func:`parametrize_with_checks` makes one pytest test per tracker and check.
+``min_pass_rate`` of the runs pass, and their messages give the rate and the first three
+failing runs (and how many more). ``check_tracker(..., report=True)`` returns a
+:class:`ConformanceReport` instead of raising; :func:`parametrize_with_checks` makes one
+pytest test per tracker and check.
 
 Example
 -------

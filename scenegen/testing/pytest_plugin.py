@@ -387,6 +387,37 @@ def _check_key(key: Any) -> PurePosixPath:
     return p
 
 
+def _marker_tolerance(marker: pytest.Mark) -> tuple[float, float]:
+    """``(atol, rtol)`` of a ``scenegen_tolerance(atol=0.0, rtol=0.0)`` marker, whose
+    arguments bind like a function's (``scenegen_tolerance(0.5)`` is ``atol=0.5``).
+
+    Raises
+    ------
+    ValueError
+        One line naming the marker and the argument at fault (an unknown or extra one,
+        or a value that is not a number >= 0).
+    """
+    import inspect
+
+    def signature(atol: Any = 0.0, rtol: Any = 0.0) -> None:
+        """The marker's arguments."""
+
+    try:
+        bound = inspect.signature(signature).bind(*marker.args, **marker.kwargs)
+    except TypeError as err:
+        raise ValueError(f"scenegen_tolerance marker (atol=0.0, rtol=0.0): {err}") from None
+    bound.apply_defaults()
+    out = []
+    for name, value in bound.arguments.items():
+        number = value if isinstance(value, (int, float, np.integer, np.floating)) else None
+        if isinstance(value, (bool, np.bool_)) or number is None or not number >= 0:
+            raise ValueError(
+                f"scenegen_tolerance marker: {name} must be a number >= 0, got {value!r}"
+            )
+        out.append(float(number))
+    return out[0], out[1]
+
+
 @pytest.fixture
 def scenegen_expect(request: pytest.FixtureRequest) -> Callable[..., None]:
     """``scenegen_expect(key, array, atol=None, rtol=None)``: compare with (or, under
@@ -394,8 +425,7 @@ def scenegen_expect(request: pytest.FixtureRequest) -> Callable[..., None]:
     folder = _fixtures_dir(request.config) / "expected"
     regen = bool(request.config.getoption("--scenegen-regen"))
     marker = request.node.get_closest_marker("scenegen_tolerance")
-    default_atol = float(marker.kwargs.get("atol", 0.0)) if marker else 0.0
-    default_rtol = float(marker.kwargs.get("rtol", 0.0)) if marker else 0.0
+    default_atol, default_rtol = _marker_tolerance(marker) if marker else (0.0, 0.0)
     written = request.config.stash[_written_key]
 
     def check(key: str, actual: Any, atol: float | None = None, rtol: float | None = None) -> None:

@@ -63,6 +63,10 @@ def test_track_rejects_a_non_tracker_and_bad_boxes():
         trackers.track(SimpleNamespace(init=lambda f, b: None), _frames(), [[1, 1, 2, 2]])
     with pytest.raises(ValueError, match=r"init_boxes must have shape \(K, 4\)"):
         trackers.track(Still(), _frames(), [[1, 2, 3]])
+    # A class has init and step too (isinstance(Still, Tracker) is True): it was run and
+    # failed with "Still.init() missing 1 required positional argument: 'boxes'".
+    with pytest.raises(TypeError, match=r"Still is a class, not a tracker: pass an instance"):
+        trackers.track(Still, _frames(), [[1, 1, 2, 2]])
 
 
 def test_track_stacks_extras_and_names_a_missing_key():

@@ -38,6 +38,9 @@ USER_MODULE = textwrap.dedent(
 
     not_callable = 3
 
+    def forgot_call():
+        return Still
+
     def broken():
         return object()
 
@@ -148,6 +151,8 @@ def test_track_runs_a_users_factory(user_dir, monkeypatch, capsys):
         (["--tracker", "nomodule_xyz:make"], "cannot import nomodule_xyz: ModuleNotFoundError"),
         (["--tracker", "usertrk:not_callable"], "not_callable is not callable"),
         (["--tracker", "usertrk:broken"], "returned a object, which has no init or step"),
+        # Was exit 1, "Still.init() missing 1 required positional argument: 'boxes'".
+        (["--tracker", "usertrk:forgot_call"], "returned the class Still, not a tracker"),
         (["--tracker", "usertrk:make", "--param", "bogus=1"], "unexpected keyword argument"),
         (["--tracker", "dps", "--param", "n_particles=abc"], "n_particles must be an integer"),
         (["--tracker", "missing.py:make"], "no such file missing.py"),

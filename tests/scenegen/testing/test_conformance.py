@@ -62,6 +62,14 @@ def test_not_a_tracker_fails_protocol_and_skips_the_rest():
     assert {r.status for r in report.results[1:]} == {"skipped"}
 
 
+def test_a_factory_returning_a_class_fails_protocol():
+    # A class has init and step (unbound): it passed protocol, then every run raised
+    # "Still.init() missing 1 required positional argument: 'boxes'".
+    report = check_tracker(lambda: Still, report=True)
+    assert report.status("protocol") == "failed"
+    assert "the factory returned the class Still, not a tracker" in str(report), str(report)
+
+
 def test_exceptions_name_the_fixture_and_frame():
     class Fragile(Still):
         def init(self, frame, boxes):
@@ -113,6 +121,29 @@ def test_writing_into_the_frames_fails():
 
     report = check_tracker(Scribbler, report=True, checks="edge_fixtures")
     assert "read-only" in report.results[0].message
+
+
+def test_drawing_on_the_frames_with_opencv_is_named():
+    # OpenCV's own error for a read-only array says only "Bad argument in function
+    # 'rectangle'": the message now says the tracker writes into its input frame.
+    import cv2
+
+    class Overlay(Still):
+        def step(self, frame):
+            cv2.rectangle(frame, (0, 0), (3, 3), (255, 0, 0), 1)
+            return super().step(frame)
+
+    message = check_tracker(Overlay, report=True, checks="edge_fixtures").results[0].message
+    assert "in function 'rectangle' (it writes into its input frame" in message, message
+    message = check_tracker(Overlay, report=True, checks="keeps_lone_target").results[0].message
+    assert "(it writes into its input frame" in message, message
+
+    class Crashes(Still):  # raises without writing: no such hint
+        def step(self, frame):
+            raise IndexError("boom")
+
+    message = check_tracker(Crashes, report=True, checks="edge_fixtures").results[0].message
+    assert "boom" in message and "writes into" not in message
 
 
 @pytest.mark.parametrize(
@@ -174,6 +205,39 @@ def test_a_rate_over_repeats_judges_a_stochastic_tracker():
     assert strict.results[0].message.startswith(
         "passed 2 of 4 runs, below the required rate 0.75: seed 1: IoU fell to"
     )
+    # Three failing runs are given, and how many more there were (were silently left out).
+    many = check_tracker(OddSeedsDrift, report=True, **{**opts, "repeats": 10})
+    message = many.results[0].message
+    assert message.startswith("passed 5 of 10 runs") and message.count("seed ") == 3
+    assert message.endswith("; and 2 more failing runs"), message
+
+
+@pytest.mark.parametrize(
+    ("convert", "needle"),
+    [
+        (lambda b: np.hstack([b[:, :2] + b[:, 2:] / 2, b[:, 2:]]), "[cx, cy, w, h] (centre)"),
+        (lambda b: np.hstack([b[:, :2], b[:, :2] + b[:, 2:]]), "[x0, y0, x1, y1] (corners)"),
+        (lambda b: b[:, [1, 0, 3, 2]], "[y, x, h, w] (row first)"),
+    ],
+)
+def test_boxes_in_another_convention_are_named(convert, needle):
+    # Were only "IoU fell to 0.14": nothing said the boxes were right in another convention.
+    class OtherConvention(Follower):
+        def step(self, frame):
+            return SimpleNamespace(boxes=convert(super().step(frame).boxes))
+
+    assert check_tracker(Follower, report=True, checks="keeps_lone_target").passed
+    message = check_tracker(OtherConvention, report=True, checks="keeps_lone_target").results[
+        0
+    ].message
+    assert message.startswith("IoU fell to") and (
+        f"read as {needle} the boxes would match: a box is [x, y, w, h]" in message
+    ), message
+
+
+def test_a_tracker_that_loses_its_target_gets_no_convention_hint():
+    message = check_tracker(Still, report=True, checks="keeps_lone_target").results[0].message
+    assert message.startswith("IoU fell to") and "read as" not in message, message
 
 
 def test_equivariance_failure_names_the_shift():
@@ -211,6 +275,8 @@ def test_occlusion_check_runs_where_claimed():
         ({"iou_threshold": None}, "iou_threshold must be a number, got None"),
         ({"equivariance_tol": "1"}, "equivariance_tol must be a number"),
         ({"deterministic": "false"}, "deterministic must be True, False or None, got 'false'"),
+        # Was every check failing as "the factory raised ValueError" (a numpy seed < 0).
+        ({"seed": -1}, "seed must be an integer >= 0, got -1"),
     ],
 )
 def test_bad_options_are_named(kw, needle):

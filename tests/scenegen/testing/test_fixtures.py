@@ -125,6 +125,13 @@ def test_cli_errors_are_one_line(tmp_path, capsys):
     assert main(["fixtures", "regen", "--dir", str(tmp_path), "--fixture", "nope"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "unknown fixture 'nope'" in err[0]
+    # A user's own tracker is not a fixture tracker; the refused command leaves no empty
+    # folder behind (it was created before the names were checked).
+    new = tmp_path / "new"
+    assert main(["fixtures", "regen", "--dir", str(new), "--tracker", "mytrack:make"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "unknown tracker 'mytrack:make'" in err[0]
+    assert not new.exists()
 
 
 def test_edge_cases_exercise_what_they_claim():

@@ -197,6 +197,48 @@ def test_markers_are_registered_and_applied(pytester):
     listed.stdout.fnmatch_lines(["@pytest.mark.scenegen:*", "@pytest.mark.scenegen_tolerance*"])
 
 
+def test_the_tolerance_marker_binds_like_a_function_and_refuses_what_it_cannot_use(pytester):
+    # scenegen_tolerance(0.5) is atol=0.5; an unknown or bad argument was silently
+    # ignored (exact comparison) before.
+    pytester.makepyfile(
+        test_marker="""
+        import numpy as np
+        import pytest
+
+        SHIFT = 0.0
+
+        @pytest.mark.scenegen_tolerance(0.5)
+        def test_positional(scenegen_expect):
+            scenegen_expect("pos", np.array([1.0 + SHIFT]))
+
+        @pytest.mark.scenegen_tolerance(0.0, 0.5)
+        def test_positional_rtol(scenegen_expect):
+            scenegen_expect("rel", np.array([1.0 + SHIFT]))
+
+        @pytest.mark.scenegen_tolerance(tol=0.5)
+        def test_unknown(scenegen_expect):
+            scenegen_expect("unknown", np.array([1.0]))
+
+        @pytest.mark.scenegen_tolerance(atol=-1)
+        def test_negative(scenegen_expect):
+            scenegen_expect("negative", np.array([1.0]))
+        """
+    )
+    pytester.runpytest("-q", "--scenegen-regen").assert_outcomes(passed=2, errors=2)
+    pytester.makepyfile(test_marker=pytester.path.joinpath("test_marker.py").read_text()
+                        .replace("SHIFT = 0.0", "SHIFT = 0.25"))  # fmt: skip
+    result = pytester.runpytest("-q")
+    result.assert_outcomes(passed=2, errors=2)
+    result.stdout.fnmatch_lines(
+        [
+            "*scenegen_tolerance marker (atol=0.0, rtol=0.0): got an unexpected keyword "
+            "argument 'tol'",
+            "*scenegen_tolerance marker: atol must be a number >= 0, got -1",
+        ],
+        consecutive=False,
+    )
+
+
 def test_expectation_keys_must_stay_inside_the_folder(pytester):
     pytester.makepyfile(
         test_keys="""
