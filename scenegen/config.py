@@ -455,7 +455,8 @@ class Camera:
     with ``|dx| <= ex``, ``|dy| <= ey``. The offset follows ``x`` and ``y`` (AR2 from 0 with
     initial ``velocity``; their boundary applies at the extent; ``margin`` is ignored) or
     the scripted ``keyframes`` ((frame, dx, dy), linear in between and held after the
-    last). Every ground-truth field is in the coordinates of the rendered frame.
+    last; an offset beyond the extent is refused). Every ground-truth field is in the
+    coordinates of the rendered frame.
 
     ``zoom`` (AR2 of the log zoom from 0; ``margin`` bounds ``|log zoom|``, 0 means the
     limits 1/2 and 2) magnifies the view about the frame centre: a scene point p appears
@@ -478,6 +479,13 @@ class Camera:
         if self.keyframes and (self.x is not None or self.y is not None):
             _fail("keyframes", "cannot be combined with x or y motion")
         _check_keyframes("keyframes", self.keyframes)
+        for i, (_, dx, dy) in enumerate(self.keyframes):
+            if abs(dx) > self.extent[0] or abs(dy) > self.extent[1]:
+                _fail(
+                    f"keyframes[{i}]",
+                    f"offset ({dx:g}, {dy:g}) is beyond the extent "
+                    f"{_short(list(self.extent))}: the view would leave the background",
+                )
 
 
 @dataclass(frozen=True)
@@ -501,7 +509,9 @@ class Photometric:
         Exposure as a fraction of the frame interval: the visible pixels of each entity
         drawn per frame are smeared along its image velocity (camera motion included)
         over ``motion_blur * |velocity|`` pixels. The static layer (background, clutter,
-        static occluders) is not blurred, unless a zoom makes every entity per-frame.
+        static entities behind every moving one) is not blurred, unless a zoom makes
+        every entity per-frame; a static entity in front of a moving one is drawn per
+        frame, so a camera pan smears it.
     jpeg_quality : int or None
         Compress every frame as JPEG at this quality (1..100).
     """

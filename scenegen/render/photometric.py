@@ -20,6 +20,10 @@ from scenegen.render.motion import ar2_path
 
 __all__ = ["illuminate", "illumination", "jpeg", "line_kernel", "motion_blur"]
 
+_LOG_GAIN_MAX = 700.0
+"""Bound of an unbounded log gain: its exp stays finite (e^710 overflows to inf, and
+0 x inf is NaN: a black pixel would have no defined value)."""
+
 
 def illumination(
     p: Photometric | None, n: int, rng: np.random.Generator
@@ -35,7 +39,8 @@ def illumination(
         return keyframe_values(p.keyframes, n)
     if p.gain is not None:
         lim = p.gain.margin if p.gain.margin > 0 else np.inf
-        gain = np.exp(ar2_path(p.gain, 0.0, 0.0, n, rng=rng, lo=-lim, hi=lim))
+        log_gain = ar2_path(p.gain, 0.0, 0.0, n, rng=rng, lo=-lim, hi=lim)
+        gain = np.exp(np.clip(log_gain, -_LOG_GAIN_MAX, _LOG_GAIN_MAX))
     if p.offset is not None:
         lim = p.offset.margin if p.offset.margin > 0 else np.inf
         offset = ar2_path(p.offset, 0.0, 0.0, n, rng=rng, lo=-lim, hi=lim)
@@ -51,17 +56,33 @@ def illuminate(rgb: NDArray[np.uint8], gain: float, offset: float) -> NDArray[np
 
 
 @lru_cache(maxsize=4096)
-def line_kernel(dx: float, dy: float) -> NDArray[np.float32]:
+def line_kernel(dx: float, dy: float, reach: tuple[int, int] | None = None) -> NDArray[np.float32]:
     """Normalised box kernel along the segment from -(dx, dy)/2 to (dx, dy)/2, shape
-    (2r+1, 2r+1) with r = ceil(max(|dx|, |dy|) / 2) (cached: read-only)."""
+    (2r+1, 2r+1) with r = ceil(max(|dx|, |dy|) / 2) (cached: read-only).
+
+    ``reach`` = (qx, qy) keeps only the central (2 qy + 1, 2 qx + 1) window (where
+    q < r): the weights are still those of the whole segment, and only the samples that
+    fall in the window are drawn, so a smear far longer than the frame costs no more
+    than the window.
+    """
     r = int(np.ceil(max(abs(dx), abs(dy)) / 2))
-    k = np.zeros((2 * r + 1, 2 * r + 1), dtype=np.float32)
+    qx, qy = (r, r) if reach is None else (min(r, reach[0]), min(r, reach[1]))
     n = max(2, int(np.ceil(np.hypot(dx, dy))) * 2 + 1)
-    s = np.linspace(-0.5, 0.5, n)
-    xs = np.clip(np.rint(r + s * dx).astype(np.intp), 0, 2 * r)
-    ys = np.clip(np.rint(r + s * dy).astype(np.intp), 0, 2 * r)
-    np.add.at(k, (ys, xs), 1.0)
-    k /= k.sum()
+    if (qx, qy) == (r, r):
+        s = np.linspace(-0.5, 0.5, n)
+    else:  # the samples at |s| <= smax can land in the window (n may be huge)
+        smax = min((q + 0.5) / abs(d) for q, d in ((qx, dx), (qy, dy)) if d != 0)
+        lo = max(int(np.floor((0.5 - smax) * (n - 1))) - 1, 0)
+        hi = min(int(np.ceil((0.5 + smax) * (n - 1))) + 1, n - 1)
+        s = np.arange(lo, hi + 1) * (1.0 / (n - 1)) - 0.5  # as np.linspace computes
+        if hi == n - 1:
+            s[-1] = 0.5
+    xs = np.rint(r + s * dx).astype(np.int64) - (r - qx)
+    ys = np.rint(r + s * dy).astype(np.int64) - (r - qy)
+    keep = (xs >= 0) & (xs <= 2 * qx) & (ys >= 0) & (ys <= 2 * qy)
+    k = np.zeros((2 * qy + 1, 2 * qx + 1), dtype=np.float32)
+    np.add.at(k, (ys[keep], xs[keep]), 1.0)
+    k /= np.float32(n)
     k.setflags(write=False)
     return k
 
@@ -95,11 +116,12 @@ def motion_blur(
     dy = round(velocity[1] * exposure * 4) / 4
     if max(abs(dx), abs(dy)) < 1.0:
         return
-    kern = line_kernel(dx, dy)
-    r = kern.shape[0] // 2
+    r = int(np.ceil(max(abs(dx), abs(dy)) / 2))
     h, w = lab.shape
     c0, r0 = max(box[0] - r, 0), max(box[1] - r, 0)
     c1, r1 = min(box[2] + r + 1, w), min(box[3] + r + 1, h)
+    # Offsets beyond the region's size carry nothing within it: crop the kernel there.
+    kern = line_kernel(dx, dy, (min(r, c1 - c0 - 1), min(r, r1 - r0 - 1)))
     region = rgb[r0:r1, c0:c1]
     m = (lab[r0:r1, c0:c1] == label).astype(np.float32)
     src = region.astype(np.float32)

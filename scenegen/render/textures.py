@@ -150,10 +150,16 @@ def value_noise(
     for _ in range(octaves):
         gw, gh = int(np.ceil(w / step)) + 2, int(np.ceil(h / step)) + 2
         grid = rng.random((gh, gw), dtype=np.float32)
-        big = cv2.resize(
-            grid, (int(round(gw * step)), int(round(gh * step))), interpolation=cv2.INTER_CUBIC
-        )
-        out += amp * big[:h, :w]
+        bw, bh = int(round(gw * step)), int(round(gh * step))
+        if bw * bh <= 4 * w * h + 2**20:
+            big = cv2.resize(grid, (bw, bh), interpolation=cv2.INTER_CUBIC)[:h, :w]
+        else:
+            # A lattice much coarser than the texture: the 2-D resize would fill
+            # (w + 2 step) x (h + 2 step) to keep w x h. Along x, keep w columns, then
+            # along y: a cost linear in the step (values within a float rounding).
+            rows = cv2.resize(grid, (bw, gh), interpolation=cv2.INTER_CUBIC)[:, :w]
+            big = cv2.resize(np.ascontiguousarray(rows), (w, bh), interpolation=cv2.INTER_CUBIC)[:h]
+        out += amp * big
         total += amp
         amp /= 2
         step = max(step / 2, 1.0)

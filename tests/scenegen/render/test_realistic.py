@@ -29,6 +29,7 @@ from scenegen.config import (
     to_dict,
 )
 from scenegen.errors import ConfigError
+from scenegen.render import photometric
 from scenegen.render.plan import plan
 from scenegen.testing.strategies import scene_configs
 
@@ -123,6 +124,96 @@ def test_motion_blur_smears_along_the_velocity():
     assert np.all(seq.frames[1, :14] == 0)  # no vertical smear
 
 
+
+def test_a_smear_longer_than_the_frame_costs_no_more_than_the_frame():
+    # A kernel as long as the smear (4001 x 4001 floats, 64 MB) was built and filtered
+    # for a 16 x 20 frame; 10^6 px/frame asked for terabytes.
+    import tracemalloc
+
+    lab = np.zeros((16, 20), dtype=np.uint16)
+    lab[6:10, 8:12] = 1
+    rgb = np.zeros((16, 20, 3), dtype=np.uint8)
+    rgb[lab == 1] = 255
+    tracemalloc.start()
+    try:
+        photometric.motion_blur(rgb, lab, 1, (8, 6, 11, 9), (4000.0, 0.0), 1.0)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 2**20, peak
+    # Spread over 4000 px, the entity's colour adds ~4/4001 of 255 next to it.
+    assert rgb[lab == 1].min() >= 254 and rgb[lab == 0].max() <= 1
+
+
+
+def test_an_unbounded_gain_that_grows_past_floats_keeps_black_defined():
+    # The log gain (default a1=2, a2=-1: a drifting velocity, margin 0: unbounded) passed
+    # 710 and exp gave inf: 0 x inf is NaN, cast to uint8 with a RuntimeWarning.
+    import warnings
+
+    cfg = SceneConfig(width=4, height=3, n_frames=3000,
+                      background=Background(kind="uniform", color=(0, 0, 0)),
+                      photometric=Photometric(gain=AR2(boundary="reflect", sigma=1.0),
+                                              offset=AR2(boundary="reflect", a1=0.0, a2=0.0,
+                                                         mean=9.0)))  # fmt: skip
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        scn = plan(cfg, 3)
+        frames = scn.render().frames
+    assert np.all(np.isfinite(scn.gain)) and scn.gain.max() > 1e300
+    np.testing.assert_array_equal(frames[np.argmax(scn.gain)], 9)  # 0 x gain + 9
+
+
+def test_a_noise_scale_far_beyond_the_texture_costs_little():
+    # The lattice was resized whole: (8 + 2 x 2000)^2 floats per octave to keep 8 x 6.
+    import tracemalloc
+
+    import cv2
+
+    from scenegen.render import textures
+
+    tracemalloc.start()
+    try:
+        v = textures.value_noise(8, 6, 2000.0, np.random.default_rng(4))
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 2**22, peak
+    # The same values as the whole 2-D resize, within float rounding.
+    rng, ref = np.random.default_rng(4), np.zeros((6, 8), np.float32)
+    for step, amp in ((2000.0, 1.0), (1000.0, 0.5), (500.0, 0.25)):
+        g = rng.random((3, 3), dtype=np.float32)
+        size = (round(3 * step), round(3 * step))
+        ref += amp * cv2.resize(g, size, interpolation=cv2.INTER_CUBIC)[:6, :8]
+    ref = (ref - ref.min()) / max(float(ref.max() - ref.min()), 1e-6)
+    np.testing.assert_allclose(v, ref, atol=1e-4)
+
+def test_a_cropped_blur_kernel_is_the_centre_of_the_whole_one():
+    for dx, dy in ((-10.5, 7.75), (14.0, 0.0), (0.0, -9.0), (3.25, -2.5), (-1.5, -1.5)):
+        full = photometric.line_kernel(dx, dy)
+        r = full.shape[0] // 2
+        for qx, qy in ((1, 2), (r - 1, 0), (0, 0), (3, 3)):
+            qx, qy = min(max(qx, 0), r), min(qy, r)
+            part = photometric.line_kernel(dx, dy, (qx, qy))
+            np.testing.assert_array_equal(part, full[r - qy : r + qy + 1, r - qx : r + qx + 1])
+
+
+def test_ground_truth_holds_for_an_entity_faster_than_the_frame():
+    cfg = from_dict({
+        "width": 40, "height": 30, "n_frames": 3,
+        "entities": [{"name": "t", "role": "target", "position": [20, 15],
+                      "appearance": {"size": [6, 6]}, "depth": 1,
+                      "motion": {"x": {"boundary": "free"}, "y": {"boundary": "free"},
+                                 "velocity": [-1e6, 3]}},
+                     {"name": "o", "role": "occluder", "position": [22, 15], "depth": 0,
+                      "appearance": {"size": [4, 4]}}],
+        "photometric": {"motion_blur": 4.0},
+    })  # fmt: skip
+    seq = scenegen.generate(cfg, seed=1)
+    check_sequence(seq, plan(cfg, 1))
+    assert seq.gt.present[:, 0].tolist() == [True, False, False]
+
+
 @settings(max_examples=12, deadline=None)
 @given(cfg=scene_configs(realistic=True, occlusion=True, clutter=True, exits=True,
                          max_frames=5, max_width=80, max_height=60),
@@ -180,6 +271,17 @@ def test_camera_extent_is_bounded():
     with pytest.raises(ConfigError, match=r"^camera\.extent: the background"):
         from_dict({"width": 100, "height": 10, "n_frames": 1, "camera": {"extent": [4050, 0]}})
 
+
+
+def test_scripted_pan_beyond_the_extent_is_refused():
+    # It was clipped to the extent without a word: the scripted pan was not the one drawn.
+    data = {"width": 40, "height": 30, "n_frames": 4,
+            "camera": {"extent": [8, 4], "keyframes": [[0, 0, 0], [3, 20, -4]]}}  # fmt: skip
+    with pytest.raises(ConfigError, match=r"^camera\.keyframes\[1\]: offset \(20, -4\) is "
+                                          r"beyond the extent \[8, 4\]"):  # fmt: skip
+        from_dict(data)
+    data["camera"]["keyframes"] = [[0, -8, 4], [3, 8, -4]]  # on the edge: fine
+    assert from_dict(data).camera.keyframes[1] == (3, 8, -4)
 
 def test_cli_exits_2_naming_the_field_and_file(tmp_path, capsys):
     import yaml
