@@ -18,8 +18,9 @@ runs the named checks of :data:`CHECKS` on small generated scenes:
     On those runs, and on a scene of two targets (K = 2), every estimate's ``boxes`` has
     shape (K, 4) and each row is either finite or all NaN (a lost target).
 ``deterministic``
-    Two trackers made with the same seed give identical boxes (only if the tracker claims
-    it: ``deterministic`` attribute, default True, or the ``deterministic`` option).
+    Two trackers made with the same seed give identical boxes, on a scene of one target
+    and on the scene of two (only if the tracker claims it: ``deterministic`` attribute,
+    default True, or the ``deterministic`` option).
 ``translation_equivariance``
     On a scene and the same scene seen by a camera shifted by (dx, dy) pixels, the
     estimated centres differ by (dx, dy) within ``equivariance_tol`` pixels, every frame.

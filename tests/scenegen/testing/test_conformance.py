@@ -339,6 +339,32 @@ def test_boxes_is_skipped_when_no_estimate_was_examined():
     assert result.status == "skipped" and "no estimate to check" in result.message
 
 
+def test_determinism_is_checked_with_two_targets_too():
+    # Differs between instances only when there are several targets (here: which one it
+    # moves depends on a count shared by every instance, like an unseeded choice would).
+    class OrdersByChance(Still):
+        made = 0
+
+        def __init__(self, rng=None):
+            OrdersByChance.made += 1
+            self.pick = OrdersByChance.made % 2
+
+        def step(self, frame):
+            out = self.boxes.copy()
+            if len(out) > 1:
+                out[self.pick] += 1.0
+            return SimpleNamespace(boxes=out)
+
+    result = check_tracker(OrdersByChance, report=True, checks=["deterministic"]).results[0]
+    assert result.status == "failed"
+    assert "differ from frame 1 (largest difference 1 px) on the 2-target scene 'pair'" in (
+        result.message
+    )
+    assert check_tracker(Still, report=True, checks=["deterministic"]).results[0].message == (
+        "same boxes twice with seed 0 on lone, pair"
+    )
+
+
 def test_determinism_failure_names_the_first_frame_that_differs():
     # NaN in both runs is no difference (it was reported as inf from the first lost frame).
     class LostThenNoisy(Still):
