@@ -40,8 +40,9 @@ scenegen_expect_distribution
 Every sequence the fixtures return holds in-memory, read-only numpy arrays (they are
 shared between tests).
 
-``<fixtures>`` is ``--scenegen-fixtures DIR``, else the ini option ``scenegen_fixtures``
-(relative to the rootdir), else ``<rootdir>/fixtures``.
+``<fixtures>`` is ``--scenegen-fixtures DIR`` (relative to the folder pytest is run from,
+as other command-line paths are), else the ini option ``scenegen_fixtures`` (relative to
+the rootdir), else ``<rootdir>/fixtures``.
 
 Markers
 -------
