@@ -350,7 +350,8 @@ def otb_curves(
     n_overlap : int
         Number of overlap thresholds (≥ 2).
     max_error : float
-        Largest centre-error threshold, pixels; thresholds are 0, 1, …, max_error.
+        Largest centre-error threshold, pixels (≥ 0); thresholds are the whole pixels 0, 1,
+        …, up to ``max_error`` (51 values, 0 … 50, by default, as in OTB).
     precision_at : float
         Centre-error threshold of the headline precision, pixels.
 
@@ -360,12 +361,14 @@ def otb_curves(
     """
     if n_overlap < 2:
         raise ValueError(f"n_overlap must be >= 2, got {n_overlap}")
+    if not max_error >= 0:
+        raise ValueError(f"max_error must be >= 0, got {max_error}")
     g = _boxes(gt)
     has_gt = np.all(np.isfinite(g), axis=-1)
     ov = np.nan_to_num(iou(est, g), nan=0.0)[has_gt]
     err = np.nan_to_num(centre_error(est, g), nan=np.inf)[has_gt]
     ths = np.linspace(0.0, 1.0, n_overlap)
-    eths = np.arange(0.0, float(max_error) + 1.0, 1.0)
+    eths = np.arange(0.0, np.floor(float(max_error)) + 1.0, 1.0)
     if ov.size == 0:
         success = np.full(ths.shape, np.nan)
         precision = np.full(eths.shape, np.nan)

@@ -113,6 +113,19 @@ def test_otb_curves_hand_worked():
     assert c2.auc == pytest.approx(0.3)
 
 
+def test_otb_precision_thresholds_stop_at_max_error():
+    """The centre-error thresholds are whole pixels up to ``max_error``, never beyond it (a
+    fractional ``max_error`` gave a threshold past it); a negative one is refused."""
+    gt = np.array([[0, 0, 10, 10.0]])
+    c = m.otb_curves(np.array([[30.5, 0, 10, 10.0]]), gt, max_error=30.5)
+    np.testing.assert_array_equal(c.error_thresholds, np.arange(31.0))
+    assert c.precision[-1] == 0.0  # error 30.5 > 30.5's largest threshold, 30
+    assert m.otb_curves(gt, gt, max_error=0).error_thresholds.tolist() == [0.0]
+    for bad in (-1.0, float("nan")):
+        with pytest.raises(ValueError, match="max_error"):
+            m.otb_curves(gt, gt, max_error=bad)
+
+
 def test_failure_frame_and_tracked_fraction():
     err = np.array([1, 9, 12, 3, 11, 12, 13, 2, 1, 1.0])
     assert m.failure_frame(err, 10.0, persist=1) == 2
