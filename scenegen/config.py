@@ -22,6 +22,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+import re
 import reprlib
 import types
 import typing
@@ -38,6 +39,7 @@ __all__ = [
     "MAX_FRAMES",
     "MAX_FRAME_ENTITIES",
     "MAX_MAGNITUDE",
+    "MAX_PATH",
     "MAX_SIDE",
     "MAX_TEMPLATE_PIXELS",
     "Appearance",
@@ -53,6 +55,7 @@ __all__ = [
     "from_dict",
     "load_config",
     "load_data",
+    "relative_to",
     "to_dict",
 ]
 
@@ -81,6 +84,13 @@ entity per frame (trajectories, presence, depths), so this caps it near 1 GB; e.
 MAX_MAGNITUDE = 1e9
 """Largest absolute value of any number in a config (positions, velocities, sigmas,
 frame indices, depths, ...): far beyond any canvas, and safe from int64 overflow."""
+MAX_PATH = 1e18
+"""Largest absolute value an :class:`AR2` path may reach (pixels; log units for a scale,
+zoom or gain; grey levels for an offset). A path that goes beyond it (or overflows to
+infinity) is refused when planned, naming the field and the frame: only an explosive
+``a1, a2`` (a root of ``z^2 - a1 z - a2`` outside the unit circle) gets there, or a
+sigma near :data:`MAX_MAGNITUDE` over most of :data:`MAX_FRAMES` frames. Twice it (a
+2x zoom) still fits a 64-bit pixel index."""
 MAX_COLORS = 256
 """Most colours drawn per clutter item (``n_colors``)."""
 MAX_BLUR = 256.0
@@ -166,6 +176,14 @@ class AR2:
     ``clamp`` puts it on the limit. Such starts are allowed (an entity may enter from
     outside the frame); give one inside ``[margin + size / 2, side - margin - size / 2]``
     for a path without that jump.
+
+    Any ``a1, a2`` is accepted, including explosive ones (roots of ``z^2 - a1 z - a2``
+    outside the unit circle; ``a1 = 2, a2 = -1`` has a double root at 1, a random walk of
+    the velocity, and is not explosive). A ``reflect`` or ``clamp`` axis stays within its
+    limits whatever they are, but a ``free`` one (or an unbounded scale, gain or offset)
+    of an explosive AR2 grows geometrically: a path beyond :data:`MAX_PATH` in magnitude is
+    refused when the scene is planned, with a ConfigError naming the field and the frame
+    (``entities[0].motion.x: the AR2 path reaches 1.2e+18 at frame 7, ...``).
     """
 
     boundary: Boundary
@@ -211,7 +229,9 @@ class Appearance:
     brought to ``size`` by ``fit``: ``stretch`` resizes, ``tile`` repeats from a window
     offset drawn from the entity's stream, ``crop`` covers and centres). The silhouette
     ``shape`` masks every pattern. ``tint`` multiplies ``image`` pixels per channel
-    (``[255, 140, 0]`` turns a grey texture orange).
+    (``[255, 140, 0]`` turns a grey texture orange). A relative file ``source`` is
+    relative to the config file's folder when the config is read from a file (and then
+    recorded absolute: :func:`load_config`), else to the current directory.
     """
 
     shape: Shape = "rect"
@@ -407,8 +427,8 @@ class Background:
     ``source`` -- :data:`SKIMAGE_NAMES` or a file path -- brought to the background's size
     by ``fit``: ``stretch`` resizes, ``tile`` repeats, ``crop`` scales to cover and takes
     the centre; multiplied per channel by ``color`` / 255, so the default white leaves it
-    unchanged). With a :class:`Camera` the background is larger than the frame by the
-    camera's ``extent`` on every side."""
+    unchanged; a relative file path as for :class:`Appearance`). With a :class:`Camera`
+    the background is larger than the frame by the camera's ``extent`` on every side."""
 
     kind: Literal["uniform", "noise", "texture", "perlin", "image"] = "uniform"
     color: Color = (255, 255, 255)
@@ -803,6 +823,21 @@ def _is_number(value: Any) -> bool:
     return _is_integer(value) or isinstance(value, (float, np.floating))
 
 
+_YAML11_EXPONENT = re.compile(r"([-+]?)(\d+)(?:\.(\d*))?[eE]([-+]?)(\d+)")
+
+
+def _yaml_number_hint(value: Any) -> str:
+    """For a string such as ``'1e9'``, which YAML 1.1 (PyYAML) reads as text since its
+    floats need a dot and a signed exponent: how to write the number instead."""
+    short = isinstance(value, str) and len(value) <= 40
+    m = _YAML11_EXPONENT.fullmatch(value) if short else None
+    if m is None:
+        return ""
+    sign, whole, frac, esign, exp = m.groups()
+    spelled = f"{sign}{whole}.{frac or 0}e{esign or '+'}{exp}"
+    return f" (a string: YAML reads {value} as text; write {spelled})"
+
+
 def _convert(value: Any, tp: Any, path: str) -> Any:
     origin = get_origin(tp)
     if origin is typing.Union or origin is types.UnionType:
@@ -840,13 +875,13 @@ def _convert(value: Any, tp: Any, path: str) -> Any:
         return value
     if tp is int:
         if not _is_number(value):
-            _fail(path, f"must be an integer, got {_short(value)}")
+            _fail(path, f"must be an integer, got {_short(value)}{_yaml_number_hint(value)}")
         if not _is_integer(value) and not float(value).is_integer():
             _fail(path, f"must be an integer, got {_short(value)}")
         return int(value)
     if tp is float:
         if not _is_number(value):
-            _fail(path, f"must be a number, got {_short(value)}")
+            _fail(path, f"must be a number, got {_short(value)}{_yaml_number_hint(value)}")
         if _is_integer(value) and abs(int(value)) > MAX_MAGNITUDE:
             _fail(path, f"must be at most {MAX_MAGNITUDE:g} in magnitude, got {_short(value)}")
         if not math.isfinite(value):
@@ -895,15 +930,50 @@ def _build(cls: type, data: Any, path: str) -> Any:
         raise ConfigError(f"{path}.{msg}" if path else msg) from None
 
 
-def from_dict(data: Any) -> SceneConfig:
+def from_dict(data: Any, *, folder: str | Path | None = None) -> SceneConfig:
     """Build and validate a :class:`SceneConfig` from plain data (as read from YAML/JSON).
+
+    Parameters
+    ----------
+    data : dict
+    folder : str or Path, optional
+        The folder that relative image file ``source`` paths are relative to (the file the
+        data came from: :func:`load_config` passes its folder): they are recorded joined
+        to it (:func:`relative_to`). ``None`` leaves them as given: relative to the current
+        directory when the scene is planned.
 
     Raises
     ------
     ConfigError
         Naming the field path and the bad value.
     """
-    return _build(SceneConfig, data, "")
+    config = _build(SceneConfig, data, "")
+    return config if folder is None else _sources_relative_to(config, Path(folder))
+
+
+def relative_to(path: str | Path, folder: str | Path | None) -> Path:
+    """``path`` read from a file in ``folder``: joined to it when relative (``None``: as
+    given). The one rule for every path a config or family file names (image sources,
+    a family's ``base`` config)."""
+    p = Path(path)
+    return p if folder is None or p.is_absolute() else Path(folder) / p
+
+
+def _sources_relative_to(config: SceneConfig, folder: Path) -> SceneConfig:
+    """``config`` with every relative image file source joined to ``folder``."""
+
+    def fix(obj: Any) -> Any:
+        src = obj.source
+        if src is None or src.startswith("skimage:") or Path(src).is_absolute():
+            return obj
+        return dataclasses.replace(obj, source=str(relative_to(src, folder)))
+
+    background = fix(config.background)
+    entities = tuple(dataclasses.replace(e, appearance=fix(e.appearance)) for e in config.entities)
+    clutter = tuple(dataclasses.replace(c, appearance=fix(c.appearance)) for c in config.clutter)
+    if (background, entities, clutter) == (config.background, config.entities, config.clutter):
+        return config
+    return dataclasses.replace(config, background=background, entities=entities, clutter=clutter)
 
 
 def _plain(value: Any) -> Any:
@@ -1059,11 +1129,16 @@ def load_data(path: str | Path, what: str = "config") -> Any:
     Raises
     ------
     ConfigError
-        One line naming the file: unreadable, too big, not UTF-8, another extension, not
-        valid YAML/JSON (the parser's problem and its line and column), an alias bomb or
-        a duplicate key.
+        One line naming the file: not a regular file (a FIFO, a device), unreadable, too
+        big, not UTF-8, another extension, not valid YAML/JSON (the parser's problem and
+        its line and column), an alias bomb or a duplicate key.
     """
+    from scenegen.io.atomic import describe_special_file
+
     p = Path(path)
+    special = describe_special_file(p)
+    if special is not None:  # a FIFO waits for a writer; /dev/zero never ends
+        raise ConfigError(special)
     try:
         if p.stat().st_size > MAX_CONFIG_BYTES:
             raise ConfigError(
@@ -1087,8 +1162,19 @@ def load_data(path: str | Path, what: str = "config") -> Any:
         raise ConfigError(f"{p}: not valid {p.suffix[1:].upper()}: {msg}") from None
 
 
-def load_config(path: str | Path) -> SceneConfig:
+def load_config(path: str | Path, *, folder: str | Path | None = None) -> SceneConfig:
     """Read a YAML (``.yaml``/``.yml``) or JSON (``.json``) config file and validate it.
+
+    A relative image file ``source`` is relative to the config file's folder, not to the
+    current directory, and the config records it as an absolute path (so the scene can be
+    generated, and its file re-rendered by ``validate --deep``, from any directory).
+
+    Parameters
+    ----------
+    path : str or Path
+    folder : str or Path, optional
+        Join relative sources to this folder instead of the file's absolute folder (a
+        family keeps them relative to its own file: :func:`from_dict`).
 
     Raises
     ------
@@ -1099,6 +1185,6 @@ def load_config(path: str | Path) -> SceneConfig:
     p = Path(path)
     data = load_data(p, "config")
     try:
-        return from_dict(data)
+        return from_dict(data, folder=p.absolute().parent if folder is None else folder)
     except ConfigError as err:
         raise ConfigError(f"{p}: {err}") from None

@@ -154,7 +154,12 @@ def _generate(d: Draw) -> Any:
     from scenegen.sequence import GroundTruth, Sequence
 
     cfg = from_dict(d.config)
-    scn = plan(cfg, d.seed, preset=d.preset)
+    try:  # planning finds what validation cannot (a missing image, a runaway AR2 path)
+        scn = plan(cfg, d.seed, preset=d.preset)
+    except ConfigError as err:
+        shown = ", ".join(f"{p}={json.dumps(v)}" for p, v in d.params.items())
+        raise ConfigError(f"sequence {d.index} ({shown}): {err}" if shown
+                          else f"sequence {d.index}: {err}") from None  # fmt: skip
     chunk = scn.render()
     return Sequence(
         name=cfg.name,

@@ -48,7 +48,7 @@ from typing import Any, Literal, get_args, get_origin
 import numpy as np
 
 from scenegen import presets
-from scenegen.config import from_dict, load_config, load_data, to_dict
+from scenegen.config import from_dict, load_config, load_data, relative_to, to_dict
 from scenegen.datasets.paths import canonical_path, leaf_type, set_path
 from scenegen.errors import ConfigError
 from scenegen.render.plan import MAX_SEED
@@ -195,7 +195,8 @@ class Family:
         The family as given (:meth:`with_overrides` keeps it: its overrides are in
         ``overrides``).
     folder : Path or None
-        Folder that relative ``base`` config files are read from.
+        Folder that relative ``base`` config files and image sources are read from
+        (:func:`scenegen.config.relative_to`; the family file's, absolute).
     """
 
     name: str
@@ -320,7 +321,7 @@ class Family:
             for p, v in sets:
                 set_path(data, p, copy.deepcopy(v))
             data["name"] = name
-            return to_dict(from_dict(data))
+            return to_dict(from_dict(data, folder=self.folder))
         except ConfigError as err:
             shown = ", ".join(f"{p}={_short(v)}" for p, v in sets)
             detail = f" ({shown})" if shown else ""
@@ -357,11 +358,13 @@ def _load_base(
     """(preset name or "", full config data) of a ``base`` entry (errors name ``where``)."""
     if isinstance(value, str):
         if value.lower().endswith((".yaml", ".yml", ".json")):
-            p = Path(value)
-            if folder is not None and not p.is_absolute():
-                p = folder / p
+            p = relative_to(value, folder)
+            # Its relative image sources: relative to the family's folder (joined to it
+            # when drawn, by _config), so the family's digest, and the seeds drawn from
+            # it, do not depend on where the files are.
+            rel = None if Path(value).is_absolute() else Path(value).parent
             try:
-                return "", to_dict(load_config(p))
+                return "", to_dict(load_config(p, folder=rel))
             except ConfigError as err:
                 raise _fail(source, where, str(err)) from None
         if value not in presets.all_names():
@@ -529,7 +532,9 @@ def family_from_dict(data: Any, *, source: str = "family", folder: Path | None =
     source : str
         Prefix of error messages (the file name).
     folder : Path, optional
-        Folder that relative ``base`` config files are read from.
+        Folder that relative ``base`` config files and image sources (in the family or
+        in a base config file, whose are relative to that file) are read from; ``None``:
+        the current directory.
 
     Raises
     ------
@@ -660,4 +665,4 @@ def load_family(path: str | Path) -> Family:
     """
     p = Path(path)
     data = load_data(p, "family")
-    return family_from_dict(data, source=str(p), folder=p.parent)
+    return family_from_dict(data, source=str(p), folder=p.absolute().parent)

@@ -47,9 +47,9 @@ def camera_offsets(
     else:
         dx, dy = np.zeros(n), np.zeros(n)
         if cam.x is not None:
-            dx = ar2_path(cam.x, 0.0, cam.velocity[0], n, rng=rng, lo=-ex, hi=ex)
+            dx = ar2_path(cam.x, 0.0, cam.velocity[0], n, rng=rng, lo=-ex, hi=ex, field="camera.x")
         if cam.y is not None:
-            dy = ar2_path(cam.y, 0.0, cam.velocity[1], n, rng=rng, lo=-ey, hi=ey)
+            dy = ar2_path(cam.y, 0.0, cam.velocity[1], n, rng=rng, lo=-ey, hi=ey, field="camera.y")
     ox = np.clip(np.rint(dx), -ex, ex).astype(np.int64)
     oy = np.clip(np.rint(dy), -ey, ey).astype(np.int64)
     return ox, oy
@@ -65,4 +65,5 @@ def camera_zoom(cam: Camera | None, n: int, rng: np.random.Generator) -> NDArray
     lo, hi = np.log(ZOOM_LIMITS[0]), np.log(ZOOM_LIMITS[1])
     if cam.zoom.margin > 0:
         lo, hi = max(lo, -cam.zoom.margin), min(hi, cam.zoom.margin)
-    return np.exp(np.clip(ar2_path(cam.zoom, 0.0, 0.0, n, rng=rng, lo=lo, hi=hi), lo, hi))
+    log_zoom = ar2_path(cam.zoom, 0.0, 0.0, n, rng=rng, lo=lo, hi=hi, field="camera.zoom")
+    return np.exp(np.clip(log_zoom, lo, hi))

@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from scenegen.config import AR2
+from scenegen.config import AR2, MAX_PATH
+from scenegen.errors import ConfigError
 
 __all__ = ["ar2_path", "ar2_stationary_moments"]
 
@@ -19,6 +20,7 @@ def ar2_path(
     rng: np.random.Generator,
     lo: float = -np.inf,
     hi: float = np.inf,
+    field: str = "motion",
 ) -> NDArray[np.float64]:
     """Simulate ``n`` values of one AR2 coordinate.
 
@@ -37,10 +39,19 @@ def ar2_path(
         (none otherwise), so the stream's later use does not depend on the path.
     lo, hi : float
         Limits applied by ``params.boundary`` (``free`` ignores them).
+    field : str
+        The AR2's field path, for the error (``entities[0].motion.x``).
 
     Returns
     -------
     ndarray of shape (n,)
+
+    Raises
+    ------
+    ConfigError
+        ``field: the AR2 path reaches V at frame t, ...`` when a value goes beyond
+        :data:`~scenegen.config.MAX_PATH` in magnitude (or overflows): an explosive AR2
+        on an unbounded axis.
     """
     mean = start if params.mean is None else params.mean
     eps = rng.standard_normal(max(n - 1, 0)) * params.sigma if params.sigma > 0 else None
@@ -63,9 +74,28 @@ def ar2_path(
             else:
                 c = min(max(c, lo), hi)
                 prev = c
+        if not -MAX_PATH <= c <= MAX_PATH:  # also NaN
+            raise ConfigError(_runaway(params, field, c, t))
         prev2, prev = prev, c
         out[t] = c
     return out
+
+
+def _runaway(params: AR2, field: str, value: float, t: int) -> str:
+    """The one-line message of a path that went beyond MAX_PATH at frame ``t``."""
+    a1, a2 = params.a1, params.a2
+    # Roots of z^2 - a1 z - a2; their largest modulus says whether the AR2 explodes.
+    radius = float(np.max(np.abs(np.roots([1.0, -a1, -a2]))))
+    if radius > 1 + 1e-6:  # a double root at 1 may come out a hair above
+        why = (
+            f"a1={a1:g}, a2={a2:g} is explosive (a root of z^2 - a1 z - a2 has modulus "
+            f"{radius:.3g} > 1): damp it (a1 = 1 + d, a2 = -d, 0 <= d <= 1), bound it "
+            "(reflect or clamp) or use fewer frames"
+        )
+    else:
+        why = f"sigma={params.sigma:g} over that many frames: use a smaller sigma or fewer frames"
+    shown = f"{value:.3g}" if np.isfinite(value) else "infinity"
+    return f"{field}: the AR2 path reaches {shown} at frame {t}, beyond +-{MAX_PATH:g}; {why}"
 
 
 def ar2_stationary_moments(a1: float, a2: float, sigma: float) -> tuple[float, float]:

@@ -39,11 +39,13 @@ def illumination(
         return keyframe_values(p.keyframes, n)
     if p.gain is not None:
         lim = p.gain.margin if p.gain.margin > 0 else np.inf
-        log_gain = ar2_path(p.gain, 0.0, 0.0, n, rng=rng, lo=-lim, hi=lim)
+        log_gain = ar2_path(p.gain, 0.0, 0.0, n, rng=rng, lo=-lim, hi=lim, field="photometric.gain")
         gain = np.exp(np.clip(log_gain, -_LOG_GAIN_MAX, _LOG_GAIN_MAX))
     if p.offset is not None:
         lim = p.offset.margin if p.offset.margin > 0 else np.inf
-        offset = ar2_path(p.offset, 0.0, 0.0, n, rng=rng, lo=-lim, hi=lim)
+        offset = ar2_path(
+            p.offset, 0.0, 0.0, n, rng=rng, lo=-lim, hi=lim, field="photometric.offset"
+        )
     return gain, offset
 
 

@@ -491,10 +491,17 @@ def _ground_truth(tidx, x0, y0, th, tw, toff, tbuf, vbox, vcount) -> dict[str, N
 
 
 def _entity_plan(
-    e: EntitySpec, cfg: SceneConfig, seed: int, tpl: NDArray[np.uint8], start: tuple[float, float]
+    e: EntitySpec,
+    cfg: SceneConfig,
+    seed: int,
+    tpl: NDArray[np.uint8],
+    start: tuple[float, float],
+    where: str = "entity",
 ) -> tuple[NDArray[np.float64], ...]:
     """Trajectory (T,) x, y, scale, angle, shade, path x, path y of one entity from its own
-    stream; x, y include the position noise, path x, path y do not."""
+    stream; x, y include the position noise, path x, path y do not. ``where`` names the
+    entity in errors (``entities[0]``): a runaway AR2 path is a ConfigError naming its
+    field (:func:`~scenegen.render.motion.ar2_path`)."""
     t_n = cfg.n_frames
     rng = entity_rng(seed, e.name, 1)
     th, tw = tpl.shape[:2]
@@ -507,14 +514,18 @@ def _entity_plan(
         x = ar2_path(
             m.x, start[0], m.velocity[0], t_n, rng=rng,
             lo=m.x.margin + tw / 2, hi=cfg.width - m.x.margin - tw / 2,
+            field=f"{where}.motion.x",
         )  # fmt: skip
         y = ar2_path(
             m.y, start[1], m.velocity[1], t_n, rng=rng,
             lo=m.y.margin + th / 2, hi=cfg.height - m.y.margin - th / 2,
+            field=f"{where}.motion.y",
         )  # fmt: skip
         if m.scale is not None:
             lim = m.scale.margin if m.scale.margin > 0 else np.inf
-            s = ar2_path(m.scale, 0.0, 0.0, t_n, rng=rng, lo=-lim, hi=lim)
+            s = ar2_path(
+                m.scale, 0.0, 0.0, t_n, rng=rng, lo=-lim, hi=lim, field=f"{where}.motion.scale"
+            )
         else:
             s = np.zeros(t_n)
     path_x, path_y = x, y
@@ -531,7 +542,8 @@ def _entity_plan(
     else:
         angle = np.zeros(t_n)
         shade = np.ones(t_n)
-    scale = np.clip(np.exp(s), *_SCALE_LIMITS)
+    # exp of a log scale beyond +-50 would overflow; the limits clip it anyway.
+    scale = np.clip(np.exp(np.clip(s, -50.0, 50.0)), *_SCALE_LIMITS)
     return x, y, scale, angle, shade, path_x, path_y
 
 
@@ -609,7 +621,7 @@ def _entity_paths(
             mx, my = paths[e.mimic][0], paths[e.mimic][1]
             t0 = min(e.appear, t_n - 1)
             start = (mx[t0] + e.mimic_offset[0], my[t0] + e.mimic_offset[1])
-        path = _entity_plan(e, cfg, seed, tpl, start)
+        path = _entity_plan(e, cfg, seed, tpl, start, f"entities[{index[e.name]}]")
         if e.position is None and e.appear > 0:
             path = tuple(_delayed(arr, e.appear) for arr in path)
         paths[e.name] = path

@@ -51,7 +51,9 @@ def _rgb(img: NDArray[np.generic]) -> NDArray[np.uint8]:
 
 
 @lru_cache(maxsize=64)
-def _load_cached(source: str) -> NDArray[np.uint8]:
+def _load_cached(source: str, cwd: str) -> NDArray[np.uint8]:
+    """The image of ``source``; ``cwd`` is the current directory for a relative file path
+    ("" otherwise): part of the cache key, and named when the file is missing."""
     if source.startswith("skimage:"):
         import skimage.data
 
@@ -59,9 +61,10 @@ def _load_cached(source: str) -> NDArray[np.uint8]:
         m = _LFW.match(name)
         img = skimage.data.lfw_subset()[int(m.group(1))] if m else getattr(skimage.data, name)()
     else:
-        path = Path(source)
+        path = Path(cwd) / source
         if not path.is_file():
-            raise ConfigError(f"no such image file {source!r}")
+            where = f" (relative to the current directory {cwd!r})" if cwd else ""
+            raise ConfigError(f"no such image file {source!r}{where}")
         try:
             img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
         except cv2.error:  # OpenCV refuses it (say more pixels than it allows): try skimage
@@ -87,14 +90,19 @@ def _load_cached(source: str) -> NDArray[np.uint8]:
 def load_source(source: str, field: str) -> NDArray[np.uint8]:
     """The image (h, w, 3) uint8 named by ``source`` (cached; read-only).
 
+    A relative file path is relative to the current directory (a config file's are made
+    absolute when it is loaded: :func:`scenegen.config.load_config`).
+
     Raises
     ------
     ConfigError
-        ``field: ...`` naming the source when it is unknown, missing or unreadable.
+        ``field: ...`` naming the source when it is unknown, missing or unreadable (and
+        the current directory, for a relative path).
     """
     try:
         check_source(source)
-        return _load_cached(source)
+        relative = not source.startswith("skimage:") and not Path(source).is_absolute()
+        return _load_cached(source, str(Path.cwd()) if relative else "")
     except ConfigError as err:
         raise ConfigError(f"{field}: {err}") from None
 

@@ -177,6 +177,25 @@ def test_numpy_scalars_are_numbers():
             from_dict({**base(), field: value})
 
 
+def test_a_yaml_1_1_exponent_without_a_dot_says_how_to_write_the_number(tmp_path):
+    # PyYAML reads 1e9 (no dot, unsigned exponent) as a string: before, the message was
+    # only "must be a number, got '1e9'", for what the user wrote as a number.
+    path = tmp_path / "e.yaml"
+    path.write_text("width: 40\nheight: 30\nn_frames: 5\nsensor_noise: 2e-1\n")
+    with pytest.raises(ConfigError, match=r"^\S+e\.yaml: sensor_noise: must be a number, "
+                       r"got '2e-1' \(a string: YAML reads 2e-1 as text; write 2\.0e-1\)$"):
+        load_config(path)
+    path.write_text("width: 40\nheight: 30\nn_frames: 1E2\n")
+    with pytest.raises(ConfigError, match=r"n_frames: must be an integer, got '1E2' "
+                       r"\(a string: YAML reads 1E2 as text; write 1\.0e\+2\)$"):
+        load_config(path)
+    path.write_text("width: 40\nheight: 30\nn_frames: 1.0e+2\nsensor_noise: 2.0e-1\n")
+    assert (load_config(path).n_frames, load_config(path).sensor_noise) == (100, 0.2)
+    # A string that is no such number gets no hint.
+    with pytest.raises(ConfigError, match=r"^sensor_noise: must be a number, got 'x'$"):
+        from_dict({**base(), "sensor_noise": "x"})
+
+
 @pytest.mark.parametrize(
     ("name", "text", "message"),
     [

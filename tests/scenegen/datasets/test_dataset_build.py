@@ -460,3 +460,20 @@ def test_a_named_axis_of_one_field_records_its_grid_position(tmp_path):
         f"{path}: entry of tiny-00000: params differs from its sequence "
         "(params['entities[0].appearance.size']: [12, 12] in the manifest, [10, 10] drawn)"
     ]
+
+
+def test_a_sequence_that_fails_when_planned_names_its_index_and_parameters(tmp_path):
+    # What validation cannot see (a runaway AR2 path, a missing image) surfaces when the
+    # sequence is planned: before, the error named the field alone, not which sequence.
+    family = {
+        "name": "runaway", "count": 1,
+        "base": {"width": 32, "height": 24, "n_frames": 40,
+                 "entities": [{"name": "a", "role": "target", "position": [10, 10],
+                               "appearance": {"size": [4, 4]},
+                               "motion": {"x": {"boundary": "free", "sigma": 1},
+                                          "y": {"boundary": "free"}}}]},
+        "sweep": {"entities[0].motion.x.a1": [1000.0]},
+    }  # fmt: skip
+    with pytest.raises(ConfigError, match=r"^sequence 0 \(entities\[0\]\.motion\.x\.a1=1000\.0\): "
+                       r"entities\[0\]\.motion\.x: the AR2 path reaches "):  # fmt: skip
+        build_dataset(family, tmp_path / "ds", jobs=1)

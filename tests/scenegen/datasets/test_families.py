@@ -2,6 +2,7 @@
 
 import json
 
+import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
@@ -258,3 +259,33 @@ def test_an_axis_level_is_the_value_its_fields_share():
     axis = Axis("w", ("a", "b"), ((36, 36), (44, 50)))
     assert axis.level(0) == 36 and axis.level(1) == [44, 50]
     assert Axis("p", ("p",), ((1,), (2,))).level(1) == 2
+
+
+def test_relative_image_sources_are_read_from_their_files_folder_wherever_it_is(tmp_path):
+    # A base config file's relative image source is relative to that file, a family's
+    # own (set/sweep) to the family file; drawn configs record them absolute. The seeds
+    # do not depend on where the folder is (the family's digest keeps them relative).
+    import cv2
+
+    draws = []
+    for root in (tmp_path / "a", tmp_path / "b" / "deeper"):
+        (root / "configs").mkdir(parents=True)
+        cv2.imwrite(str(root / "configs" / "my.png"), np.zeros((8, 8, 3), np.uint8))
+        cv2.imwrite(str(root / "bg.png"), np.zeros((8, 8, 3), np.uint8))
+        (root / "configs" / "x.yaml").write_text(
+            "width: 16\nheight: 16\nn_frames: 2\nentities:\n"
+            "  - {name: a, role: target, position: [8, 8],\n"
+            "     appearance: {size: [4, 4], pattern: image, source: my.png}}\n"
+        )
+        (root / "f.yaml").write_text(
+            "name: f\nbase: configs/x.yaml\ncount: 2\n"
+            "set: {background.kind: image, background.source: bg.png}\n"
+        )
+        fam = load_family(root / "f.yaml")
+        d = fam.draws()
+        assert d[0].config["entities"][0]["appearance"]["source"] == str(
+            root / "configs" / "my.png"
+        )
+        assert d[1].config["background"]["source"] == str(root / "bg.png")
+        draws.append((fam.digest(), [x.seed for x in d]))
+    assert draws[0] == draws[1]

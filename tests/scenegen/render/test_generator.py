@@ -21,6 +21,7 @@ from scenegen.config import (
     SceneConfig,
     Variation,
 )
+from scenegen.errors import ConfigError
 from scenegen.render.motion import ar2_path, ar2_stationary_moments
 from scenegen.render.plan import plan
 
@@ -232,6 +233,40 @@ def test_bounded_motion_stays_inside(boundary):
     rng = np.random.default_rng(0)
     x = ar2_path(AR2(boundary=boundary, sigma=5.0), 50.0, 3.0, 5000, rng=rng, lo=10.0, hi=90.0)
     assert x.min() >= 10.0 and x.max() <= 90.0
+
+
+def test_a_runaway_free_path_is_a_config_error_naming_the_field_and_frame(recwarn):
+    # a1 = 1000 explodes: before, the path overflowed to inf/NaN with RuntimeWarnings and
+    # a NaN cast to int64 when drawn; now the frame where it passes MAX_PATH is named.
+    ar = AR2(boundary="free", a1=1000.0, a2=-1.0, sigma=1.0)
+    with pytest.raises(ConfigError, match=r"^entities\[2\]\.motion\.x: the AR2 path reaches "
+                       r"\S+ at frame \d+, beyond \+-1e\+18; a1=1000, a2=-1 is explosive"):
+        ar2_path(ar, 5.0, 0.0, 500, rng=np.random.default_rng(0), field="entities[2].motion.x")
+    # Oscillating growth (complex roots of modulus sqrt(1.1)) is caught as well.
+    with pytest.raises(ConfigError, match="is explosive"):
+        ar2_path(AR2(boundary="free", a1=0.0, a2=-1.1, sigma=1.0), 0.0, 1.0, 2000,
+                 rng=np.random.default_rng(0))  # fmt: skip
+    assert not [w for w in recwarn if issubclass(w.category, RuntimeWarning)]
+
+
+@pytest.mark.parametrize("boundary", ["reflect", "clamp"])
+def test_an_explosive_ar2_on_a_bounded_axis_stays_inside(boundary):
+    ar = AR2(boundary=boundary, a1=1e9, a2=-1e9, sigma=1e9)
+    x = ar2_path(ar, 50.0, 3.0, 3000, rng=np.random.default_rng(0), lo=10.0, hi=90.0)
+    assert x.min() >= 10.0 and x.max() <= 90.0
+
+
+def test_the_unit_root_default_with_the_largest_drift_is_allowed():
+    # a1 = 2, a2 = -1 (a random walk of the velocity) is not explosive: a path that drifts
+    # by the largest velocity for 100,000 frames (1e14 px) is planned, off the frame.
+    ar = AR2(boundary="free", sigma=1e3)
+    x = ar2_path(ar, 0.0, 1e9, 100_000, rng=np.random.default_rng(0))
+    assert np.isfinite(x).all() and x[-1] > 9e13
+    cfg = SceneConfig(width=20, height=20, n_frames=500, entities=(EntitySpec(
+        name="a", role="target", position=(10.0, 10.0),
+        motion=Motion(x=ar, y=AR2(boundary="free"), velocity=(1e9, 0.0))),))  # fmt: skip
+    seq = scenegen.generate(cfg, seed=0)
+    assert seq.gt.present[0, 0] and not seq.gt.present[1:, 0].any()
 
 
 def test_depth_keyframes_change_the_order():

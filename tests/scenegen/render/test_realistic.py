@@ -381,3 +381,43 @@ def test_textures_are_keyed_by_the_entity_name():
     c = plan(cfg, 10)
     assert not np.array_equal(a.templates[2], c.templates[2])
     assert not np.array_equal(a.templates[1], c.templates[1])
+
+
+def test_a_config_files_relative_image_sources_are_read_from_its_folder(
+    tmp_path, monkeypatch, capsys
+):
+    # Before, `generate --config scenes/x.yaml` from elsewhere failed with "no such image
+    # file 'img/my.png'", and a file written from the config's folder recorded the
+    # relative path, so `validate --deep` failed from any other directory.
+    import cv2
+    import yaml
+
+    scenes, elsewhere = tmp_path / "scenes", tmp_path / "elsewhere"
+    (scenes / "img").mkdir(parents=True)
+    elsewhere.mkdir()
+    img = (np.random.default_rng(0).random((20, 24, 3)) * 255).astype(np.uint8)
+    cv2.imwrite(str(scenes / "img" / "my.png"), img)
+    cfg = {"width": 32, "height": 24, "n_frames": 3,
+           "background": {"kind": "image", "source": "img/my.png"},
+           "entities": [{"name": "a", "role": "target", "position": [10, 10],
+                         "appearance": {"size": [8, 8], "pattern": "image",
+                                        "source": "img/my.png"}}]}  # fmt: skip
+    (scenes / "x.yaml").write_text(yaml.safe_dump(cfg))
+    monkeypatch.chdir(elsewhere)
+    assert main(["generate", "--config", str(scenes / "x.yaml"), "-o", "out.h5"]) == 0
+    stored = scenegen.read("out.h5").config
+    expect = str(scenes / "img" / "my.png")
+    assert stored.background.source == expect
+    assert stored.entities[0].appearance.source == expect
+    monkeypatch.chdir(tmp_path)
+    capsys.readouterr()
+    assert main(["validate", "--deep", str(elsewhere / "out.h5")]) == 0, capsys.readouterr()
+    # Plain data (no file) keeps its relative paths: relative to the current directory,
+    # which a missing file's error names.
+    with pytest.raises(ConfigError, match=r"^entities\[0\]\.appearance\.source: no such image "
+                       r"file 'img/my\.png' \(relative to the current directory '"):  # fmt: skip
+        scenegen.generate(cfg, seed=0)
+    monkeypatch.chdir(scenes)
+    np.testing.assert_array_equal(
+        scenegen.generate(cfg, seed=1).frames, scenegen.generate(stored, seed=1).frames
+    )
