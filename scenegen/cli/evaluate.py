@@ -47,11 +47,17 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _is_hdf5(path: Path) -> bool:
+    from scenegen.io.atomic import describe_special_file
+
+    if describe_special_file(path) is not None:  # opening a FIFO would wait for a writer
+        return False  # the MOT reader refuses it in one line
+    if path.suffix.lower() in (".h5", ".hdf5"):  # even empty or damaged: never read as MOT
+        return True
     try:
         with open(path, "rb") as f:
             return f.read(8) == b"\x89HDF\r\n\x1a\n"
-    except OSError:
-        return path.suffix.lower() in (".h5", ".hdf5")
+    except OSError:  # unreadable: the MOT reader says why in one line
+        return False
 
 
 def cmd_evaluate(args: argparse.Namespace) -> int:

@@ -30,6 +30,7 @@ import os
 import re
 import shutil
 import socket
+import stat
 import tempfile
 from collections.abc import Iterator
 from pathlib import Path
@@ -43,6 +44,7 @@ from scenegen.errors import ConfigError
 __all__ = [
     "atomic_path",
     "clean_temp_files",
+    "describe_special_file",
     "describe_temp_file",
     "temp_file_owner",
     "temp_prefix",
@@ -186,10 +188,44 @@ def _target_folder(target: Path) -> Path:
         raise ConfigError(f"{target}: folder {folder} does not exist")
     if target.is_dir():
         raise ConfigError(f"{target}: is a folder, expected a file name")
-    if target.exists() and not target.is_file():
-        # A rename would put a regular file in place of /dev/null, a FIFO or a socket.
-        raise ConfigError(f"{target}: is not a regular file (a device, FIFO or socket)")
+    # A rename would put a regular file in place of /dev/null, a FIFO or a socket.
+    special = describe_special_file(target)
+    if special is not None:
+        raise ConfigError(special)
     return folder
+
+
+def describe_special_file(path: str | Path) -> str | None:
+    """``"PATH: is not a regular file (a FIFO)"`` if ``path`` names (through symbolic
+    links) a FIFO, a device or a socket; else None (a regular file, a folder, nothing).
+
+    Writers refuse such a target (a rename would replace it), and readers refuse such an
+    input at once: opening a FIFO waits for a writer that may never come, and a device
+    such as ``/dev/zero`` never ends.
+
+    Parameters
+    ----------
+    path : str or Path
+
+    Returns
+    -------
+    str or None
+    """
+    try:
+        mode = os.stat(path).st_mode
+    except (OSError, ValueError):
+        return None
+    if stat.S_ISREG(mode) or stat.S_ISDIR(mode):
+        return None
+    if stat.S_ISFIFO(mode):
+        kind = "a FIFO"
+    elif stat.S_ISCHR(mode) or stat.S_ISBLK(mode):
+        kind = "a device"
+    elif stat.S_ISSOCK(mode):
+        kind = "a socket"
+    else:
+        kind = "a special file"
+    return f"{path}: is not a regular file ({kind})"
 
 
 def _real_target(path: str | Path) -> Path:

@@ -56,6 +56,7 @@ from scenegen.io import guard
 from scenegen.io.atomic import (
     atomic_path,
     clean_temp_files,
+    describe_special_file,
     describe_temp_file,
     temp_file_owner,
     temp_prefix,
@@ -618,9 +619,9 @@ def open_checked(path: str | Path) -> h5py.File:
     Raises
     ------
     DataError
-        If the file is missing, a folder, a temporary file of an unfinished write, not
-        HDF5, truncated, being written by another process, or of another schema; or if
-        its metadata is damaged or cannot be read within the deadline
+        If the file is missing, a folder, a FIFO or device, a temporary file of an
+        unfinished write, not HDF5, truncated, being written by another process, or of
+        another schema; or if its metadata is damaged or cannot be read within the deadline
         (:func:`scenegen.io.guard.preflight`).
     """
     p = Path(path)
@@ -628,6 +629,9 @@ def open_checked(path: str | Path) -> h5py.File:
         raise DataError(f"{p}: no such file")
     if p.is_dir():
         raise DataError(f"{p}: is a folder, not a scenegen file")
+    special = describe_special_file(p)
+    if special is not None:  # HDF5 would wait on a FIFO until the deadline
+        raise DataError(special)
     temp = describe_temp_file(p)
     if temp is not None:  # incomplete by construction, even when HDF5 could open it
         raise DataError(temp)

@@ -33,7 +33,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from scenegen.errors import ConfigError, DataError
-from scenegen.io.atomic import atomic_path
+from scenegen.io.atomic import atomic_path, describe_special_file
 from scenegen.sequence import Sequence
 
 __all__ = [
@@ -216,10 +216,14 @@ def read_mot_tracker_rows(
     DataError
         Naming the file and line of a malformed row (fewer than 6 columns, a frame or id
         that is not an integer, an id beyond ``MAX_TRACK_ID``, a box value that is not a
-        finite number, a negative width or height), a frame out of range, or a track id
-        that appears twice in a frame.
+        finite number or whose right or bottom edge is not, a negative width or height), a
+        frame out of range, or a track id that appears twice in a frame; a path that is
+        not a regular file (a FIFO, a device).
     """
     p = Path(path)
+    special = describe_special_file(p)
+    if special is not None:  # a FIFO waits for a writer; /dev/zero never ends
+        raise DataError(special)
     try:
         if p.stat().st_size > MAX_TRACKER_FILE_BYTES:
             raise DataError(f"{p}: larger than {MAX_TRACKER_FILE_BYTES} bytes; not a tracker file")
@@ -240,6 +244,8 @@ def read_mot_tracker_rows(
             vals = [float(c) for c in cells[2:6]]
             if not all(np.isfinite(vals)):
                 raise ValueError("a box value is not a finite number")
+            if not (math.isfinite(vals[0] + vals[2]) and math.isfinite(vals[1] + vals[3])):
+                raise ValueError("the box's right or bottom edge overflows to infinity")
             if vals[2] < 0 or vals[3] < 0:
                 raise ValueError("width and height must not be negative")
         except ValueError as err:

@@ -37,7 +37,7 @@ from typing import Any
 
 from scenegen.config import json_object
 from scenegen.errors import DataError
-from scenegen.io.atomic import write_json
+from scenegen.io.atomic import describe_special_file, write_json
 
 __all__ = [
     "MAX_BYTES",
@@ -130,6 +130,9 @@ def _parse(p: Path) -> Any:
         raise DataError(f"{p}: no such file")
     if p.is_dir():
         raise DataError(f"{p}: is a folder, not a JSON file")
+    special = describe_special_file(p)
+    if special is not None:  # a FIFO waits for a writer; /dev/zero never ends
+        raise DataError(special)
     try:
         size = p.stat().st_size
         if size > MAX_BYTES:

@@ -3,14 +3,16 @@
 :func:`check_file` returns one line per problem (empty when the file is valid), each
 naming the file, the sequence and what is wrong:
 
-- the file: missing, a folder, an unfinished temporary file of a write, not HDF5,
-  truncated (with the byte counts), locked by a writer, or with a wrong or missing schema;
+- the file: missing, a folder, a FIFO or device, an unfinished temporary file of a write,
+  not HDF5, truncated (with the byte counts), locked by a writer, or with a wrong or
+  missing schema;
 - the layout: missing attributes, groups or datasets, shape or dtype mismatches, a config
   attribute that does not parse or disagrees with the size attributes, missing templates;
 - the data: chunks that fail their checksum or decompression (named by frame), ids that
-  are not unique and >= 1, unknown roles, ``labels`` naming unknown ids, visible boxes or
-  visibilities that disagree with ``labels``, NaN patterns that disagree with ``present``,
-  centres that disagree with boxes, values out of range.
+  are not unique and >= 1 (or above what uint16 labels hold), unknown roles, ``labels``
+  naming unknown ids, visible boxes or visibilities that disagree with ``labels``, NaN
+  patterns that disagree with ``present``, infinite boxes or centres (or a box off the
+  frame) where present, centres that disagree with boxes, values out of range.
 
 Frames and labels are read one frame at a time, so memory stays bounded whatever the
 file's length; ground truth (T x K) is read whole. Nothing here raises on a damaged file.
@@ -31,11 +33,12 @@ from scipy import ndimage
 from scenegen.config import from_dict
 from scenegen.errors import ConfigError, DataError
 from scenegen.io import describe_open_error, describe_read_error, describe_temp_file
+from scenegen.io.atomic import describe_special_file
 from scenegen.io.guard import beat, call
 from scenegen.io.guard import timeout as guard_timeout
 from scenegen.io.integrity import ATTRS_DIGEST, DIGEST, INTEGRITY, Hasher, as_text, attrs_digest
 from scenegen.io.results import bad_box_rows, repeated_ids
-from scenegen.io.schema import GT_FIELDS, RESULT_FIELDS, ROLES, SCHEMA, SEQUENCE_FIELDS
+from scenegen.io.schema import GT_FIELDS, RESULT_FIELDS, ROLES, SCHEMA, SEQUENCE_FIELDS, field
 
 __all__ = ["check_file", "require_valid"]
 
@@ -45,6 +48,8 @@ _ROLES = set(ROLES)
 _OPTIONAL = {f.path for f in SEQUENCE_FIELDS if f.optional}  # absent from older files
 _RESULT_DTYPE = {f.path: f.numpy_dtype for f in RESULT_FIELDS}
 _ATTRS = ("seed", "config", "preset", "n_frames", "height", "width")
+_LABELS_DTYPE = field("labels").numpy_dtype
+_MAX_ID = int(np.iinfo(_LABELS_DTYPE).max)  # the largest id labels can hold
 
 
 def check_file(
@@ -87,6 +92,9 @@ def check_file(
         return [f"{p}: no such file"]
     if p.is_dir():
         return [f"{p}: is a folder, not a scenegen file"]
+    special = describe_special_file(p)
+    if special is not None:  # HDF5 would wait on a FIFO until the deadline
+        return [special]
     temp = describe_temp_file(p)
     if temp is not None:
         return [temp]
@@ -289,6 +297,13 @@ def _check_sequence(where: str, g: h5py.Group, check_pixels: bool) -> list[str]:
     if np.any(ids < 1) or len(np.unique(ids)) != k:
         problems.append(f"{where}: entities/id must be unique and >= 1, got {ids.tolist()[:10]}")
         return problems
+    if k and int(ids.max()) > _MAX_ID:  # labels could not name it (and the checks below
+        # would size their tables by it: 2**31 ids stalled the check)
+        problems.append(
+            f"{where}: entities/id must be at most {_MAX_ID} (labels are "
+            f"{np.dtype(_LABELS_DTYPE)}), got {int(ids.max())}"
+        )
+        return problems
     if "entities/role" in data:
         roles = {r.decode() if isinstance(r, bytes) else str(r) for r in data["entities/role"]}
         if roles - _ROLES:
@@ -296,7 +311,7 @@ def _check_sequence(where: str, g: h5py.Group, check_pixels: bool) -> list[str]:
     problems += _check_templates(where, g["templates"], ids)
     gt = {key: data.get(f"gt/{key}") for key in GT_FIELDS if f"gt/{key}" in g}
     if all(v is not None for v in gt.values()):
-        problems += _check_gt(where, gt)
+        problems += _check_gt(where, gt, (h, w))
     if check_pixels:
         problems += _check_frames(where, g["frames"])
         problems += _check_labels(where, g["labels"], ids, gt)
@@ -324,7 +339,8 @@ def _check_templates(where: str, grp: h5py.Group, ids: NDArray[Any]) -> list[str
     return problems
 
 
-def _check_gt(where: str, gt: dict[str, NDArray[Any]]) -> list[str]:
+def _check_gt(where: str, gt: dict[str, NDArray[Any]], size: tuple[int, int]) -> list[str]:
+    """The ground-truth invariants of docs/format.md; ``size`` is the frame's (H, W)."""
     beat()
     problems = []
     present = gt["present"].astype(bool)
@@ -338,6 +354,19 @@ def _check_gt(where: str, gt: dict[str, NDArray[Any]]) -> list[str]:
             problems.append(
                 f"{where}: gt/{key} NaN pattern disagrees with gt/present at frames {_frames(bad)}"
             )
+        bad = np.flatnonzero((np.isinf(gt[key]).any(axis=-1) & present).any(axis=1))
+        if bad.size:
+            problems.append(f"{where}: gt/{key} is infinite where present at frames {_frames(bad)}")
+    # Present: one pixel of the shape is inside the frame, so the amodal box overlaps it.
+    box = gt["box"]
+    with np.errstate(invalid="ignore"):
+        x, y, bw, bh = box[..., 0], box[..., 1], box[..., 2], box[..., 3]
+        inside = (x < size[1]) & (y < size[0]) & (x + bw > 0) & (y + bh > 0)
+    bad = np.flatnonzero((~inside & present & np.isfinite(box).all(axis=-1)).any(axis=1))
+    if bad.size:
+        problems.append(
+            f"{where}: gt/box lies outside the frame where present at frames {_frames(bad)}"
+        )
     bad = np.flatnonzero((~np.isnan(gt["visible_box"]).all(axis=-1) & ~present).any(axis=1))
     if bad.size:
         problems.append(

@@ -95,6 +95,28 @@ def test_bad_tracker_files_name_file_and_line(tmp_path, capsys):
     assert code == 2
 
 
+
+def test_an_overflowing_box_and_a_non_hdf5_result_h5_are_refused(tmp_path, capsys):
+    seq_file = FIXTURES / "full-occlusion.h5"
+    # Finite values whose right edge overflows: four lines of numpy overflow warnings,
+    # then scores and exit 0.
+    bad = tmp_path / "huge.txt"
+    row = "2,1,1e308,3,1e308,5"
+    bad.write_text(f"1,1,2,3,4,5\n{row}\n")
+    code, _, err = run(capsys, "evaluate", seq_file, bad)
+    assert code == 1 and err.strip() == (
+        f"scenegen: error: {bad}:2: not a MOTChallenge row (the box's right or bottom edge "
+        f"overflows to infinity): {row!r}"
+    )
+    # An empty (or text) result.h5 was read as a MOTChallenge file: an empty one scored as
+    # a tracker that gave no box, exit 0.
+    for content in (b"", b"1,1,2,3,4,5\n"):
+        result = tmp_path / "result.h5"
+        result.write_bytes(content)
+        code, out, err = run(capsys, "evaluate", seq_file, result)
+        assert (code, out, err.strip()) == (1, "", f"scenegen: error: {result}: not an HDF5 file")
+
+
 def test_gt_export_modes(tmp_path, capsys):
     src = FIXTURES / "distractor-on-target.h5"
     seq = read(src)

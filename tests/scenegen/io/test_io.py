@@ -138,3 +138,31 @@ def test_put_text_is_the_attribute_h5py_makes_and_replaces(tmp_path, value):
         assert repr(ours.attrs["k"]) == repr(ref.attrs["k"])
         put_attrs_digest(ours, {"k": value})
         assert as_text(ours.attrs["attrs_sha256"]) == attrs_digest(ref.attrs)
+
+
+def test_validate_names_infinite_or_off_frame_ground_truth_where_present(tmp_path, seq):
+    # A sequence written through the API is sealed with its digests: only the ground-truth
+    # checks can tell. Before, an infinite path centre, or an infinite or far-away box of a
+    # fully occluded entity (no visible box to compare with), was called valid.
+    import dataclasses
+
+    gt = seq.gt
+    k = int(np.flatnonzero(gt.present[3])[0])
+    box, center = np.array(gt.box), np.array(gt.center)
+    path, vbox = np.array(gt.path_center), np.array(gt.visible_box)
+    vis = np.array(gt.visibility)
+    path[3, k, 1] = np.inf
+    box[4, k, :2] = 1e30
+    center[4, k] = box[4, k, :2] + box[4, k, 2:] / 2
+    box[5, k, 0] = center[5, k, 0] = np.inf
+    vbox[4:6, k], vis[4:6, k] = np.nan, 0.0
+    bad_gt = dataclasses.replace(
+        gt, box=box, center=center, path_center=path, visible_box=vbox, visibility=vis
+    )
+    bad = dataclasses.replace(seq, gt=bad_gt)
+    write(tmp_path / "bad.h5", bad)
+    problems = "\n".join(check_file(tmp_path / "bad.h5", check_pixels=False))
+    assert "gt/path_center is infinite where present at frames 3" in problems
+    assert "gt/box is infinite where present at frames 5" in problems
+    assert "gt/center is infinite where present at frames 5" in problems
+    assert "gt/box lies outside the frame where present at frames 4" in problems

@@ -280,6 +280,65 @@ def test_ids_must_be_unique(copy):
     assert check_file(p) == [f"{p}: {SEQ}: entities/id must be unique and >= 1, got [1, 1, 3]"]
 
 
+def test_an_id_labels_cannot_hold_is_named_at_once(copy):
+    # Labels are uint16: an id above 65535 can name no pixel. The check used to size its
+    # id tables by the largest id (16 GiB for 2**31 - 1) and was killed at the deadline as
+    # "metadata unreadable".
+    big = np.array([1, 2, 2**31 - 1], np.int32)
+    p = edit(copy(), lambda g, f: replace(g, "entities/id", big))
+    line = f"{p}: {SEQ}: entities/id must be at most 65535 (labels are uint16), got 2147483647"
+    assert check_file(p) == [line]
+    assert check_file(p, isolate=True) == [line]
+
+
+
+def _limited_memory() -> None:  # a reader of /dev/zero must fail, not fill the machine
+    import resource
+
+    resource.setrlimit(resource.RLIMIT_AS, (3 * 2**30, 3 * 2**30))
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo") or not os.path.exists("/dev/zero"),
+                    reason="needs FIFOs and /dev/zero")  # fmt: skip
+def test_a_fifo_or_a_device_is_refused_at_once_by_every_reader(originals, tmp_path):
+    # A FIFO kept HDF5 waiting until the 10 s deadline ("metadata unreadable ... damaged
+    # file", 100 s with --deep); evaluate's result and a --config FIFO waited for a writer
+    # for ever; /dev/zero as a tracker file or config was read until memory ran out.
+    import subprocess
+    import sys
+
+    fifo = tmp_path / "scene.h5"
+    os.mkfifo(fifo)
+    link = tmp_path / "link.h5"
+    link.symlink_to(fifo)
+    zero = tmp_path / "zero.txt"
+    zero.symlink_to("/dev/zero")
+    cfg = tmp_path / "scene.yaml"
+    os.mkfifo(cfg)
+    seq = originals["gzip"]
+    cases = [
+        (["validate", fifo], 1, f"{fifo}: is not a regular file (a FIFO)"),
+        (["validate", "--deep", link], 1, f"{link}: is not a regular file (a FIFO)"),
+        (["track", link, "--tracker", "kalman", "-o", tmp_path / "r.h5"], 1, f"{link}: is not"),
+        (["evaluate", seq, fifo], 1, f"{fifo}: is not a regular file (a FIFO)"),
+        (["evaluate", seq, zero], 1, f"{zero}: is not a regular file (a device)"),
+        (["generate", "--config", cfg, "-o", tmp_path / "g.h5"], 2, f"{cfg}: is not a regular"),
+    ]
+    for args, code, needle in cases:
+        try:
+            done = subprocess.run(
+                [sys.executable, "-m", "scenegen.cli", *map(str, args)], capture_output=True,
+                text=True, timeout=60, preexec_fn=_limited_memory,
+                env={**os.environ, "SCENEGEN_READ_TIMEOUT": "30"},
+            )  # fmt: skip
+        except subprocess.TimeoutExpired:
+            pytest.fail(f"scenegen {args[0]} on {args[-1]} did not answer within 60 s")
+        assert (done.returncode, done.stderr.count("\n")) == (code, 1), (args, done.stderr)
+        assert needle in done.stderr and "Traceback" not in done.stderr
+    with pytest.raises(DataError, match="is not a regular file"):
+        read(link)
+
+
 @pytest.mark.parametrize("cut", ["0", "8", "100", "half", "size-1"])
 def test_truncated(copy, cut):
     p = copy()
