@@ -294,7 +294,12 @@ def read_manifest(root: Path, *, check_entries: bool = True) -> dict[str, Any]:
         If it is missing, unreadable or not a scenegen dataset manifest, or (with
         ``check_entries``) an entry is damaged: one line naming the file and the entry.
     """
+    from scenegen.io.atomic import describe_special_file
+
     p = Path(root) / MANIFEST
+    special = describe_special_file(p)  # a FIFO would wait for a writer, /dev/zero not end
+    if special is not None:
+        raise DataError(special)
     try:
         data = json.loads(p.read_text(encoding="utf-8"))
     except FileNotFoundError:
@@ -477,9 +482,15 @@ def holds_benchmark_outputs(folder: Path) -> bool:
 
 
 def _results_json(folder: Path) -> Any:
-    """The parsed ``folder/results.json``, or None (missing, unreadable or not JSON)."""
+    """The parsed ``folder/results.json``, or None (missing, unreadable, not JSON, or not a
+    regular file)."""
+    from scenegen.io.atomic import describe_special_file
+
+    path = Path(folder) / "results.json"
+    if describe_special_file(path) is not None:
+        return None
     try:
-        return json.loads((Path(folder) / "results.json").read_text(encoding="utf-8"))
+        return json.loads(path.read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, ValueError):
         return None
 

@@ -214,9 +214,10 @@ def read_mot_tracker_rows(
     Raises
     ------
     DataError
-        Naming the file and line of a malformed row (fewer than 6 columns, a frame or id
-        that is not an integer, an id beyond ``MAX_TRACK_ID``, a box value that is not a
-        finite number or whose right or bottom edge is not, a negative width or height), a
+        Naming the file and line of a malformed row (fewer than 6 columns, a ``_`` in a
+        number, a frame or id that is not an integer, an id beyond ``MAX_TRACK_ID``, a box
+        value that is not a finite number or whose right or bottom edge is not, a negative
+        width or height), a
         frame out of range, or a track id that appears twice in a frame; a path that is
         not a regular file (a FIFO, a device).
     """
@@ -238,6 +239,8 @@ def read_mot_tracker_rows(
         try:
             if len(cells) < 6:
                 raise ValueError("fewer than 6 columns")
+            if any("_" in c for c in cells[:6]):  # Python's int and float read 1_0 as 10
+                raise ValueError("'_' is not part of a number")
             frame, ident = _integer(cells[0]), _integer(cells[1])
             if abs(ident) >= MAX_TRACK_ID:
                 raise ValueError(f"id beyond ±{MAX_TRACK_ID - 1}")

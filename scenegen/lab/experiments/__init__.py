@@ -42,6 +42,7 @@ from scenegen.datasets.build import (
     make_output_folder,
 )
 from scenegen.errors import ConfigError
+from scenegen.io.atomic import describe_special_file
 from scenegen.lab.experiments.definitions import EXPERIMENTS, PAPER, Experiment, Method, get, names
 from scenegen.lab.experiments.outputs import (
     RECORDS,
@@ -154,6 +155,8 @@ def _refuse_other_outputs(out: Path, name: str) -> None:
         raise ConfigError(
             f"-o {out}: holds the outputs of `scenegen benchmark`; choose another folder"
         )
+    if describe_special_file(out / "results.json") is not None:
+        return  # not a file: writing the results refuses it
     try:
         held = json.loads((out / "results.json").read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, ValueError):

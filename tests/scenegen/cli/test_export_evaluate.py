@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from scenegen.cli import _parser, main
+from scenegen.errors import DataError
 from scenegen.io import TrackerResult, read, write_result
 from scenegen.io.benchmarks import cover_level, export_benchmark
 from scenegen.io.mot import read_mot_tracker, write_mot_tracker
@@ -314,3 +315,12 @@ def test_export_options_the_export_would_ignore_are_refused(tmp_path, capsys):
         out = tmp_path / "out.txt"
         code, _, err = run(capsys, "export", *argv, "-o", out)
         assert code == 2 and msg in err and not out.exists(), err
+
+
+@pytest.mark.parametrize("row", ["1,1_0,1,1,5,5", "1,1,1_0,1,5,5", "1_0,1,1,1,5,5"])
+def test_an_underscore_in_a_number_is_refused(tmp_path, row):
+    # Python's int() and float() read "1_0" as 10: a row with one was scored as that number.
+    path = tmp_path / "t.txt"
+    path.write_text(f"1,1,1,1,5,5\n{row}\n")
+    with pytest.raises(DataError, match=r"t.txt:2: not a MOTChallenge row \('_' is not part"):
+        read_mot_tracker(path, 20)

@@ -477,3 +477,33 @@ def test_a_sequence_that_fails_when_planned_names_its_index_and_parameters(tmp_p
     with pytest.raises(ConfigError, match=r"^sequence 0 \(entities\[0\]\.motion\.x\.a1=1000\.0\): "
                        r"entities\[0\]\.motion\.x: the AR2 path reaches "):  # fmt: skip
         build_dataset(family, tmp_path / "ds", jobs=1)
+
+
+@pytest.mark.parametrize("name", ["manifest.json", "results.json"])
+def test_a_fifo_in_a_folder_is_refused_not_waited_on(tmp_path, name):
+    # A FIFO manifest.json (or results.json, read to tell report folders apart) waited
+    # for a writer for ever.
+    os.mkfifo(tmp_path / name)
+    try:
+        done = subprocess.run(
+            [sys.executable, "-m", "scenegen.cli", "validate", str(tmp_path)],
+            capture_output=True, text=True, timeout=60,
+        )  # fmt: skip
+    except subprocess.TimeoutExpired:
+        pytest.fail(f"validate on a folder with a FIFO {name} did not answer within 60 s")
+    assert done.returncode == 1 and done.stderr.count("\n") == 1, done.stderr
+    assert f"{tmp_path / name}: is not a regular file (a FIFO)" in done.stderr
+
+
+def test_telling_folders_apart_does_not_wait_on_a_fifo_results_json(tmp_path):
+    # holds_report (asked before any run writes into -o) read a FIFO results.json for ever.
+    os.mkfifo(tmp_path / "results.json")
+    code = (
+        "import sys; from scenegen.datasets.build import holds_report; "
+        f"sys.exit(int(holds_report(__import__('pathlib').Path({str(tmp_path)!r}))))"
+    )
+    try:
+        done = subprocess.run([sys.executable, "-c", code], capture_output=True, timeout=60)
+    except subprocess.TimeoutExpired:
+        pytest.fail("holds_report on a FIFO results.json did not answer within 60 s")
+    assert done.returncode == 0, done.stderr
