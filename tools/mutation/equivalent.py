@@ -776,3 +776,115 @@ EQUIVALENT["mot"] = [  # noqa: F821
      "asspr[a] = np.sum(mc * (mc / np.maximum( 0, trk_count))) / np.maximum(1, tp[a])",
      _EVERY_ID),
 ]
+
+# Round 18, every mutant of the generator's AR2 paths, compositor and ground truth:
+EQUIVALENT["motion"] = [  # noqa: F821
+    ("*,", "/,",
+     "ar2_path's keyword-only marker read as an operator: every caller passes params, "
+     "start, velocity and n by position; the mutant only also accepts rng, lo, hi, field "
+     "by position"),
+    ("limit = lo if c < lo else hi", "limit = lo if c <= lo else hi",
+     "only reached for c outside [lo, hi]: c is never equal to lo there"),
+]
+
+_RESCAN = ("widens the test of a static entity's rectangle against the rectangles drawn over "
+           "it: the entity is rescanned more often, and a rescan of labels that nothing was "
+           "drawn over gives the static layer's statistics, which the shortcut copies")
+_EMPTY_BOX = ("the box of an entity without visible pixels is never read (visible_box is "
+              "NaN where the count is 0, and motion blur skips it); with pixels the first "
+              "one found replaces the initial value")
+_SAME = "assigns the value the variable already holds"
+EQUIVALENT["compose"] = [  # noqa: F821
+    *[(a, b, _RESCAN) for a, b in (
+        ("drawn[d, 0] < bx1", "drawn[d, 0] <= bx1"),
+        ("and bx0 < drawn[d, 2]", "and bx0 <= drawn[d, 2]"),
+        ("and drawn[d, 1] < by1", "and drawn[d, 1] <= by1"),
+        ("and by0 < drawn[d, 3]", "and by0 <= drawn[d, 3]"),
+        ("and bx0 < drawn[d, 2]", "or bx0 < drawn[d, 2]"),
+        ("and drawn[d, 1] < by1", "or drawn[d, 1] < by1"),
+        ("and by0 < drawn[d, 3]", "or by0 < drawn[d, 3]"),
+        ("touched = False", "touched = True"),
+    )],
+    ("break", "continue",
+     "(_draw_frame) order is padded with -1 only at its end: continue skips the same "
+     "entries; (_frame_stats) once touched is set, the remaining rectangles can only set "
+     "it again"),
+    ("k_n = tidx.shape[0]", "k_n = tidx.shape[ -1]", "tidx is one-dimensional (K,)"),
+    ("for k in range(tidx.shape[0]):", "for k in range(tidx.shape[ -1]):",
+     "a frame's tidx is one-dimensional (K,)"),
+    ("for j in range(order.shape[0]):", "for j in range(order.shape[ -1]):",
+     "a frame's order is one-dimensional (D,)"),
+    ("out_count[0] = n", "out_count[ -1] = n", "out_count has one element: [-1] is [0]"),
+    ("out_count[k] = cnt[0]", "out_count[k] = cnt[ -1]", "cnt has one element: [-1] is [0]"),
+    ("vis_count[k] = cnt[0]", "vis_count[k] = cnt[ -1]", "cnt has one element: [-1] is [0]"),
+    ("drawn = np.empty((order.shape[1], 4), dtype=np.int64)",
+     "drawn = np.empty((order.shape[1], 5), dtype=np.int64)",
+     "a fifth column that nothing reads"),
+    ("cnt = np.empty(1, dtype=np.int64)", "cnt = np.empty( 2, dtype=np.int64)",
+     "a second element that nothing reads"),
+    ("box = np.empty(4, dtype=np.int64)", "box = np.empty( 5, dtype=np.int64)",
+     "a fifth element that nothing reads"),
+    ("if c < cmin:", "if c <= cmin:", _SAME),
+    ("if c > cmax:", "if c >= cmax:", _SAME),
+    ("if r < rmin:", "if r <= rmin:", _SAME),
+    ("if r > rmax:", "if r >= rmax:", _SAME),
+    ("cmin, rmin, cmax, rmax, n = w, h, -1, -1, 0",
+     "cmin, rmin, cmax, rmax, n = w, h, - 0, -1, 0", _EMPTY_BOX),
+    ("cmin, rmin, cmax, rmax, n = w, h, -1, -1, 0",
+     "cmin, rmin, cmax, rmax, n = w, h, -1, - 0, 0", _EMPTY_BOX),
+    ("cmin, rmin, cmax, rmax, n = w, h, -1, -1, 0",
+     "cmin, rmin, cmax, rmax, n = w, h, - 2, -1, 0", _EMPTY_BOX),
+    ("cmin, rmin, cmax, rmax, n = w, h, -1, -1, 0",
+     "cmin, rmin, cmax, rmax, n = w, h, -1, - 2, 0", _EMPTY_BOX),
+    *[("vis_count[k] = 0", f"vis_count[k] = {v}",
+       "the static layer's count of an entity outside it: only static entities' counts "
+       "are read (is_static), and those are all in the layer") for v in ("1", "-1")],
+    ("if ti < 0:", "if ti < -1:",
+     "(in _frame_stats) an absent entity's label is nowhere in the frame's labels, so "
+     "the scan, or the static layer's count, gives the 0 pixels the shortcut writes"),
+]
+
+_PARTIAL = "partial = present & ((x0 < 0) | (y0 < 0) | (x0 + tw[safe] > w) | (y0 + th[safe] > h))"
+_EDGES = ("only chooses which entities crossing the frame's edge get the exact test of their "
+          "in-frame alpha. Templates are cropped to their silhouette, so the template's "
+          "outer row and column at each edge hold an opaque pixel: an entity crossing one "
+          "edge, or none, always shows one. Only an entity crossing two edges (a corner, "
+          "or wider or taller than the frame) can be wholly transparent in the frame, and "
+          "the mutant still selects each such entity, or selects more, which the exact "
+          "test keeps present")
+EQUIVALENT["ground-truth"] = [  # noqa: F821
+    *[(_PARTIAL, _PARTIAL.replace(a, b), _EDGES) for a, b in (
+        ("y0 + th[safe] > h", "y0 - th[safe] > h"),
+        ("y0 + th[safe] > h", "y0 + th[safe] >= h"),
+        ("x0 + tw[safe] > w", "x0 - tw[safe] > w"),
+        ("x0 + tw[safe] > w", "x0 + tw[safe] >= w"),
+        ("(x0 + tw[safe] > w) | (y0", "(x0 + tw[safe] > w) & (y0"),
+        ("(x0 < 0) | (y0 < 0)", "(x0 < 0) & (y0 < 0)"),
+        ("(y0 < 0) | (x0", "(y0 < 0) & (x0"),
+        ("(y0 < 0)", "(y0 < 1)"),
+        ("(y0 < 0)", "(y0 <= 0)"),
+        ("(x0 < 0)", "(x0 < 1)"),
+        ("(x0 < 0)", "(x0 <= 0)"),
+        ("(x0 < 0)", "(x0 < -1)"),
+        ("(y0 < 0)", "(y0 < -1)"),
+    )],
+    (_PARTIAL, _PARTIAL.replace("present & (", "present | ("),
+     "also tests the present entities inside the frame (their whole template, which has "
+     "an opaque pixel: kept) and the absent ones (already not present)"),
+    *[("if len(templates) > 1:", f"if len(templates) {m}:",
+       "with one template the assignment to toff[1:] is empty") for m in ("> 0", ">= 1")],
+    *[(f"for {a} in zip({b}, strict=True){c}", f"for {a} in zip({b}, strict=False){c}",
+       "the zipped sequences have equal lengths by construction (the templates' offsets "
+       "and sizes; np.nonzero's indices)")
+      for a, b, c in (("o, hh, ww", "toff, th, tw", ""), ("f, k", "*np.nonzero(partial)", ":"))],
+    ("else np.zeros(0, dtype=np.uint8)", "else np.zeros( 1, dtype=np.uint8)",
+     "the buffer of no templates: nothing reads it"),
+    ("amodal = np.where(present, alpha_count[safe], 1.0)",
+     "amodal = np.where(present, alpha_count[safe], 2.0)",
+     "the guard of a division whose value np.where discards for absent entities (0.0 "
+     "is killed: 0/0 warns)"),
+    ("safe = np.maximum(tidx, 0)", "safe = np.maximum(tidx, -1)",
+     "an absent entity's size is then read from the last template: _drop_shapes_outside "
+     "never tests absent entities, and _ground_truth replaces every value computed from "
+     "it (box and centre by NaN, the silhouette's pixels by the guard 1)"),
+]

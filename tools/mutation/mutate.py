@@ -69,6 +69,17 @@ _MEAN_SHIFT_TESTS = (
     "tests/trackers/test_equivalences.py",
 )
 
+# The generator's tests (the README is not copied to the mutation tree: its example's
+# test is left out).
+_RENDER_TESTS = (
+    "tests/scenegen/render/test_generator.py", "tests/scenegen/render/test_realistic.py",
+    "--deselect",
+    "tests/scenegen/render/test_realistic.py::test_readme_realistic_example_generates",
+)
+# Hypothesis without shrinking (tests/conftest.py): a failing example kills the mutant,
+# and shrinking it took 20-40 s a mutant in the generator's drawn scenes.
+_NO_SHRINK = {"HYPOTHESIS_PROFILE": "mutate"}
+
 MODULES: dict[str, Module] = {
     "resampling": Module(
         "trackers/filters/resampling.py",
@@ -187,6 +198,32 @@ MODULES: dict[str, Module] = {
          "the_paper_puts_above_dps",
          "tests/scenegen/lab/test_experiments.py::test_mcnemar_claims_carry_the_paired_interval",
          "tests/scenegen/lab/test_experiments.py::test_clustered_claims_count_scenes_not_runs"),
+    ),
+    # The generator's ground truth: the AR2 paths and their boundary rules, and the
+    # compiled compositor that paints the labels and scans every entity's visible box and
+    # pixel count (the visibility's numerator). gtcheck.py in tests/scenegen/render
+    # recomputes every frame's labels and ground truth with plain numpy.
+    "motion": Module(
+        "scenegen/render/motion.py",
+        ("ar2_path", "ar2_stationary_moments"),
+        ("tests/scenegen/render/test_motion_oracle.py", *_RENDER_TESTS),
+        _NO_SHRINK,
+    ),
+    "compose": Module(
+        "scenegen/render/compose.py",
+        ("paint", "_scan_visible", "scan_static", "render_chunk", "_draw_frame",
+         "_frame_stats"),
+        ("tests/scenegen/render/test_compose_oracle.py", *_RENDER_TESTS),
+        # Out-of-bounds writes in compiled code are undefined behaviour, not errors.
+        {"NUMBA_BOUNDSCHECK": "1", **_NO_SHRINK},
+    ),
+    # What the generator writes from the compositor's output: amodal boxes and centres,
+    # the visibility (visible pixels / the silhouette's pixels), visible boxes, presence.
+    "ground-truth": Module(
+        "scenegen/render/plan.py",
+        ("_top_left", "_drop_shapes_outside", "_pack", "_ground_truth"),
+        ("tests/scenegen/render/test_compose_oracle.py", *_RENDER_TESTS),
+        _NO_SHRINK,
     ),
 }
 
