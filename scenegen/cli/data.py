@@ -142,7 +142,12 @@ def cmd_generate(args: argparse.Namespace) -> int:
         if args.frames < 1:
             raise ConfigError(f"--frames must be >= 1, got {args.frames}")
         cfg = replace(cfg, n_frames=args.frames)
-    scn = plan(cfg, args.seed, preset=preset)
+    try:  # a config that parses may still fail when planned (a runaway path, an image)
+        scn = plan(cfg, args.seed, preset=preset)
+    except ConfigError as err:
+        if args.config is None:
+            raise
+        raise ConfigError(f"{args.config}: {err}") from None
     with bar(cfg.n_frames, f"generate {cfg.name}", unit="frame") as pb:
         write_scenario(
             args.output, scn, compression=args.compression, progress=lambda n: pb.update(n - pb.n)

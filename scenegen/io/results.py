@@ -103,7 +103,21 @@ class TrackerResult:
                 f"order_prob has shape {prob.shape}, expected "
                 f"({boxes.shape[0]}, {orderings.shape[0]}) (T frames, L orderings)"
             )
+        if bad := bad_probabilities(prob):
+            out.append(bad)
         return out
+
+
+def bad_probabilities(prob: ArrayLike) -> str:
+    """The problem with ``order_prob`` (T, L) whose values are not probabilities, finite
+    and within [0, 1] ("" if none): a damaged or wrong result."""
+    a = np.asarray(prob, dtype=np.float64)
+    bad = ~((a >= 0.0) & (a <= 1.0))  # NaN fails both
+    if not bad.any():
+        return ""
+    t = int(np.argwhere(bad)[0][0])
+    return (f"order_prob holds values that are not probabilities in [0, 1] (first at frame "
+            f"{t}: {a[bad][0]:g})")  # fmt: skip
 
 
 def repeated_ids(ids: ArrayLike) -> str:

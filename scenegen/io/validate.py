@@ -37,7 +37,7 @@ from scenegen.io.atomic import describe_special_file
 from scenegen.io.guard import beat, call
 from scenegen.io.guard import timeout as guard_timeout
 from scenegen.io.integrity import ATTRS_DIGEST, DIGEST, INTEGRITY, Hasher, as_text, attrs_digest
-from scenegen.io.results import bad_box_rows, repeated_ids
+from scenegen.io.results import bad_box_rows, bad_probabilities, repeated_ids
 from scenegen.io.schema import GT_FIELDS, RESULT_FIELDS, ROLES, SCHEMA, SEQUENCE_FIELDS, field
 
 __all__ = ["check_file", "require_valid"]
@@ -549,6 +549,9 @@ def _check_results(p: Path, root: h5py.Group) -> list[str]:
             and (orderings.min() < 0 or orderings.max() >= m)
         ):
             problems.append(f"{where}: orderings name positions outside 0..{m - 1}")
+        prob = data.get("order_prob")
+        if prob is not None and (bad := bad_probabilities(prob)):
+            problems.append(f"{where}: {bad}")
     return problems
 
 

@@ -105,6 +105,7 @@ def test_bad_config_exits_2_with_one_line(tmp_path, capsys, config, field):
     code, out, err = run(capsys, "generate", "--config", path, "-o", tmp_path / "x.h5")
     assert code == 2 and out == ""
     assert len(err.strip().splitlines()) == 1 and field in err and "Traceback" not in err
+    assert err.startswith(f"scenegen: error: {path}: "), err  # the file is named
     assert not (tmp_path / "x.h5").exists()
 
 

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import h5py
 import numpy as np
 import pytest
@@ -166,3 +168,29 @@ def test_validate_names_infinite_or_off_frame_ground_truth_where_present(tmp_pat
     assert "gt/box is infinite where present at frames 5" in problems
     assert "gt/center is infinite where present at frames 5" in problems
     assert "gt/box lies outside the frame where present at frames 4" in problems
+
+
+@pytest.mark.parametrize("value", [1.5, -0.25, np.nan, np.inf])
+def test_order_prob_must_hold_probabilities(tmp_path, value):
+    """A result whose ``order_prob`` is not in [0, 1] is refused when written, and a file
+    holding one (its digest resealed, as another writer would) is not valid."""
+    from scenegen.io import integrity
+
+    prob = np.full((4, 2), 0.5, np.float32)
+    res = TrackerResult(
+        tracker="shm", params={}, seed=0, sequence="x",
+        target_ids=np.array([1, 2], np.int32), boxes=np.ones((4, 2, 4), np.float32),
+        orderings=np.array([[0, 1], [1, 0]], np.int16), order_prob=prob,
+    )  # fmt: skip
+    path = tmp_path / "r.h5"
+    write_result(path, res)
+    assert check_file(path) == []
+    bad = prob.copy()
+    bad[2, 1] = value
+    problem = "order_prob holds values that are not probabilities in [0, 1] (first at frame 2: "
+    assert any(p.startswith(problem) for p in dataclasses.replace(res, order_prob=bad).problems())
+    with h5py.File(path, "r+") as f:
+        ds = f["results/shm/order_prob"]
+        ds[...] = bad
+        integrity.put_text(ds, integrity.DIGEST, integrity.digest(ds[()]))
+    assert any(problem in line for line in check_file(path)), check_file(path)
