@@ -104,20 +104,35 @@ from numpy.typing import NDArray
 
 from trackers.params import TrackerParams
 
-__all__ = ["BaseTracker", "Estimate", "Tracker", "as_generator", "check_boxes", "check_frame"]
+__all__ = [
+    "MAX_BOX_VALUE",
+    "BaseTracker",
+    "Estimate",
+    "Tracker",
+    "as_generator",
+    "box_array",
+    "check_boxes",
+    "check_frame",
+]
 
 RngLike = np.random.Generator | int | None
+
+MAX_BOX_VALUE = 1e9
+"""Largest |x|, |y|, w and h of an initial box, in pixels (``check_boxes``). Larger boxes
+overflowed: a 1e308 box failed in the colour kernels with "boxes must be finite", and
+beyond 9.2e18 the template trackers cast coordinates to int64 with undefined results."""
 
 
 def as_generator(rng: RngLike) -> np.random.Generator:
     """Turn an ``rng`` argument into a Generator (a Generator is used as is)."""
     if isinstance(rng, np.random.Generator):
         return rng
-    if isinstance(rng, (int, np.integer)) and not isinstance(rng, bool) and rng < 0:
-        raise ValueError(f"rng must be a numpy Generator, a non-negative int or None, not {rng!r}")
-    if rng is None or isinstance(rng, (int, np.integer)):
+    if rng is None or (isinstance(rng, (int, np.integer)) and not isinstance(rng, bool)
+                       and rng >= 0):
         return np.random.default_rng(rng)
-    raise ValueError(f"rng must be a numpy Generator, an int or None, not {rng!r}")
+    # True was seed 1; a SeedSequence's repr took three lines.
+    what = repr(rng) if isinstance(rng, (int, np.integer, float, str)) else type(rng).__name__
+    raise ValueError(f"rng must be a numpy Generator, a non-negative int or None, not {what}")
 
 
 @dataclass
@@ -163,30 +178,51 @@ def check_frame(frame: Any, expected_shape: tuple[int, ...] | None = None) -> ND
     return np.ascontiguousarray(arr)
 
 
+def box_array(boxes: Any, name: str = "boxes") -> NDArray[np.float64]:
+    """``boxes`` as a new float64 array (K, 4), K >= 1; one box (4,) is one row.
+
+    Raises
+    ------
+    ValueError
+        Naming ``name``, if ``boxes`` is not numbers of that shape (strings, ragged
+        lists, ``None``).
+    """
+    try:
+        arr = np.array(boxes, dtype=np.float64)
+    except (TypeError, ValueError) as err:
+        raise ValueError(f"{name} must be numbers [x, y, w, h] of shape (K, 4), got "
+                         f"{type(boxes).__name__}: {str(err).splitlines()[0]}") from None
+    if arr.ndim == 1 and arr.shape[0] == 4:
+        arr = arr[None, :]
+    if arr.ndim != 2 or arr.shape[1] != 4 or arr.shape[0] < 1:
+        raise ValueError(f"{name} must have shape (K, 4) with K >= 1, got {np.shape(boxes)}")
+    return arr
+
+
 def check_boxes(boxes: Any, frame_shape: tuple[int, ...]) -> NDArray[np.float64]:
     """Validate initial boxes (K, 4) against a frame of shape (H, W, ...).
 
-    A box must have positive width and height and overlap the frame.
+    A box must have positive width and height, overlap the frame and have no coordinate
+    or size beyond :data:`MAX_BOX_VALUE` pixels.
 
     Raises
     ------
     ValueError
         Naming the first offending box and what is wrong with it.
     """
-    arr = np.asarray(boxes, dtype=np.float64)
-    if arr.ndim == 1 and arr.shape[0] == 4:
-        arr = arr[None, :]
-    if arr.ndim != 2 or arr.shape[1] != 4 or arr.shape[0] < 1:
-        raise ValueError(f"boxes must have shape (K, 4) with K >= 1, got {np.shape(boxes)}")
+    arr = box_array(boxes, "boxes")
     h, w = frame_shape[0], frame_shape[1]
     for k, (x, y, bw, bh) in enumerate(arr):
         if not np.all(np.isfinite([x, y, bw, bh])):
             raise ValueError(f"box {k} is not finite: {arr[k].tolist()}")
         if bw <= 0 or bh <= 0:
             raise ValueError(f"box {k} has zero or negative size: {arr[k].tolist()}")
+        if max(abs(x), abs(y), bw, bh) > MAX_BOX_VALUE:
+            raise ValueError(f"box {k} {arr[k].tolist()} is too large: |x|, |y|, w and h "
+                             f"must be <= {MAX_BOX_VALUE:g} px")
         if x >= w or y >= h or x + bw <= 0 or y + bh <= 0:
             raise ValueError(f"box {k} {arr[k].tolist()} lies outside the {w}x{h} frame")
-    return arr.copy()
+    return arr
 
 
 class BaseTracker(ABC):
@@ -264,12 +300,19 @@ class BaseTracker(ABC):
         """Build the tracker's parts from its validated ``params`` (called by ``__init__``)."""
 
     def init(self, frame: Any, boxes: Any) -> None:
-        """Initialise on ``frame`` (H, W, 3) with one box per target, ``boxes`` (K, 4)."""
+        """Initialise on ``frame`` (H, W, 3) with one box per target, ``boxes`` (K, 4).
+
+        An ``init`` that raises leaves the tracker uninitialised (``step`` refuses to run
+        until an ``init`` succeeds), never half-set-up for the new boxes.
+        """
         frame = check_frame(frame)
         boxes = check_boxes(boxes, frame.shape)
-        self._frame_shape = frame.shape
+        # Unset first: a _init refusing the new boxes (SHM's 5 targets, DPS's groups) had
+        # left step running on the old state or failing with an IndexError.
+        self._frame_shape = None
         self.n_targets = boxes.shape[0]
         self._init(frame, boxes)
+        self._frame_shape = frame.shape
 
     def step(self, frame: Any) -> Estimate:
         """Advance one frame (H, W, 3) and return the estimate."""

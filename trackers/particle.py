@@ -254,11 +254,19 @@ class PSParams(PartitionedParams):
                                  f"got {order!r}")
             self._set("ordering", int(order))
             return
+        # A string was read digit by digit ("10" -> (1, 0)) and 1.5 as 1: refused.
         try:
-            self._set("ordering", tuple(int(o) for o in order))
-        except (TypeError, ValueError):
+            items = [] if isinstance(order, (str, bytes)) else list(order)
+        except TypeError:
+            items = []
+        if not items or not all(
+            (isinstance(o, (int, np.integer)) and not isinstance(o, bool))
+            or (isinstance(o, (float, np.floating)) and np.isfinite(o) and int(o) == o)
+            for o in items
+        ):
             raise ValueError(f"ordering must be an int (circular shift) or a sequence of "
-                             f"target indices, got {order!r}") from None
+                             f"target indices, got {order!r}")
+        self._set("ordering", tuple(int(o) for o in items))
 
 
 @dataclass(frozen=True)

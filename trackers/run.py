@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from trackers.base import box_array
 from trackers.protocol import Tracker
 
 __all__ = ["TrackResult", "estimate_boxes", "track"]
@@ -82,15 +83,6 @@ def estimate_boxes(tracker: Any, estimate: Any, n_targets: int, frame: int) -> N
     return boxes
 
 
-def _init_boxes(boxes: Any) -> NDArray[np.float64]:
-    arr = np.asarray(boxes, dtype=np.float64)
-    if arr.ndim == 1 and arr.shape[0] == 4:
-        arr = arr[None, :]
-    if arr.ndim != 2 or arr.shape[1] != 4 or arr.shape[0] < 1:
-        raise ValueError(f"init_boxes must have shape (K, 4) with K >= 1, got {np.shape(boxes)}")
-    return arr
-
-
 def _stack_extras(tracker: Any, per_frame: list[dict[str, Any]], n: int) -> dict[str, Any]:
     extras: dict[str, NDArray[Any]] = {}
     if n < 2:
@@ -137,7 +129,8 @@ def track(
         If ``frames`` is empty, ``init_boxes`` is not (K, 4), or an estimate breaks the
         protocol (naming the frame).
     TypeError
-        If ``tracker`` lacks ``init`` or ``step``, or is a class rather than an instance.
+        If ``tracker`` lacks ``init`` or ``step``, or is a class rather than an instance,
+        or ``frames`` has no length (a generator: pass ``list(frames)``).
     """
     if isinstance(tracker, type):  # a class has init and step too, unbound
         raise TypeError(
@@ -150,10 +143,16 @@ def track(
             f"{_label(tracker)} is not a tracker: it has no {' or '.join(missing)} method "
             "(the protocol: init(frame, boxes), step(frame) -> estimate with .boxes)"
         )
+    if not (hasattr(frames, "__len__") and hasattr(frames, "__getitem__")):
+        # len() said "object of type 'generator' has no len()", naming no argument.
+        raise TypeError(
+            f"frames must be an array (T, H, W, 3) or a sequence of frames with a length, "
+            f"got {type(frames).__name__} (for a generator or iterator: list(frames))"
+        )
     n = len(frames)
     if n < 1:
         raise ValueError("frames is empty: need at least one frame")
-    start = _init_boxes(init_boxes)
+    start = box_array(init_boxes, "init_boxes")
     k = start.shape[0]
     tracker.init(frames[0], start.copy())
     boxes = np.empty((n, k, 4), dtype=np.float64)

@@ -124,3 +124,31 @@ def test_frames_that_are_not_uint8_are_refused_not_converted(dtype):
     frame = np.zeros((40, 40, 3), dtype=dtype)
     with pytest.raises(ValueError, match=f"frame must be uint8 RGB, got dtype {np.dtype(dtype)}"):
         t.init(frame, [[10, 10, 8, 8]])
+
+
+def test_an_opencv_init_refused_on_a_later_box_leaves_it_uninitialised(monkeypatch):
+    # The cv2 trackers of the boxes before the refused one were kept, and step returned
+    # fewer rows than init's boxes.
+    import cv2
+
+    from trackers.adapters import opencv
+
+    class Still:
+        def __init__(self, ok):
+            self.ok = ok
+
+        def init(self, frame, box):
+            if not self.ok:
+                raise cv2.error("OpenCV(5.0.0) x.cpp:1: error: (-215:Assertion failed) no")
+
+        def update(self, frame):
+            return True, (1, 1, 8, 8)
+
+    made = iter([True, False])
+    t = opencv("MIL", rng=0)
+    monkeypatch.setattr(t, "_make", lambda: Still(next(made)))
+    frame = np.zeros((60, 80, 3), np.uint8)
+    with pytest.raises(ValueError, match="could not start on box"):
+        t.init(frame, [[30, 20, 20, 20], [5, 5, 20, 20]])
+    with pytest.raises(ValueError, match=r"call init\(\) before step\(\)"):
+        t.step(frame)

@@ -74,6 +74,14 @@ def test_unknown_keyword_is_a_type_error_naming_it():
         ("hybrid", {"resampler": "best"}, "unknown resampler 'best'; valid: multinomial"),
         ("dps", {"n_groups": 301}, r"n_groups must be an integer in \[1, 300\] or None"),
         ("ps", {"ordering": -1}, "ordering must be a circular shift >= 0"),
+        # A string was read digit by digit ("10" -> the permutation (1, 0)), 1.5 as 1.
+        ("ps", {"ordering": "10"}, "ordering must be an int .* or a sequence of target"),
+        ("ps", {"ordering": [1.5, 0]}, "ordering must be an int .* got \\[1.5, 0\\]"),
+        ("annealed", {"sigma": True}, "sigma must be a number or 3 numbers"),  # was 1 px
+        ("kams", {"sigma": [True, True, False]}, "sigma must be a number or 3 numbers"),
+        ("condensation", {"rng": True}, "rng must be a numpy Generator, a non-negative int or "
+                                        "None, not True"),  # was seed 1
+        ("meanshift", {"rng": np.random.SeedSequence(1)}, "not SeedSequence$"),  # 3 lines
         ("condensation", {"lam": -1.0}, "lam must be finite and > 0"),
         ("joint-pf", {"bins": 0}, r"bins must be an integer in \[1, 256\]"),
         ("joint-pf", {"kernel": "gauss"}, "unknown kernel 'gauss'"),

@@ -93,3 +93,72 @@ def test_matcher_parameters_of_the_wrong_type_are_named(value):
 
     with pytest.raises(ValueError, match=r"blur must be in \[0, 20\] pixels, got"):
         check_matcher_params(5, 1, 0.5, "box", value)
+
+
+_FIVE = [[i * 5.0, 2.0, 4.0, 4.0] for i in range(5)]
+
+
+@pytest.mark.parametrize(
+    ("name", "params", "refused"),
+    [
+        ("shm", {}, _FIVE),  # 5 targets: 120 orderings, refused by _init
+        ("shm-fast", {}, _FIVE),
+        ("dps", {"n_particles": 3}, _FIVE),  # one group per target > n_particles
+        ("ps", {"ordering": (1, 0)}, [[2.0, 3.0, 5.0, 6.0]]),  # not a permutation of 1
+    ],
+)
+def test_an_init_that_fails_leaves_the_tracker_uninitialised(name, params, refused):
+    # step after a refused init ran on the previous init's state (SHM: 2 boxes from a
+    # tracker whose n_targets said 5) or failed with an IndexError / AttributeError.
+    frames = _frames()
+    t = trackers.make(name, rng=0, **params)
+    with pytest.raises(ValueError):
+        t.init(frames[0], refused)
+    with pytest.raises(ValueError, match=r"call init\(\) before step\(\)"):
+        t.step(frames[1])
+    t.init(frames[0], [[2.0, 3.0, 5.0, 6.0], [15.0, 10.0, 6.0, 5.0]])
+    assert t.step(frames[1]).boxes.shape == (2, 4)
+    with pytest.raises(ValueError):
+        t.init(frames[0], refused)
+    with pytest.raises(ValueError, match=r"call init\(\) before step\(\)"):
+        t.step(frames[2])
+
+
+@pytest.mark.parametrize("frames", [(f for f in _frames()), iter(_frames()), None, {1, 2}])
+def test_track_names_frames_without_a_length(frames):
+    # len() said "object of type 'generator' has no len()", naming no argument.
+    with pytest.raises(TypeError, match=r"^frames must be an array \(T, H, W, 3\) or a sequence"):
+        trackers.track(Still(), frames, [[1, 1, 2, 2]])
+
+
+@pytest.mark.parametrize(
+    ("boxes", "needle"),
+    [
+        ([["a", 1, 2, 3]], "could not convert string to float: 'a'"),
+        ([[1, 2, 3, 4], [1, 2]], "inhomogeneous shape"),
+        ({"x": 1}, "got dict"),
+    ],
+)
+def test_boxes_that_are_not_numbers_are_one_error_naming_them(boxes, needle):
+    # numpy's own message, naming neither boxes nor init_boxes.
+    with pytest.raises(ValueError, match=r"^init_boxes must be numbers \[x, y, w, h\]") as info:
+        trackers.track(Still(), _frames(), boxes)
+    assert needle in str(info.value) and "\n" not in str(info.value)
+    with pytest.raises(ValueError, match=r"^boxes must be numbers \[x, y, w, h\]"):
+        trackers.make("meanshift").init(_frames()[0], boxes)
+
+
+@pytest.mark.parametrize(
+    ("name", "box"),
+    [("condensation", [0.0, 0.0, 1e308, 1e308]), ("kalman", [0.0, 0.0, 1e20, 1e20]),
+     ("meanshift", [-2e9, 5.0, 3e9, 4.0])],
+)
+def test_a_box_beyond_the_largest_value_is_refused_at_init(name, box):
+    # 1e308 passed init and failed at the first step with "boxes must be finite with
+    # positive width and height"; 1e20 made the template trackers cast to int64 with
+    # undefined results (RuntimeWarning: invalid value encountered in cast).
+    t = trackers.make(name, rng=0)
+    with pytest.raises(ValueError, match=r"^box 0 .* is too large: .* <= 1e\+09 px$"):
+        t.init(_frames()[0], [box])
+    t.init(_frames()[0], [[0.0, 0.0, 1e9, 1e9]])  # the largest is accepted and tracked
+    assert np.isfinite(t.step(_frames()[1]).boxes).all()

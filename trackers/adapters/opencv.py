@@ -154,7 +154,9 @@ class OpenCVTracker:
         if self.rng is not None:
             cv2.setRNGSeed(int(self.rng))
         bgr = np.ascontiguousarray(rgb[:, :, ::-1])
-        self._shape = rgb.shape
+        # Unset until every box has started: a box refused had left step tracking only
+        # the boxes before it (fewer rows than init's boxes).
+        self._shape = None
         self._trackers, self._sizes = [], []
         for box in boxes:
             t = self._make()
@@ -169,6 +171,7 @@ class OpenCVTracker:
             self._trackers.append(t)
             grown = px[2] > np.ceil(box[2]) or px[3] > np.ceil(box[3])
             self._sizes.append((float(box[2]), float(box[3])) if grown else None)
+        self._shape = rgb.shape
 
     def step(self, frame: Any) -> Estimate:
         """Update every cv2 tracker on ``frame``; NaN boxes where one reports failure."""
