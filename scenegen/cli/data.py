@@ -131,6 +131,7 @@ def load_source(preset: str | None, config: Path | None) -> tuple[Any, str]:
 
 def cmd_generate(args: argparse.Namespace) -> int:
     from scenegen.io import COMPRESSIONS, write_scenario
+    from scenegen.io.mot import writable
     from scenegen.render.plan import plan
 
     if args.compression not in COMPRESSIONS:
@@ -148,7 +149,8 @@ def cmd_generate(args: argparse.Namespace) -> int:
         if args.config is None:
             raise
         raise ConfigError(f"{args.config}: {err}") from None
-    with bar(cfg.n_frames, f"generate {cfg.name}", unit="frame") as pb:
+    # A full disk or a read-only folder: one line naming the output, exit 2.
+    with bar(cfg.n_frames, f"generate {cfg.name}", unit="frame") as pb, writable(args.output):
         write_scenario(
             args.output, scn, compression=args.compression, progress=lambda n: pb.update(n - pb.n)
         )

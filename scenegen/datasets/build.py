@@ -188,6 +188,7 @@ def make_shard(task: ShardTask) -> dict[str, Any]:
         so far, MiB).
     """
     from scenegen.io import write
+    from scenegen.io.mot import writable
     from scenegen.testing.fixtures import digests
 
     cpu = time.process_time()
@@ -195,9 +196,11 @@ def make_shard(task: ShardTask) -> dict[str, Any]:
     if kept is not None:
         return {"shard": task.shard, "reused": True, "entries": kept, **_worker(cpu)}
     seqs = [_generate(d) for d in task.draws]
-    Path(task.root).mkdir(parents=True, exist_ok=True)  # a worker without the shared folder
     entries = [_entry(d, task.file, s, digests(s)) for d, s in zip(task.draws, seqs, strict=True)]
-    write(Path(task.root) / task.file, *seqs, compression=task.compression)
+    target = Path(task.root) / task.file
+    with writable(target):  # a full disk or a read-only folder: one line naming the shard
+        Path(task.root).mkdir(parents=True, exist_ok=True)  # a worker without the folder
+        write(target, *seqs, compression=task.compression)
     return {"shard": task.shard, "reused": False, "entries": entries, **_worker(cpu)}
 
 
@@ -271,11 +274,18 @@ _IDENTITY = ("schema", "family_digest", "seed", "shard_size", "compression")
 
 
 def write_manifest(root: Path, manifest: dict[str, Any]) -> None:
-    """Write ``manifest.json`` atomically (sorted keys, entries in index order)."""
+    """Write ``manifest.json`` atomically (sorted keys, entries in index order).
+
+    Raises
+    ------
+    ConfigError
+        ``DIR/manifest.json: cannot write: REASON`` (a full disk, a read-only folder).
+    """
     from scenegen.io import atomic_path
+    from scenegen.io.mot import writable
 
     text = json.dumps(manifest, sort_keys=True, indent=1, allow_nan=False)
-    with atomic_path(root / MANIFEST, ".json") as tmp:
+    with writable(root / MANIFEST), atomic_path(root / MANIFEST, ".json") as tmp:
         tmp.write_text(text + "\n", encoding="utf-8")
 
 

@@ -27,6 +27,8 @@ Ground-truth modes (``gt_mode``) say which ground-truth boxes count:
 from __future__ import annotations
 
 import math
+import os
+import re
 from pathlib import Path
 
 import numpy as np
@@ -286,6 +288,22 @@ class writable:
         return None
 
     def __exit__(self, kind: type | None, err: BaseException | None, tb: object) -> bool:
-        if isinstance(err, OSError) and err.errno is not None:
-            raise ConfigError(f"{self.target}: cannot write: {err.strerror or err}") from None
+        code = _write_errno(err)
+        if code is not None:
+            raise ConfigError(f"{self.target}: cannot write: {os.strerror(code)}") from None
         return False
+
+
+def _write_errno(err: BaseException | None) -> int | None:
+    """The operating-system error number of a failed write, or None if it is not one.
+
+    An :class:`OSError`'s ``errno``; h5py reports a write that fails when a file is
+    flushed or closed (a full disk) as a ``RuntimeError`` (or an ``OSError`` without
+    ``errno``) whose multi-line HDF5 message holds ``errno = N``.
+    """
+    if isinstance(err, OSError) and err.errno is not None:
+        return int(err.errno)
+    if isinstance(err, (OSError, RuntimeError)):
+        found = re.search(r"\berrno = (\d+)", str(err))
+        return int(found.group(1)) if found else None
+    return None

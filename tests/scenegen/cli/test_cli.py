@@ -222,3 +222,19 @@ def test_a_sequence_or_tracker_the_file_lacks_is_a_usage_error(tmp_path, capsys)
     code, _, err = run(capsys, "export", res, "--format", "mot", "--tracker", "x",
                        "-o", tmp_path / "r.txt")  # fmt: skip
     assert code == 2 and err.strip().endswith("(choose with --tracker)")
+
+
+def test_a_full_disk_is_one_line_naming_the_output(tmp_path, capsys, monkeypatch):
+    # h5py reports a write that fails when HDF5 flushes a file (a full disk) as a
+    # RuntimeError whose text holds the errno: it was an internal error, exit 1.
+    import scenegen.io
+
+    def full(*args, **kwargs):
+        raise RuntimeError("Disable slist on flush dest failure failed (file write failed: "
+                           "time = ...\n, errno = 28, error message = 'No space left')")
+
+    monkeypatch.setattr(scenegen.io, "write_scenario", full)
+    out = tmp_path / "x.h5"
+    code, _, err = run(capsys, "generate", "--preset", "kams-a", "--frames", "2", "-o", out)
+    line = f"scenegen: error: {out}: cannot write: No space left on device"
+    assert (code, err.strip()) == (2, line)

@@ -192,6 +192,10 @@ def test_cover_levels_and_occlusion_tags(tmp_path, occluded):
 
 def test_unwritable_output_names_the_target(tmp_path, capsys, monkeypatch):
     src = FIXTURES / "full-occlusion.h5"
+    # The guarded read of the input starts its fork server with a temporary folder: done
+    # here first, so that only the output's temporary files are denied (run alone, the
+    # test had denied the guard's too and got an internal error).
+    read(src)
 
     def denied(*args, **kwargs):
         raise PermissionError(13, "Permission denied", str(tmp_path / ".x.tmp-1@h-abc"))

@@ -507,3 +507,43 @@ def test_telling_folders_apart_does_not_wait_on_a_fifo_results_json(tmp_path):
     except subprocess.TimeoutExpired:
         pytest.fail("holds_report on a FIFO results.json did not answer within 60 s")
     assert done.returncode == 0, done.stderr
+
+
+# h5py's error when HDF5 flushes a file on a full disk: a RuntimeError, its errno in text.
+_H5_FULL = ("Disable slist on flush dest failure failed (file write failed: time = Thu Dec  3 "
+            "07:13:17 2026\n, filename = '/x/.shard-00000.h5.tmp-1@h-abc', file descriptor = 3, "
+            "errno = 28, error message = 'No space left on device', buf = 0x55, total write "
+            "size = 9316, bytes this sub-write = 9316, offset = 20480)")  # fmt: skip
+
+
+@pytest.mark.parametrize("error", [RuntimeError(_H5_FULL),
+                                   OSError(28, "Can't synchronously write data (file write "
+                                           "failed: time = ...\n, errno = 28)")])  # fmt: skip
+def test_a_full_disk_is_one_line_naming_the_shard(tmp_path, monkeypatch, error):
+    # It was "internal error: RuntimeError: Disable slist on flush dest failure failed
+    # (file write failed: time = ..." (exit 1), or h5py's multi-line OSError text.
+    def full(*args, **kwargs):
+        raise error
+
+    monkeypatch.setattr(scenegen.io, "write", full)
+    out = tmp_path / "ds"
+    with pytest.raises(ConfigError) as caught:
+        build_dataset(TINY, out, jobs=1, shard_size=SHARD)
+    assert str(caught.value) == f"{out / 'shard-00000.h5'}: cannot write: No space left on device"
+
+
+def test_a_read_only_folder_is_one_line_naming_the_manifest(tmp_path, monkeypatch):
+    # It was "internal error: OSError: [Errno 30] Read-only file system:
+    # '.../.manifest.json.tmp-PID@HOST-RANDOM.json'" (exit 1).
+    import errno
+    import tempfile
+
+    def read_only(*args, **kwargs):
+        raise OSError(errno.EROFS, os.strerror(errno.EROFS), str(tmp_path / ".m.tmp-1@h-abc"))
+
+    out = tmp_path / "ds"
+    out.mkdir()
+    monkeypatch.setattr(tempfile, "mkstemp", read_only)
+    with pytest.raises(ConfigError) as caught:
+        build_dataset(TINY, out, jobs=1, shard_size=SHARD)
+    assert str(caught.value) == f"{out / 'manifest.json'}: cannot write: Read-only file system"
