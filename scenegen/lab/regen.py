@@ -8,7 +8,6 @@ it lives in the lab. ``scenegen fixtures verify`` and ``scenegen fixtures regen`
 from __future__ import annotations
 
 import json
-import shutil
 from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
@@ -198,7 +197,8 @@ def regen(
 
     Files are rewritten only when their contents change (HDF5 files carry timestamps, so
     an unchanged fixture keeps its file). Fixtures no longer defined are removed when all
-    fixtures are regenerated.
+    fixtures are regenerated (their file and the expected outputs regen wrote; other
+    files a user stored under ``expected/<name>/`` are kept and reported).
 
     Parameters
     ----------
@@ -280,9 +280,27 @@ def _remove_undefined(root: Path, entries: dict[str, Any], defs: dict[str, Any])
     for gone in sorted(set(entries) - set(defs)):
         old = entries.pop(gone)
         (root / old.get("file", f"{gone}.h5")).unlink(missing_ok=True)
-        shutil.rmtree(root / "expected" / gone, ignore_errors=True)
-        changes.append(f"fixture {gone}: removed")
+        kept = _remove_expected(root / "expected" / gone, old.get("trackers"))
+        note = f"; kept expected/{gone}/ ({kept} file(s) regen did not write)" if kept else ""
+        changes.append(f"fixture {gone}: removed{note}")
     return changes
+
+
+def _remove_expected(folder: Path, runs: Any) -> int:
+    """Remove from ``folder`` the expected outputs regen writes (``<tracker>.npy`` of the
+    registry's runs), then the folder if it is empty. Anything else a user stored there
+    is kept; returns how many entries were kept."""
+    if not folder.is_dir() or folder.is_symlink():
+        return 0
+    names = set(runs) if isinstance(runs, dict) else set()
+    for tname in names:
+        path = folder / f"{tname}.npy"
+        if isinstance(tname, str) and path.parent == folder and path.is_file():
+            path.unlink()
+    kept = sum(1 for _ in folder.iterdir())
+    if not kept:
+        folder.rmdir()
+    return kept
 
 
 def _regen_sequence(

@@ -118,6 +118,26 @@ def test_regen_removes_fixtures_no_longer_defined(tmp_path):
     assert not (tmp_path / "old.h5").exists()
 
 
+def test_regen_keeps_what_a_user_stored_beside_a_removed_fixture(tmp_path):
+    regen(tmp_path, fixtures=["one-pixel"], tracker_names=["kalman"])
+    path = tmp_path / "registry.json"
+    registry = json.loads(path.read_text())
+    registry["fixtures"]["old"] = {"file": "old.h5", "digests": {}, "trackers": {"kalman": {}}}
+    registry["fixtures"]["older"] = {"file": "older.h5", "digests": {}, "trackers": {"kalman": {}}}
+    path.write_text(json.dumps(registry))
+    for name in ("old", "older"):
+        folder = tmp_path / "expected" / name
+        folder.mkdir(parents=True)
+        shutil.copy(tmp_path / "expected" / "one-pixel" / "kalman.npy", folder / "kalman.npy")
+    (tmp_path / "expected" / "old" / "mine.npy").write_bytes(b"user data")
+    changes, _ = regen(tmp_path, fixtures=None, tracker_names=["kalman"])
+    assert "fixture old: removed; kept expected/old/ (1 file(s) regen did not write)" in changes
+    assert (tmp_path / "expected" / "old" / "mine.npy").read_bytes() == b"user data"
+    assert not (tmp_path / "expected" / "old" / "kalman.npy").exists()
+    assert "fixture older: removed" in changes
+    assert not (tmp_path / "expected" / "older").exists()
+
+
 def test_cli_errors_are_one_line(tmp_path, capsys):
     assert main(["fixtures", "verify", "--dir", str(tmp_path)]) == 1
     err = capsys.readouterr().err.strip().splitlines()
