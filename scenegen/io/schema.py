@@ -274,8 +274,8 @@ def render_markdown() -> str:
         "fails to read instead of returning wrong values, and carries `sha256`, the SHA-256 "
         "of its values as stored (C order, stored dtype); the root and each sequence or "
         "result group carry `attrs_sha256`, a digest of their other attributes, and the root "
-        '`integrity = "sha256"` says every dataset has a digest (`scenegen validate` checks '
-        "them all; files of older versions lack them and stay valid).",
+        '`integrity = "sha256"` says every dataset has a digest and the filter (`scenegen '
+        "validate` checks them all; files of older versions lack them and stay valid).",
         "",
         "Strings (attributes and `entities/role`, `entities/name`) are fixed-length UTF-8, "
         "outside HDF5's unchecksummed global heap; h5py reads them as `bytes` "

@@ -617,6 +617,13 @@ def _check_digests(p: Path, f: h5py.File, check_pixels: bool, found: list[str]) 
                 if required:
                     problems.append(f"{where}: {key} has no digest ({DIGEST} attribute)")
                 continue
+            try:
+                unchecked = required and ds.size > 0 and not ds.fletcher32
+            except _READ_ERRORS as err:
+                problems.append(f"{where}: {key} is unreadable ({describe_read_error(err)})")
+                continue
+            if unchecked:  # its damaged chunks would read as values, not fail
+                problems.append(f"{where}: {key} is stored without the Fletcher-32 checksum")
             if key in ("frames", "labels") and not check_pixels:
                 continue
             try:

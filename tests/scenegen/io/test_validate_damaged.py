@@ -583,6 +583,26 @@ def test_edits_with_valid_digests_are_caught_by_deep(copy):
     assert check_file(copy(), deep=True) == []
 
 
+def test_a_dataset_rewritten_without_its_checksum_filter_is_named(copy):
+    """Same values, same attributes and digests: only the Fletcher-32 filter is gone, so
+    a damaged chunk would read as wrong values instead of failing."""
+
+    def unfiltered(g, f):
+        for key in ("gt/box", "templates/1"):
+            values, attrs = g[key][()], dict(g[key].attrs)
+            del g[key]
+            g.create_dataset(key, data=values)
+            for name in ("description", "units", integrity.DIGEST, integrity.ATTRS_DIGEST):
+                if name in attrs:
+                    integrity.put_text(g[key], name, integrity.as_text(attrs[name]))
+
+    p = edit(copy(), unfiltered)
+    assert check_file(p) == [
+        f"{p}: {SEQ}: gt/box is stored without the Fletcher-32 checksum",
+        f"{p}: {SEQ}: templates/1 is stored without the Fletcher-32 checksum",
+    ]
+
+
 def test_zeroed_chunks_and_renamed_entities_are_caught(copy):
     p = copy("none")
     with h5py.File(p) as f:
