@@ -71,7 +71,16 @@ from scenegen.io.integrity import (
     put_text,
     text_array,
 )
-from scenegen.io.schema import CONVENTIONS, GT_FIELDS, SCHEMA, Field, dataset_attrs, field
+from scenegen.io.schema import (
+    CONVENTIONS,
+    GT_FIELDS,
+    SCHEMA,
+    Field,
+    dataset_attrs,
+    field,
+    schema_problem,
+    template_size_problem,
+)
 from scenegen.sequence import Entities, GroundTruth, Sequence
 
 __all__ = [
@@ -645,13 +654,9 @@ def open_checked(path: str | Path) -> h5py.File:
     except (OSError, RuntimeError, KeyError):
         f.close()
         raise DataError(f"{p}: damaged HDF5 file (unreadable attributes)") from None
-    if isinstance(schema, bytes):
-        schema = schema.decode(errors="replace")
-    if schema != SCHEMA:
+    if problem := schema_problem(schema):
         f.close()
-        if schema is None:
-            raise DataError(f"{p}: missing schema attribute (expected {SCHEMA!r})")
-        raise DataError(f"{p}: schema is {schema!r}, expected {SCHEMA!r}")
+        raise DataError(f"{p}: {problem}")
     return f
 
 
@@ -721,6 +726,8 @@ def read(path: str | Path, name: str | None = None) -> Sequence:
 def _members(p: Path, f: h5py.File, group: str) -> list[str]:
     """Names in ``/group`` (none if absent); a damaged group is a DataError."""
     try:
+        if group in f and not isinstance(f[group], h5py.Group):
+            raise DataError(f"{p}: /{group} is not a group")
         return list(f[group].keys()) if group in f else []
     except (KeyError, ValueError, TypeError, OSError, RuntimeError) as err:
         raise DataError(f"{p}: /{group} is damaged: {describe_read_error(err)}") from None
@@ -748,7 +755,10 @@ def _read_once(p: Path, name: str | None) -> Sequence:
                 name=_str_array(g["entities/name"]),
             )
             gt = _read_gt(g)
-            templates = {int(k): v[()] for k, v in g["templates"].items()}
+            held = dict(g["templates"].items())
+            if too_big := template_size_problem([getattr(v, "shape", ()) for v in held.values()]):
+                raise DataError(f"{p}: sequence {name!r} is damaged: {too_big}")
+            templates = {int(k): v[()] for k, v in held.items()}
             seed, preset = int(g.attrs["seed"]), as_text(g.attrs["preset"])
             frames = LazyArray(p, f"sequences/{name}/frames", stamp=stamp)
             labels = LazyArray(p, f"sequences/{name}/labels", stamp=stamp)

@@ -24,7 +24,7 @@ from typing import Any, get_args
 
 import numpy as np
 
-from scenegen.config import Role
+from scenegen.config import MAX_TEMPLATE_PIXELS, Role
 
 __all__ = [
     "ATTRIBUTES",
@@ -40,6 +40,8 @@ __all__ = [
     "field",
     "gt_fields",
     "render_markdown",
+    "schema_problem",
+    "template_size_problem",
 ]
 
 SCHEMA = "scenegen/1"
@@ -215,6 +217,38 @@ def gt_fields() -> tuple[Field, ...]:
 
 GT_FIELDS: dict[str, Any] = {f.name: f.numpy_dtype for f in gt_fields()}
 """Ground-truth dataset name (under ``gt/``) -> numpy dtype, in layout order."""
+
+
+def schema_problem(value: Any) -> str | None:
+    """What is wrong with a file's ``schema`` attribute ``value`` (None: it is
+    :data:`SCHEMA`); the text follows the file's path in a problem line."""
+    if isinstance(value, np.ndarray) and value.shape == ():
+        value = value[()]
+    if isinstance(value, (bytes, np.bytes_)):
+        value = bytes(value).decode(errors="replace")
+    if value is None:
+        return f"missing schema attribute (expected {SCHEMA!r})"
+    if not isinstance(value, str):
+        shape = getattr(value, "shape", None)
+        what = f"an array of shape {shape}" if shape is not None else type(value).__name__
+        return f"schema attribute is {what}, expected the string {SCHEMA!r}"
+    if value != SCHEMA:
+        return f"schema is {value!r}, expected {SCHEMA!r}"
+    return None
+
+
+def template_size_problem(shapes: list[tuple[int, ...]]) -> str | None:
+    """What is wrong with the sizes of a sequence's templates (their ``shapes``) before
+    they are read (None: nothing): together they may not exceed the generator's
+    :data:`scenegen.config.MAX_TEMPLATE_PIXELS`, so a damaged or foreign file cannot ask a
+    reader for terabytes."""
+    pixels = sum(int(np.prod(s[:2], dtype=np.float64)) for s in shapes if len(s) >= 2)
+    if pixels > MAX_TEMPLATE_PIXELS:
+        return (
+            f"templates hold {pixels} pixels, more than the generator ever writes "
+            f"({MAX_TEMPLATE_PIXELS})"
+        )
+    return None
 
 
 def dataset_attrs(f: Field) -> dict[str, str]:

@@ -38,7 +38,15 @@ from scenegen.io.guard import beat, call
 from scenegen.io.guard import timeout as guard_timeout
 from scenegen.io.integrity import ATTRS_DIGEST, DIGEST, INTEGRITY, Hasher, as_text, attrs_digest
 from scenegen.io.results import bad_box_rows, bad_probabilities, repeated_ids
-from scenegen.io.schema import GT_FIELDS, RESULT_FIELDS, ROLES, SCHEMA, SEQUENCE_FIELDS, field
+from scenegen.io.schema import (
+    GT_FIELDS,
+    RESULT_FIELDS,
+    ROLES,
+    SEQUENCE_FIELDS,
+    field,
+    schema_problem,
+    template_size_problem,
+)
 
 __all__ = ["check_file", "require_valid"]
 
@@ -166,16 +174,14 @@ def _check_in_child(p: Path, check_pixels: bool, deep: bool) -> list[str]:
 
 
 def _check_open_file(p: Path, f: h5py.File, check_pixels: bool) -> list[str]:
-    schema = f.attrs.get("schema")
-    if isinstance(schema, bytes):
-        schema = schema.decode(errors="replace")
-    if schema is None:
-        return [f"{p}: missing schema attribute (expected {SCHEMA!r})"]
-    if schema != SCHEMA:
-        return [f"{p}: schema is {schema!r}, expected {SCHEMA!r}"]
+    if problem := schema_problem(f.attrs.get("schema")):
+        return [f"{p}: {problem}"]
     problems: list[str] = []
     if "generator_version" not in f.attrs:
         problems.append(f"{p}: missing attribute generator_version")
+    for group in ("sequences", "results"):
+        if group in f and not isinstance(f[group], h5py.Group):
+            return [*problems, f"{p}: /{group} is not a group"]
     if "sequences" in f:
         names = list(f["sequences"].keys())
         if not names:
@@ -319,6 +325,8 @@ def _check_sequence(where: str, g: h5py.Group, check_pixels: bool) -> list[str]:
 
 
 def _check_templates(where: str, grp: h5py.Group, ids: NDArray[Any]) -> list[str]:
+    if too_big := template_size_problem([getattr(ds, "shape", ()) for ds in grp.values()]):
+        return [f"{where}: {too_big}"]
     problems = []
     missing = [int(i) for i in ids if str(int(i)) not in grp]
     if missing:
@@ -560,10 +568,13 @@ def _check_results(p: Path, root: h5py.Group) -> list[str]:
 
 
 def _named(problems: list[str], where: str, key: str) -> bool:
-    """Whether a problem line of ``where`` already names ``key`` (then a digest mismatch
-    of the same dataset is the same problem: not reported twice)."""
+    """Whether a problem line of ``where`` already names ``key`` or a group holding it
+    (then a digest mismatch of the same dataset is the same problem: not reported twice,
+    and a dataset already found oversized is not read)."""
+    parts = key.split("/")
+    names = "|".join(re.escape("/".join(parts[:i])) for i in range(1, len(parts) + 1))
     return any(
-        line.startswith(f"{where}: ") and re.search(rf"(^|[\s/]){re.escape(key)}(\s|\[|$)",
+        line.startswith(f"{where}: ") and re.search(rf"(^|[\s/])({names})(\s|\[|$)",
                                                      line[len(where) + 2 :])
         for line in problems
     )  # fmt: skip

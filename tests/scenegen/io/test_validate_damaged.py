@@ -583,6 +583,35 @@ def test_edits_with_valid_digests_are_caught_by_deep(copy):
     assert check_file(copy(), deep=True) == []
 
 
+def test_exotic_damage_is_one_clear_line_for_validate_and_read(copy):
+    def oversized(g, f):  # 3.6 TiB declared, nothing stored: must not be read
+        del g["templates/1"]
+        ds = g.create_dataset("templates/1", shape=(10**6, 10**6, 4), dtype=np.uint8,
+                              chunks=(1000, 1000, 4), fletcher32=True)  # fmt: skip
+        integrity.put_text(ds, integrity.DIGEST, "0" * 64)
+
+    def sequences_as_dataset(g, f):
+        del f["sequences"]
+        f["sequences"] = np.zeros(3)
+
+    with h5py.File(copy(), "r") as f:
+        held = f["sequences/small/templates"]
+        others = sum(held[k].shape[0] * held[k].shape[1] for k in held if k != "1")
+    cases = [
+        (lambda g, f: f.attrs.__setitem__("schema", np.array([b"scenegen/1", b"x"])),
+         "schema attribute is an array of shape (2,), expected the string 'scenegen/1'"),
+        (sequences_as_dataset, "/sequences is not a group"),
+        (oversized, f"{SEQ}: templates hold {10**12 + others} pixels, more than the "
+                    "generator ever writes (16777216)"),
+    ]  # fmt: skip
+    for damage, line in cases:
+        p = edit(copy(), damage)
+        assert check_file(p) == [f"{p}: {line}"]
+        with pytest.raises(DataError) as err:
+            read(p)
+        assert str(err.value).endswith(line.split(": ")[-1]), str(err.value)
+
+
 def test_a_dataset_rewritten_without_its_checksum_filter_is_named(copy):
     """Same values, same attributes and digests: only the Fletcher-32 filter is gone, so
     a damaged chunk would read as wrong values instead of failing."""
