@@ -78,7 +78,7 @@ from trackers.kernels.stages import (
     state_boxes,
     weighted_mean_states,
 )
-from trackers.models.dynamics import AR2, boxes_from_states, states_from_boxes
+from trackers.models.dynamics import AR2, boxes_from_states, check_ar2, states_from_boxes
 from trackers.models.observation import (
     MODELS,
     ColourModel,
@@ -150,9 +150,11 @@ class ParticleParams(TrackerParams):
     box_levels : int, optional
         Levels of the "box" kernel (nested rectangles), in [1, 16].
     sigma : tuple of 3 floats, optional
-        (σ_u, σ_v, σ_a) of the AR2 tracking dynamics (DPS: 2, 2, 0.001).
+        (σ_u, σ_v, σ_a) of the AR2 tracking dynamics (DPS: 2, 2, 0.001); σ_u, σ_v in
+        [0, 1e9] px, σ_a in [0, 20.7] (``trackers.models.dynamics.check_ar2``).
     a1, a2 : float, optional
-        AR2 coefficients (2, −1: constant velocity).
+        AR2 coefficients (2, −1: constant velocity), not explosive: |a2| <= 1 and
+        |a1| <= 1 − a2 (``check_ar2``).
     resampler : {"systematic", "multinomial", "stratified", "residual"}, optional
         Resampling scheme of every (weighted) resampling step.
     observation : ObservationModel or None, optional
@@ -184,9 +186,10 @@ class ParticleParams(TrackerParams):
         if self.kernel is not None:
             check_choice(self, "kernel", KERNELS)
         check_integer(self, "box_levels", low=1, high=16)
-        check_sigma3(self, "sigma")
-        check_number(self, "a1")
-        check_number(self, "a2")
+        sigma, a1, a2 = check_ar2(self.sigma, self.a1, self.a2)
+        self._set("sigma", sigma)
+        self._set("a1", a1)
+        self._set("a2", a2)
         check_choice(self, "resampler", RESAMPLERS, what="resampler")
         check_observation(self, "observation")
 
@@ -295,19 +298,6 @@ class DPSParams(PartitionedParams):
         check_integer(self, "n_groups", low=1, high=self.n_particles, optional=True)
         check_choice(self, "assignment", ASSIGNMENTS)
         check_choice(self, "mixture", MIXTURES)
-
-
-def check_sigma3(params: TrackerParams, name: str) -> None:
-    """Field ``name``: three finite numbers >= 0 (σ_u, σ_v, σ_a), stored as a tuple."""
-    value = getattr(params, name)
-    try:
-        sig = tuple(float(v) for v in value)
-    except (TypeError, ValueError):
-        sig = ()
-    if len(sig) != 3 or not all(np.isfinite(v) and v >= 0 for v in sig):
-        raise ValueError(f"{name} must be 3 finite non-negative numbers (u, v, a), got "
-                         f"{value!r}")
-    params._set(name, sig)
 
 
 def check_observation(params: TrackerParams, name: str) -> None:

@@ -56,6 +56,45 @@ def test_opencv_parameters_that_would_crash_it_are_refused(params, needle):
     assert needle in str(info.value)
 
 
+@pytest.mark.parametrize(
+    ("params", "needle"),
+    [
+        # init failed for 17 seeds in 30 (cv2's "!negSamples.empty()"), 3 in 30 with 3.
+        ({"samplerInitMaxNegNum": 1}, "cv2.TrackerMIL parameter samplerInitMaxNegNum=1 gives "
+                                      "init 0.76 negative samples on average (with "
+                                      "samplerSearchWinSize=25, samplerInitInRadius=3), so "
+                                      "init fails for some seeds: it must be >= 27"),
+        ({"samplerInitMaxNegNum": 26}, "samplerInitMaxNegNum=26 gives init 19.8"),
+        # Fewer window positions: the default 65 is too few.
+        ({"samplerSearchWinSize": 3.0}, "samplerInitMaxNegNum=65 gives init 15.4 negative"),
+        # No position at all between the radii: init failed for every seed.
+        ({"samplerInitInRadius": 40.0}, "samplerSearchWinSize=25, samplerInitInRadius=40 "
+                                        "leave init no negative samples"),
+        ({"samplerSearchWinSize": 2.0}, "leave init no negative samples"),
+        ({"samplerInitMaxNegNum": 40.5}, "samplerInitMaxNegNum must be an integer, got 40.5"),
+    ],
+)
+def test_mil_parameters_whose_init_depends_on_the_seed_are_refused(params, needle):
+    from trackers.adapters import opencv
+
+    with pytest.raises(ValueError) as info:
+        opencv("MIL", rng=0, **params)
+    assert needle in str(info.value) and "\n" not in str(info.value)
+
+
+def test_mil_parameters_just_accepted_start_for_every_seed():
+    from trackers.adapters import opencv
+
+    frame = np.random.default_rng(0).integers(0, 256, (120, 160, 3), dtype=np.uint8)
+    for seed in range(20):
+        # 65.0 (as --param may give it) was cv2's "required to be an integer".
+        for params in ({"samplerInitMaxNegNum": 27}, {"samplerSearchWinSize": 3.0,
+                                                       "samplerInitMaxNegNum": 85.0}):
+            t = opencv("MIL", rng=seed, **params)
+            t.init(frame, [[60.0, 40.0, 30.0, 30.0]])
+            assert t.step(frame).boxes.shape == (1, 4)
+
+
 def test_an_opencv_tracker_that_cannot_start_is_one_line(monkeypatch):
     # cv2's init raised its multi-line cv2.error (here: made to, whatever cv2's version).
     import cv2
@@ -87,12 +126,13 @@ def test_an_opencv_failure_at_init_names_the_params_given(monkeypatch):
                             ".cpp:81: error: (-215:Assertion failed) !negSamples.empty() in "
                             "function 'init'\n")  # fmt: skip
 
-    t = opencv("MIL", rng=0, samplerInitMaxNegNum=1)
+    # (samplerInitMaxNegNum=1 itself is now refused at construction: check_mil.)
+    t = opencv("MIL", rng=0, samplerInitMaxNegNum=40)
     monkeypatch.setattr(t, "_make", lambda: Refuses())
     with pytest.raises(ValueError) as info:
         t.init(np.zeros((60, 80, 3), np.uint8), [[30, 20, 20, 20]])
     assert str(info.value) == (
-        "cv2.TrackerMIL with params samplerInitMaxNegNum=1 could not start on box "
+        "cv2.TrackerMIL with params samplerInitMaxNegNum=40 could not start on box "
         "(30, 20, 20, 20): (-215:Assertion failed) !negSamples.empty() in function 'init'"
     )
 

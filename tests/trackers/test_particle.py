@@ -183,6 +183,64 @@ def test_bad_parameters_raise(name, params, match):
         trackers.make(name, **params)
 
 
+@pytest.mark.parametrize("name", PF_NAMES)
+@pytest.mark.parametrize("params, match", [
+    # Each failed in the first steps with "boxes must be finite with positive width and
+    # height" (or overflow warnings), naming no parameter.
+    ({"a1": 1e200}, r"^a1, a2 must not be explosive \(\|a2\| <= 1 and \|a1\| <= 1 - a2\), "
+                    r"got a1=1e\+200, a2=-1 \(a root"),
+    ({"a2": -50}, r"got a1=2, a2=-50 \(a root of z\^2 - a1 z - a2 has modulus 7.07\)$"),
+    ({"a1": 3, "a2": -1}, "a1, a2 must not be explosive .* modulus 2.62"),
+    ({"a1": 0.5, "a2": 1.0}, "a1, a2 must not be explosive"),
+    ({"sigma": (1e300, 1e300, 1e300)},
+     r"^sigma must be \(u, v, a\) with u, v <= 1e\+09 px and a <= 20.7, got \(1e\+300"),
+    ({"sigma": (2.0, 2.0, 1000.0)}, "sigma must be .* a <= 20.7, got .*1000.0"),
+    ({"sigma": (2.0, 2e9, 0.0)}, "sigma must be .* u, v <= 1e"),
+    ({"sigma": (True, 1.0, 0.0)}, "sigma must be 3 finite non-negative numbers"),  # was 1 px
+    ({"sigma": "abc"}, "sigma must be 3 finite non-negative numbers"),
+    ({"a1": "x"}, "a1 must be finite, got 'x'"),
+    ({"a2": True}, "a2 must be finite, got True"),
+])
+def test_dynamics_that_leave_the_box_range_are_refused_naming_the_parameter(name, params,
+                                                                           match):
+    with pytest.raises(ValueError, match=match) as info:
+        trackers.make(name, **params)
+    assert "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize("name", PF_NAMES)
+@pytest.mark.parametrize("params", [
+    {"a1": 2.0, "a2": -1.0},            # constant velocity: a double root at 1
+    {"a1": 1.0, "a2": 0.0},             # random walk
+    {"a1": -2.0, "a2": -1.0},           # a double root at -1
+    {"a1": 0.0, "a2": 1.0},             # roots +-1
+    {"a1": 1.6, "a2": -0.64},           # damped
+    {"sigma": (1e9, 1e9, 20.7)},        # the largest noise
+    {"sigma": (0.0, 0.0, 0.0)},
+])
+def test_dynamics_on_the_boundary_are_accepted_and_stay_finite(name, params):
+    frames, boxes = _scene(2, n_frames=8)
+    tracker = trackers.make(name, n_particles=40, rng=3, **params)
+    tracker.init(frames[0], boxes[0])
+    for f in frames[1:]:
+        est = tracker.step(f)
+        assert np.all(np.isfinite(est.boxes))
+        # sigma 0 gave NaN: 0 / 0 (the set never spreads in a coordinate without noise).
+        assert np.all(np.isfinite(est.extras["effective_dynamics"]))
+
+
+def test_effective_dynamics_without_noise_is_one():
+    frames, boxes = _scene(2)
+    tracker = trackers.make("ps", n_particles=30, sigma=(0.0, 2.0, 0.0), rng=0)
+    tracker.init(frames[0], boxes[0])
+    est = tracker.step(frames[1])
+    want = (1.0 + tracker.particles[:, :, 1].var(axis=0) / 4.0) / 2
+    np.testing.assert_allclose(est.extras["effective_dynamics"], want, rtol=1e-12)
+    est = trackers.make("dps", n_particles=30, sigma=(0.0, 0.0, 0.0), rng=0)
+    est.init(frames[0], boxes[0])
+    assert est.step(frames[1]).extras["effective_dynamics"].tolist() == [1.0, 1.0]
+
+
 @pytest.mark.parametrize("tracker, match", [
     (PartitionedSampling(ordering=3), r"ordering \(circular shift\) must lie in \[0, 2\)"),
     (PartitionedSampling(ordering=(0, 0)), "not a permutation"),

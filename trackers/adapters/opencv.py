@@ -16,9 +16,10 @@ OpenCV boxes are integers: an initial box is rounded outward to whole pixels and
 to the frame, and grown about its centre to at least :data:`MIN_SIDE` pixels a side
 (``cv2.TrackerMIL`` never returns from ``update`` on a box under 5 px, measured with
 cv2 5.0); a grown box is reported with its initial size, centred where OpenCV puts it.
-A cv2 error at construction or ``init`` is a ``ValueError`` naming the parameters given
-(MIL's ``samplerInitMaxNegNum`` is the mean of a random count of negative samples: under
-about 5, ``init`` may draw none and fail, depending on the seed).
+A cv2 error at construction or ``init`` is a ``ValueError`` naming the parameters given.
+MIL's parameters are checked at construction for an ``init`` that would fail depending
+on the seed (:func:`check_mil`: its negative samples are a random draw, and a draw of
+none failed ``init`` for 17 seeds in 30 with ``samplerInitMaxNegNum=1``).
 When a cv2 tracker reports failure its target's box is NaN for that frame
 (``extras["ok"]`` says which succeeded); it keeps updating and may find the target again.
 OpenCV's trackers draw from OpenCV's global random state: ``rng`` becomes a C ``int``
@@ -36,7 +37,8 @@ from numpy.typing import NDArray
 
 from trackers.base import Estimate, check_boxes, check_frame
 
-__all__ = ["OpenCVTracker", "cv2_seed", "opencv", "opencv_names"]
+__all__ = ["MIN_MIL_NEGATIVES", "OpenCVTracker", "check_mil", "cv2_seed", "opencv",
+           "opencv_names"]
 
 # Trackers that construct without model files in opencv-python-headless (checked in the
 # suite: tests/trackers/test_adapters.py).
@@ -124,13 +126,15 @@ class OpenCVTracker:
                     f"unknown parameter {key!r} for cv2.Tracker{self.name}; valid: "
                     f"{', '.join(valid)}"
                 )
-            _check_value(self.name, key, value, getattr(p, key))
+            value = _check_value(self.name, key, value, getattr(p, key))
             try:
                 setattr(p, key, value)
             except (TypeError, cv2.error) as err:
                 raise ValueError(
                     f"cv2.Tracker{self.name} parameter {key}={value!r}: {err}"
                 ) from None
+        if self.name == "MIL":
+            check_mil(p)
         try:
             return self._cls.create(p)
         except cv2.error as err:
@@ -273,9 +277,11 @@ def opencv(name: str, **kw: Any) -> OpenCVTracker:
 MAX_PARAM_FACTOR = 100
 
 
-def _check_value(name: str, key: str, value: Any, default: Any) -> None:
+def _check_value(name: str, key: str, value: Any, default: Any) -> Any:
     """Refuse a numeric parameter OpenCV would take and then crash on: not finite, or, where
-    the default is positive, not in (0, MAX_PARAM_FACTOR x default].
+    the default is positive, not in (0, MAX_PARAM_FACTOR x default]. Returns the value to
+    set: an integral float (``65.0``, as ``--param`` may give it) for an int parameter is
+    an int, as for the other trackers' integer parameters.
 
     Raises
     ------
@@ -284,7 +290,7 @@ def _check_value(name: str, key: str, value: Any, default: Any) -> None:
     """
     numeric = (int, float, np.integer, np.floating)
     if isinstance(default, bool) or not isinstance(default, numeric):
-        return
+        return value
     if isinstance(value, bool) or not isinstance(value, numeric) or not np.isfinite(value):
         raise ValueError(f"cv2.Tracker{name} parameter {key} must be a finite number, "
                          f"got {value!r}")
@@ -292,3 +298,63 @@ def _check_value(name: str, key: str, value: Any, default: Any) -> None:
         raise ValueError(f"cv2.Tracker{name} parameter {key} must be in "
                          f"(0, {MAX_PARAM_FACTOR * default:g}] ({MAX_PARAM_FACTOR}x its "
                          f"default {default:g}), got {value!r}")
+    if isinstance(default, (int, np.integer)):
+        if int(value) != value:
+            raise ValueError(f"cv2.Tracker{name} parameter {key} must be an integer, "
+                             f"got {value!r}")
+        return int(value)
+    return value
+
+
+MIN_MIL_NEGATIVES = 20.0
+"""Fewest negative samples :func:`check_mil` lets MIL's ``init`` expect: the count is a
+sum of independent draws, so it is 0 with probability at most exp(−20) ≈ 2e-9."""
+
+
+def check_mil(p: Any) -> None:
+    """Refuse ``cv2.TrackerMIL_Params`` with which ``init`` may fail depending on the seed.
+
+    MIL's ``init`` takes as negative samples the window positions at distance d from the
+    box, 1.5 ``samplerInitInRadius`` <= d < 2 ``samplerSearchWinSize`` (an annulus, in a
+    square window of side 2 ⌊2 ``samplerSearchWinSize``⌋ + 1), each with probability
+    ``samplerInitMaxNegNum`` / (window positions); with none it fails. The expected count
+    over a window that the frame does not clip must be at least :data:`MIN_MIL_NEGATIVES`
+    (the defaults, 25, 3 and 65, give 49.7). A box too large for its frame can still
+    leave no room for samples: that fails at ``init``, naming the box.
+
+    Raises
+    ------
+    ValueError
+        One line naming ``samplerInitMaxNegNum`` (or the radii, when the annulus is
+        empty), the values and the least count that works.
+    """
+    inrad = np.float32(2.0 * p.samplerSearchWinSize)
+    outrad = np.float32(1.5 * p.samplerInitInRadius)
+    r = int(inrad)
+    # Offsets (dr, dc) with outrad² <= dr² + dc² < inrad², counted row by row (the window
+    # is up to 10001 x 10001).
+    sq = np.arange(r + 1, dtype=np.float64) ** 2
+    squares = np.sort(np.concatenate([sq, sq[1:]]))
+    hi, lo = float(inrad * inrad), float(outrad * outrad)
+    rows = (np.searchsorted(squares, hi - squares, side="left")
+            - np.searchsorted(squares, lo - squares, side="left"))
+    ring = int(np.sum(np.maximum(rows, 0)))
+    if ring == 0:
+        raise ValueError(
+            f"cv2.TrackerMIL parameters samplerSearchWinSize={p.samplerSearchWinSize:g}, "
+            f"samplerInitInRadius={p.samplerInitInRadius:g} leave init no negative samples "
+            f"(those lie between 1.5 x samplerInitInRadius and 2 x samplerSearchWinSize px "
+            f"from the box): raise samplerSearchWinSize or lower samplerInitInRadius"
+        )
+    window = (2 * r + 1) ** 2
+    expected = ring * min(p.samplerInitMaxNegNum / window, 1.0)
+    if expected < MIN_MIL_NEGATIVES and p.samplerInitMaxNegNum < window:
+        least = int(np.ceil(MIN_MIL_NEGATIVES * window / ring))
+        if least >= window:
+            least = window
+        raise ValueError(
+            f"cv2.TrackerMIL parameter samplerInitMaxNegNum={p.samplerInitMaxNegNum} gives "
+            f"init {expected:.3g} negative samples on average (with samplerSearchWinSize="
+            f"{p.samplerSearchWinSize:g}, samplerInitInRadius={p.samplerInitInRadius:g}), "
+            f"so init fails for some seeds: it must be >= {least}"
+        )

@@ -9,7 +9,10 @@
   reports it in %; it may exceed 1 because particles follow the observations).
   **(open)** The variance is unweighted — the spread of the sample itself, which is what
   impoverishment shrinks; the weighted variance estimates the posterior's spread, which
-  weighted resampling leaves unchanged by design.
+  weighted resampling leaves unchanged by design. A parameter with σ_c = 0 has effective
+  dynamics 1: the dynamics add no spread to it, so there is none for the sampler to thin
+  (the particle filters start every particle on its box, so such a parameter never
+  spreads; its variance is 0 up to rounding, and 0 / 0 was NaN).
 """
 
 from __future__ import annotations
@@ -56,18 +59,20 @@ def effective_dynamics(particles: NDArray[np.floating], sigma: NDArray[np.floati
     particles : ndarray of shape (N, K, 3)
         Particle states (u, v, a).
     sigma : array_like of shape (3,)
-        σ of the tracking dynamics per parameter; a parameter with σ = 0 gives NaN.
+        σ of the tracking dynamics per parameter; a parameter with σ = 0 gives 1 (no
+        spread to lose).
 
     Example
     -------
     >>> p = np.zeros((2, 1, 3)); p[:, 0, 0] = [0.0, 4.0]
     >>> effective_dynamics(p, [2.0, 2.0, 1.0]).tolist()
     [[1.0, 0.0, 0.0]]
+    >>> effective_dynamics(p, [2.0, 2.0, 0.0]).tolist()
+    [[1.0, 0.0, 1.0]]
     """
     p = _check_particles(particles)
     sig2 = np.asarray(sigma, dtype=np.float64) ** 2
     if sig2.shape != (3,):
         raise ValueError(f"sigma must have shape (3,), got {np.shape(sigma)}")
     var = p.var(axis=0)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return np.where(sig2 > 0, var / np.where(sig2 > 0, sig2, 1.0), np.nan)
+    return np.where(sig2 > 0, var / np.where(sig2 > 0, sig2, 1.0), 1.0)

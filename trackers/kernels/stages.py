@@ -716,13 +716,13 @@ def _effective_uv(var, sig2):
     for o in range(k):
         e = np.empty(2)
         for c in range(2):
-            e[c] = var[o, c] / sig2[c] if sig2[c] > 0 else np.nan
+            e[c] = var[o, c] / sig2[c] if sig2[c] > 0 else 1.0
         out[o] = (e[0] + e[1]) / 2
     return out
 
 
 def effective_uv(var: NDArray[np.float64], sigma: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Mean over (u, v) of the effective dynamics var / σ² (NaN where σ = 0), shape (K,),
+    """Mean over (u, v) of the effective dynamics var / σ² (1 where σ = 0), shape (K,),
     from the variances ``var`` (K, 3) and σ (3,) (``effective_dynamics(...)[:, :2]
     .mean(axis=1)``)."""
     return _effective_uv(var, np.asarray(sigma, dtype=np.float64) ** 2)

@@ -12,16 +12,86 @@ the AR2 model (docs/algorithms.md §1.1) predicts from both:
 
 A1 = 2, A2 = −1 (the defaults) is constant velocity with acceleration noise, for which
 X̄ drops out; with a damped or stationary choice X̄ is the object's initial state.
+
+The valid parameters (:func:`check_ar2`) keep the propagated state finite: A1, A2 must not
+be explosive (every root of z² − A1 z − A2 in the closed unit disk, i.e. |A2| <= 1 and
+|A1| <= 1 − A2; an explosive AR2 pushes every particle away from X̄ geometrically, and
+A1 = 1e200 overflowed at the second step), σ_u, σ_v <= :data:`MAX_SIGMA_UV` pixels and
+σ_a <= :data:`MAX_SIGMA_A` (a larger σ_a overflowed exp(a) at the first step).
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["AR2", "boxes_from_states", "states_from_boxes"]
+from trackers.base import MAX_BOX_VALUE
+
+__all__ = ["AR2", "MAX_SIGMA_A", "MAX_SIGMA_UV", "boxes_from_states", "check_ar2",
+           "states_from_boxes"]
+
+MAX_SIGMA_UV = MAX_BOX_VALUE
+"""Largest σ_u, σ_v (pixels per frame): a noise step beyond the largest box coordinate
+(:data:`trackers.base.MAX_BOX_VALUE`) says nothing about where a target is."""
+
+MAX_SIGMA_A = math.log(MAX_BOX_VALUE)
+"""Largest σ_a (log scale per frame), about 20.7: one σ then scales a box by
+:data:`trackers.base.MAX_BOX_VALUE`. exp(a) overflows beyond 709."""
+
+
+def check_ar2(sigma: object, a1: object, a2: object
+              ) -> tuple[tuple[float, float, float], float, float]:
+    """Validate AR2 tracking dynamics; return (σ_u, σ_v, σ_a), A1, A2 as floats.
+
+    Raises
+    ------
+    ValueError
+        One line naming the parameter and its value: ``sigma`` not three finite numbers
+        in [0, :data:`MAX_SIGMA_UV`] (u, v) and [0, :data:`MAX_SIGMA_A`] (a); ``a1`` or
+        ``a2`` not a finite number; ``a1, a2`` explosive (a root of z² − A1 z − A2
+        outside the unit circle).
+
+    Example
+    -------
+    >>> check_ar2((2, 2, 0.001), 2, -1)
+    ((2.0, 2.0, 0.001), 2.0, -1.0)
+    >>> check_ar2((2, 2, 0.001), 3.0, -1.0)
+    Traceback (most recent call last):
+    ...
+    ValueError: a1, a2 must not be explosive (|a2| <= 1 and |a1| <= 1 - a2), got a1=3, ...
+    """
+    try:
+        items = [] if isinstance(sigma, (str, bytes)) else list(sigma)  # type: ignore[call-overload]
+        # True was read as 1 px.
+        sig = tuple(math.nan if isinstance(v, bool) else float(v) for v in items)
+    except (TypeError, ValueError):
+        sig = ()
+    if len(sig) != 3 or not all(math.isfinite(v) and v >= 0 for v in sig):
+        raise ValueError(f"sigma must be 3 finite non-negative numbers (u, v, a), got "
+                         f"{sigma!r}")
+    if max(sig[:2]) > MAX_SIGMA_UV or sig[2] > MAX_SIGMA_A:
+        raise ValueError(f"sigma must be (u, v, a) with u, v <= {MAX_SIGMA_UV:g} px and "
+                         f"a <= {MAX_SIGMA_A:.3g}, got {sigma!r}")
+    coef = []
+    for name, val in (("a1", a1), ("a2", a2)):
+        try:
+            x = float(val)  # type: ignore[arg-type]
+        except (TypeError, ValueError):
+            x = math.nan
+        if isinstance(val, bool) or not math.isfinite(x):
+            raise ValueError(f"{name} must be finite, got {val!r}")
+        coef.append(x)
+    c1, c2 = coef
+    # Schur-Cohn for a real quadratic: both roots of z^2 - a1 z - a2 in |z| <= 1.
+    if not (abs(c2) <= 1 and abs(c1) <= 1 - c2):
+        radius = float(np.max(np.abs(np.roots([1.0, -c1, -c2]))))
+        raise ValueError(f"a1, a2 must not be explosive (|a2| <= 1 and |a1| <= 1 - a2), "
+                         f"got a1={c1:g}, a2={c2:g} (a root of z^2 - a1 z - a2 has modulus "
+                         f"{radius:.3g})")
+    return sig, c1, c2  # type: ignore[return-value]
 
 
 def states_from_boxes(boxes: NDArray[np.floating]) -> tuple[NDArray[np.float64],
@@ -59,7 +129,12 @@ class AR2:
         Noise standard deviations (σ_u, σ_v, σ_a): pixels, pixels, log scale per frame.
         DPS tracks with (2, 2, 0.001).
     a1, a2 : float, optional
-        AR coefficients A1, A2.
+        AR coefficients A1, A2, not explosive (:func:`check_ar2`).
+
+    Raises
+    ------
+    ValueError
+        For parameters :func:`check_ar2` refuses, naming the parameter.
 
     Example
     -------
@@ -75,14 +150,8 @@ class AR2:
     _sigma: NDArray[np.float64] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        sig = np.asarray(self.sigma, dtype=np.float64)
-        if sig.shape != (3,) or not np.all(np.isfinite(sig)) or np.any(sig < 0):
-            raise ValueError(f"sigma must be 3 finite non-negative numbers (u, v, a), got "
-                             f"{self.sigma!r}")
-        for name, val in (("a1", self.a1), ("a2", self.a2)):
-            if not np.isfinite(val):
-                raise ValueError(f"{name} must be finite, got {val!r}")
-        object.__setattr__(self, "_sigma", sig)
+        sig, _, _ = check_ar2(self.sigma, self.a1, self.a2)
+        object.__setattr__(self, "_sigma", np.asarray(sig, dtype=np.float64))
 
     def propagate(
         self,
