@@ -189,11 +189,11 @@ def _reference_hsv(frame, hb, sb, vb, s_min, v_min):
     hbin = np.minimum(h6 * hb // np.maximum(6 * d, 1), hb - 1)
     sbin = np.minimum(d * sb // np.maximum(mx, 1), sb - 1)
     vbin = np.minimum(mx * vb // 255, vb - 1)
-    # The documented rule, in exact rationals: S >= floor(s_min 2**20) / 2**20.
-    from fractions import Fraction
-
-    s_thr = Fraction(int(np.floor(s_min * 2**20)), 2**20)
-    sat_ok = np.vectorize(lambda dd, m: Fraction(int(dd), max(int(m), 1)) >= s_thr)(d, mx)
+    # The documented rule, in exact rationals: S >= floor(s_min 2**20) / 2**20, i.e.
+    # d / mx >= k / 2**20, compared cross-multiplied in integers (exact, as Fractions
+    # would be, without a Python call per colour).
+    k = int(np.floor(s_min * 2**20))
+    sat_ok = d * 2**20 >= k * np.maximum(mx, 1)
     coloured = (d > 0) & sat_ok & (mx >= v_min * 255 - 1e-9)
     return np.where(coloured, hbin * sb + sbin, hb * sb + vbin)
 
