@@ -97,6 +97,13 @@ class ShardTask:
         return shard_name(self.shard)
 
 
+def _shard_label(task: ShardTask) -> str:
+    """``making shard-00002.h5 (sequences 8-11)``: what a worker that died was doing."""
+    first, last = task.draws[0].index, task.draws[-1].index
+    which = f"sequences {first}-{last}" if last > first else f"sequence {first}"
+    return f"making {task.file} ({which})"
+
+
 def _entry(d: Draw, file: str, seq: Any, digests: dict[str, str]) -> dict[str, Any]:
     roles = [str(r) for r in seq.entities.role]
     return {
@@ -700,7 +707,7 @@ def build_dataset(
     try:
         run_tasks(
             make_shard, tasks, store, jobs=jobs, scheduler=scheduler,
-            key=lambda t: t.file, name="scenegen-dataset",
+            key=lambda t: t.file, name="scenegen-dataset", label=_shard_label,
         )  # fmt: skip
     finally:
         bar.close()

@@ -2,25 +2,35 @@
 
 The same picklable function runs on the same task objects whichever executor is chosen;
 results are handed to a callback in the parent as they arrive (in completion order, so
-callers must not depend on it). Local pools use the ``forkserver`` start method (never
-fork a parent whose numba threads may already run). A Dask scheduler is probed first
-(within :data:`SCHEDULER_TIMEOUT` seconds) so that a wrong address fails with one line;
-tasks are retried up to 3 times when a worker is lost.
+callers must not depend on it). Local pools (:class:`LocalPool`) use the ``forkserver``
+start method (never fork a parent whose numba threads may already run); their workers die
+with this process, a worker's death (the out-of-memory killer's SIGKILL, a crash) is one
+line naming the task it ran, and Ctrl-C stops the running tasks at once (each removes its
+temporary file). A Dask scheduler is probed first (within :data:`SCHEDULER_TIMEOUT`
+seconds) so that a wrong address fails with one line; tasks are retried up to 3 times when
+a worker is lost.
 """
 
 from __future__ import annotations
 
+import contextlib
+import ctypes
 import os
-from collections.abc import Callable, Hashable
-from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+import signal
+from collections.abc import Callable, Hashable, Sequence
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
 from multiprocessing import get_context
 from typing import Any
 
 from scenegen.errors import ConfigError
+from scenegen.io.atomic import discard_temp_files
+from scenegen.io.guard import describe_exit, die_with_parent, prepare_temp_dir
 
 __all__ = [
     "SCHEDULER_TIMEOUT",
     "WORKER_TIMEOUT",
+    "LocalPool",
     "check_executor",
     "connect",
     "probe",
@@ -124,6 +134,7 @@ def run_tasks(
     scheduler: str | None = None,
     key: Callable[[Any], Hashable] = id,
     name: str = "scenegen",
+    label: Callable[[Any], str] | None = None,
 ) -> None:
     """Run ``fn(task)`` for every task; call ``on_result(task, result)`` in this process.
 
@@ -143,11 +154,16 @@ def run_tasks(
         A unique text key per task (Dask task keys).
     name : str
         Prefix of the Dask task keys (a random part follows it).
+    label : callable, optional
+        What running a task does, in words (``"making shard-00002.h5 (sequences 8-11)"``),
+        for the line that reports the death of its local worker (default: ``"running "``
+        and its ``key``).
 
     Raises
     ------
     ConfigError
-        For jobs < 1 or an unreachable scheduler. A task's own exception is re-raised
+        For jobs < 1 or an unreachable scheduler; a local worker process that died (one
+        line naming its task, :meth:`LocalPool.death`). A task's own exception is re-raised
         after the pending tasks are cancelled.
     """
     check_executor(jobs, scheduler)
@@ -161,37 +177,169 @@ def run_tasks(
         for t in tasks:
             on_result(t, fn(t))
         return
+    said = label or (lambda t: f"running {key(t)}")
     # Bounded in-flight work: at most 2 tasks per worker are submitted at once, so a long
     # run's results never pile up in the parent.
-    ctx = get_context("forkserver")
-    with ProcessPoolExecutor(max_workers=n, mp_context=ctx, initializer=_ignore_sigint) as pool:
-        pending: dict[Any, Any] = {}
-        it = iter(tasks)
-        try:
-            for t in it:
-                pending[pool.submit(fn, t)] = t
-                if len(pending) >= 2 * n:
-                    break
-            while pending:
-                done, _ = wait(pending, return_when=FIRST_COMPLETED)
-                for fut in done:
-                    t = pending.pop(fut)
-                    on_result(t, fut.result())
-                    nxt = next(it, None)
-                    if nxt is not None:
-                        pending[pool.submit(fn, nxt)] = nxt
-        except BaseException:
-            # Ctrl-C or a failed task: drop the queued tasks; the running ones finish
-            # (each writes its own file atomically, so a rerun finds them done).
-            pool.shutdown(wait=True, cancel_futures=True)
-            raise
+    pool = LocalPool(n)
+    pending: dict[Any, Any] = {}
+    it = iter(tasks)
+    try:
+        for t in it:
+            pending[pool.submit(fn, t, said(t))] = t
+            if len(pending) >= 2 * n:
+                break
+        while pending:
+            done, _ = wait(pending, return_when=FIRST_COMPLETED)
+            for fut in done:
+                t = pending.pop(fut)
+                on_result(t, fut.result())
+                nxt = next(it, None)
+                if nxt is not None:
+                    pending[pool.submit(fn, nxt, said(nxt))] = nxt
+    except BrokenProcessPool:
+        raise pool.death() from None
+    except KeyboardInterrupt:
+        pool.close(interrupt=True)
+        raise
+    except BaseException:
+        # A failed task: drop the queued tasks; the running ones finish (each writes its
+        # own file atomically, so a rerun finds them done).
+        pool.close()
+        raise
+    pool.close()
 
 
-def _ignore_sigint() -> None:
-    """Pool workers leave Ctrl-C to the parent, which stops the pool cleanly."""
-    import signal
+_SLOT = 2  # per worker in LocalPool's notes: its pid, and the number of its task (-1: idle)
+_notes: Any = None  # in a LocalPool worker: the shared notes
+_slot = -1  # in a LocalPool worker: the index of its slot in them
 
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+class LocalPool:
+    """A ``forkserver`` process pool whose workers die with this process and whose death
+    is one line naming the task it ran.
+
+    Workers ignore Ctrl-C (this process stops them, :meth:`close`); ``PR_SET_PDEATHSIG``
+    and a watching thread end them when this process dies, even by SIGKILL
+    (:func:`scenegen.io.guard.die_with_parent`); each notes, in memory shared with this
+    process, which task it runs, so that :meth:`death` can name it.
+
+    Parameters
+    ----------
+    n : int
+        Worker processes.
+    preload : sequence of str, optional
+        Modules the fork server imports before it forks the workers (when this process
+        starts its fork server first).
+
+    Example
+    -------
+    >>> pool = LocalPool(2)                                 # doctest: +SKIP
+    >>> fut = pool.submit(abs, -3, "taking abs(-3)")        # doctest: +SKIP
+    >>> fut.result(); pool.close()                          # doctest: +SKIP
+    3
+    """
+
+    def __init__(self, n: int, *, preload: Sequence[str] | None = None) -> None:
+        prepare_temp_dir()
+        ctx = get_context("forkserver")
+        if preload is not None:
+            ctx.set_forkserver_preload(list(preload))
+        self._notes = ctx.RawArray(ctypes.c_longlong, [0, -1] * n)
+        self._count = ctx.Value(ctypes.c_int, 0)
+        self._labels: list[str] = []
+        self._pool = ProcessPoolExecutor(
+            max_workers=n, mp_context=ctx, initializer=_start_worker,
+            initargs=(os.getpid(), self._notes, self._count),
+        )  # fmt: skip
+
+    def submit(self, fn: Callable[[Any], Any], task: Any, label: str) -> Future[Any]:
+        """Run ``fn(task)`` on a worker; ``label`` says what it does (``"making FILE"``), for
+        :meth:`death`.
+
+        Raises
+        ------
+        BrokenProcessPool
+            A worker has died (report it with :meth:`death`).
+        """
+        self._labels.append(label)
+        return self._pool.submit(_run_noted, fn, task, len(self._labels) - 1)
+
+    def _running(self) -> dict[int, int]:
+        """pid -> number of the task that worker runs, for the busy workers."""
+        notes = list(self._notes)
+        return {notes[i]: notes[i + 1] for i in range(0, len(notes), _SLOT)
+                if notes[i] > 0 and notes[i + 1] >= 0}  # fmt: skip
+
+    def death(self) -> ConfigError:
+        """After :class:`BrokenProcessPool`: stop the pool and say which worker died.
+
+        Returns
+        -------
+        ConfigError
+            One line: how the worker died (e.g. ``SIGKILL``, as when the system runs out
+            of memory), the task it ran when known, and that running the same command
+            again resumes (finished tasks are kept).
+        """
+        running = self._running()
+        procs = dict(getattr(self._pool, "_processes", None) or {})
+        self._pool.shutdown(wait=True, cancel_futures=True)
+        # The others were stopped by the pool (SIGTERM, :func:`_on_sigterm`); the dead one
+        # died otherwise.
+        stopped = (None, 0, -signal.SIGTERM, 128 + signal.SIGTERM)
+        dead = [(pid, p.exitcode) for pid, p in procs.items() if p.exitcode not in stopped]
+        how, what = "", ""
+        if len(dead) == 1:
+            pid, code = dead[0]
+            how = f" ({describe_exit(code)}{_WHY.get(code, '')})"
+            number = running.get(pid)
+            if number is not None and number < len(self._labels):
+                what = f" while {self._labels[number]}"
+        return ConfigError(
+            f"a worker process died{how}{what}; run the same command again to resume "
+            "(finished work is kept)"
+        )
+
+    def close(self, *, interrupt: bool = False) -> None:
+        """Drop the queued tasks and stop the workers: let the running tasks finish, or
+        (``interrupt``, after Ctrl-C) stop them at once (SIGTERM: each worker removes the
+        temporary file it was writing and exits)."""
+        if interrupt:
+            for pid in self._running():
+                with contextlib.suppress(OSError):
+                    os.kill(pid, signal.SIGTERM)
+        self._pool.shutdown(wait=True, cancel_futures=True)
+
+
+_WHY = {-signal.SIGKILL: ", as when the system runs out of memory: fewer --jobs use less"}
+
+
+def _start_worker(parent: int, notes: Any, count: Any) -> None:
+    """Initialise a :class:`LocalPool` worker."""
+    global _notes, _slot
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
+    signal.signal(signal.SIGTERM, _on_sigterm)
+    die_with_parent(parent)
+    with count.get_lock():
+        _slot = _SLOT * (count.value % (len(notes) // _SLOT))
+        count.value += 1
+    _notes = notes
+    _notes[_slot] = os.getpid()
+
+
+def _on_sigterm(signum: int, frame: Any) -> None:
+    """Exit at once, removing the temporary file of a write in progress (the pool stops:
+    Ctrl-C in the parent, or another worker died)."""
+    discard_temp_files()
+    os._exit(128 + signum)
+
+
+def _run_noted(fn: Callable[[Any], Any], task: Any, number: int) -> Any:
+    """``fn(task)``, noted as task ``number`` of this worker."""
+    _notes[_slot + 1] = number
+    try:
+        return fn(task)
+    finally:
+        _notes[_slot + 1] = -1
 
 
 def _run_dask(

@@ -46,12 +46,15 @@ __all__ = [
     "clean_temp_files",
     "describe_special_file",
     "describe_temp_file",
+    "discard_temp_files",
     "temp_file_owner",
     "temp_prefix",
     "write_json",
     "write_npy",
     "write_text",
 ]
+
+_in_progress: set[Path] = set()  # temporary files of this process's unfinished writes
 
 _TEMP_NAME = re.compile(r"^\.(?P<target>.+)\.(?P<kind>tmp|old)-(?P<pid>\d+)@(?P<host>[\w.]*)-")
 
@@ -265,6 +268,7 @@ def atomic_path(path: str | Path, suffix: str = "") -> Iterator[Path]:
     fd, tmp = tempfile.mkstemp(prefix=temp_prefix(target.name), suffix=suffix, dir=folder)
     os.close(fd)
     tmp_path = Path(tmp)
+    _in_progress.add(tmp_path)
     # mkstemp makes the file private; give it the permissions a plain open() would.
     umask = os.umask(0)
     os.umask(umask)
@@ -277,7 +281,20 @@ def atomic_path(path: str | Path, suffix: str = "") -> Iterator[Path]:
         with contextlib.suppress(OSError):
             tmp_path.unlink()
         raise
+    finally:
+        _in_progress.discard(tmp_path)
     _fsync_dir(folder)
+
+
+def discard_temp_files() -> None:
+    """Remove the temporary files of this process's unfinished atomic writes.
+
+    For a process about to exit at once (a pool worker told to stop by SIGTERM): its
+    targets stay untouched and no temporary file is left behind.
+    """
+    for tmp in list(_in_progress):
+        with contextlib.suppress(OSError):
+            tmp.unlink()
 
 
 def describe_temp_file(path: str | Path) -> str | None:

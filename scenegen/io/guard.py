@@ -52,7 +52,10 @@ __all__ = [
     "beat",
     "call",
     "clear_cache",
+    "describe_exit",
+    "die_with_parent",
     "preflight",
+    "prepare_temp_dir",
     "in_child",
     "survey",
     "timeout",
@@ -92,8 +95,21 @@ def timeout() -> float:
 # The child side
 
 
-def _die_with_parent(parent: int) -> None:
-    """Arrange for this process to die when ``parent`` does."""
+def die_with_parent(parent: int) -> None:
+    """Arrange for this process, a child started by ``forkserver``, to die when ``parent``
+    (the process that asked for it) does.
+
+    Used by guarded children and by the workers of local pools
+    (:class:`scenegen.datasets.executor.LocalPool`): ``PR_SET_PDEATHSIG`` on Linux kills
+    the child at once when the fork server exits, which it does when ``parent`` dies once no
+    child holds its keep-alive pipe (closed here); a thread polling ``parent`` every 0.5 s
+    covers other systems and a fork server that outlives ``parent``.
+
+    Parameters
+    ----------
+    parent : int
+        The process id to outlive by at most about half a second.
+    """
     # A forkserver child holds the write end of the server's "alive" pipe, which keeps the
     # server (this process's parent) alive as long as the child runs: closing it lets the
     # server exit when the caller dies, and PR_SET_PDEATHSIG then kills this child.
@@ -163,7 +179,7 @@ def _child(
     conn: Connection, parent: int, seconds: float, fn: Callable[..., Any], args: tuple[Any, ...]
 ) -> None:
     global _conn
-    _die_with_parent(parent)
+    die_with_parent(parent)
     _arm(math.ceil(seconds) + 1)
     faulthandler.disable()  # a crash is reported by the parent, in one line
     _conn = conn
@@ -225,6 +241,67 @@ def _context() -> Any:
     return multiprocessing.get_context("spawn")
 
 
+# A fork server listens on "TEMP/pymp-XXXXXXXX/listener-XXXXXXXX", a Unix socket path of at
+# most 103 bytes (104 with its NUL on macOS, 108 on Linux).
+_SOCKET_PATH_MAX = 103
+_SOCKET_NAME = "/listener-XXXXXXXX"
+_SYSTEM_TEMP_DIRS = ("/tmp", "/var/tmp", "/usr/tmp")
+
+
+def _fits(folder: str) -> bool:
+    return len(os.fsencode(folder)) + len(_SOCKET_NAME) <= _SOCKET_PATH_MAX
+
+
+def prepare_temp_dir() -> None:
+    """Make sure multiprocessing has a temporary folder a fork server can listen in.
+
+    multiprocessing makes a private folder (``pymp-XXXXXXXX``, mode 0700) in the temporary
+    folder (``TMPDIR``, or ``tempfile.tempdir`` when a program sets it) for its sockets. When
+    that folder cannot be written to, or its path is too long for a Unix socket (about 75
+    characters), the private folder is made under the system's ``/tmp`` (or ``/var/tmp``)
+    instead, as Python 3.14 itself does for long paths. Called before a guarded child or a
+    local pool starts; cheap once the folder exists.
+
+    Raises
+    ------
+    ConfigError
+        One line naming ``TMPDIR`` and why each folder was refused, when none is usable.
+    """
+    import shutil
+    import tempfile
+    from multiprocessing import process, util
+
+    config = process.current_process()._config
+    held = config.get("tempdir")
+    if held is not None and _fits(held):
+        return
+    bases: list[str] = []
+    refused: list[str] = []
+    try:
+        bases.append(tempfile.gettempdir())
+    except OSError:  # no usable folder among TMPDIR, TEMP, TMP, /tmp, ... and the cwd
+        refused.append("tempfile: no writable default folder")
+    bases += [b for b in _SYSTEM_TEMP_DIRS if b not in bases]
+    for base in bases:
+        if not _fits(os.path.join(base, "pymp-XXXXXXXX")):
+            refused.append(f"{base}: too long a path for a socket")
+            continue
+        try:
+            made = tempfile.mkdtemp(prefix="pymp-", dir=base)
+        except OSError as err:
+            refused.append(f"{base}: {err.strerror or type(err).__name__}")
+            continue
+        util.Finalize(None, shutil.rmtree, args=(made,), kwargs={"ignore_errors": True},
+                      exitpriority=-100)  # fmt: skip
+        config["tempdir"] = made
+        return
+    where = f"TMPDIR={os.environ['TMPDIR']!r}" if "TMPDIR" in os.environ else "TMPDIR unset"
+    raise ConfigError(
+        f"no usable temporary folder to start child processes in ({where}; "
+        f"{'; '.join(refused)}): set TMPDIR to a writable folder with a short path"
+    )
+
+
 @contextlib.contextmanager
 def _main_hidden() -> Any:
     """Start a child without re-running the caller's ``__main__``: ``spawn`` and
@@ -252,7 +329,8 @@ def _main_hidden() -> Any:
             config["daemon"] = daemon
 
 
-def _how(code: int | None) -> str:
+def describe_exit(code: int | None) -> str:
+    """How a child process ended, from its ``exitcode``: ``"SIGKILL"``, ``"exit status 3"``."""
     if code is None:
         return "no exit status"
     if code < 0:
@@ -291,6 +369,8 @@ def call(
 
     Raises
     ------
+    ConfigError
+        No usable temporary folder to start the child in (:func:`prepare_temp_dir`).
     Unreadable
         If the child made no progress within the deadline (it is killed) or died (a
         crash of the HDF5 library): ``"LABEL: metadata unreadable: ..."``.
@@ -301,6 +381,8 @@ def call(
     """
     limit = timeout() if seconds is None else float(seconds)
     ctx = _context()
+    if ctx.get_start_method() == "forkserver":
+        prepare_temp_dir()
     recv, send = ctx.Pipe(duplex=False)
     proc = ctx.Process(
         target=_child, args=(send, os.getpid(), limit, fn, args), name="scenegen-guard"
@@ -337,7 +419,8 @@ def call(
         proc.close()
     if msg is None:
         raise Unreadable(
-            f"{label}: metadata unreadable: the HDF5 library crashed reading it ({_how(code)})"
+            f"{label}: metadata unreadable: the HDF5 library crashed reading it "
+            f"({describe_exit(code)})"
         )
     kind, value = msg[0], msg[1]
     if kind == "ok":

@@ -654,7 +654,8 @@ def run_benchmark(
 
     try:
         run_tasks(run_pair, todo, store, jobs=jobs, scheduler=scheduler,
-                  key=lambda t: f"{_slug(t.tracker)}-{t.index}", name="scenegen-benchmark")
+                  key=lambda t: f"{_slug(t.tracker)}-{t.index}", name="scenegen-benchmark",
+                  label=lambda t: f"running {t.tracker!r} on sequence {t.index} ({t.name})")
     finally:  # fmt: skip
         bar.close()
     ordered = [records[(t.tracker, t.index)] for t in tasks]

@@ -20,15 +20,15 @@ import hashlib
 import json
 import os
 from collections.abc import Callable, Iterable
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import as_completed
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import asdict, dataclass
-from multiprocessing import get_context
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from scenegen.datasets.executor import SCHEDULER_TIMEOUT, connect
+from scenegen.datasets.executor import SCHEDULER_TIMEOUT, LocalPool, connect
 from scenegen.errors import ConfigError
 from scenegen.lab.experiments.definitions import Experiment, get
 
@@ -615,14 +615,15 @@ class Workers:
             _ACTIVE.append(self)
         return self
 
-    def __exit__(self, *exc: Any) -> None:
+    def __exit__(self, kind: Any, *exc: Any) -> None:
         if self._active:
             _ACTIVE.remove(self)
         for fut, _ in self._pending.values():
             fut.cancel()
         self._pending.clear()
         if self._pool is not None:
-            self._pool.shutdown(wait=True, cancel_futures=True)
+            # After Ctrl-C the running batches stop at once (their runs are not stored yet).
+            self._pool.close(interrupt=kind is not None and issubclass(kind, KeyboardInterrupt))
             self._pool = None
         if self._client is not None:
             self._client.close()
@@ -653,11 +654,12 @@ class Workers:
         if self._pool is None:
             # forkserver: never fork a parent whose numba threads may already be running;
             # the server imports the heavy modules once, and every worker forks from it.
-            ctx = get_context("forkserver")
-            ctx.set_forkserver_preload(["__main__", *_PRELOAD])
-            self._pool = ProcessPoolExecutor(max_workers=self._n, mp_context=ctx)
+            self._pool = LocalPool(self._n, preload=["__main__", *_PRELOAD])
         for b in batches(todo):
-            fut = self._pool.submit(run_batch, b)
+            first = b[0]
+            said = (f"running {len(b)} run{'s' if len(b) > 1 else ''} of {first.experiment} on "
+                    f"{first.preset} scene {first.scene} (from {first.filename()})")  # fmt: skip
+            fut = self._pool.submit(run_batch, b, said)
             for i, t in enumerate(b):
                 self._pending[runs_dir, t] = (fut, i)
 
@@ -677,7 +679,10 @@ class Workers:
             by_future.setdefault(fut, []).append((t, i))
         try:
             for fut in self._completed(list(by_future)):
-                out = fut.result()
+                try:
+                    out = fut.result()
+                except BrokenProcessPool:  # a local worker died (out of memory, a crash)
+                    raise self._pool.death() from None
                 for t, i in by_future[fut]:
                     del self._pending[runs_dir, t]
                     store(t, out if i is None else out[i])

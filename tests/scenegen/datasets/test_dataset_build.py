@@ -1,5 +1,6 @@
 """Building datasets: the same bytes on any executor, resuming after a kill, validation."""
 
+import contextlib
 import json
 import os
 import shutil
@@ -547,3 +548,150 @@ def test_a_read_only_folder_is_one_line_naming_the_manifest(tmp_path, monkeypatc
     with pytest.raises(ConfigError) as caught:
         build_dataset(TINY, out, jobs=1, shard_size=SHARD)
     assert str(caught.value) == f"{out / 'manifest.json'}: cannot write: Read-only file system"
+
+
+# A driver script whose make_shard misbehaves in the pool's workers: the fork server and
+# every worker import the main script, so the replacement is what the workers run.
+_DRIVER = """
+import os, signal, sys, time
+from pathlib import Path
+
+import scenegen.datasets.build as build
+
+_make = build.make_shard
+
+
+def make_shard(task):
+    how = os.environ["MISBEHAVE"]
+    if how == "die" and task.shard == 1:
+        os.kill(os.getpid(), signal.SIGKILL)  # as the out-of-memory killer does
+    if how == "sleep":
+        time.sleep(60)
+    if how == "write":  # a long write in progress: its temporary file exists
+        from scenegen.io.atomic import atomic_path
+
+        with atomic_path(Path(task.root) / task.file) as tmp:
+            tmp.write_bytes(b"partial")
+            time.sleep(60)
+    return _make(task)
+
+
+build.make_shard = make_shard
+
+if __name__ == "__main__":
+    from scenegen.cli import main
+
+    sys.exit(main(sys.argv[1:]))
+"""
+
+
+def _driver(tmp_path: Path, how: str, out: Path, **popen) -> subprocess.Popen:
+    script = tmp_path / "driver.py"
+    script.write_text(_DRIVER)
+    family = tmp_path / "tiny.json"
+    family.write_text(json.dumps(TINY))
+    cmd = [sys.executable, str(script), "dataset", str(family), "-o", str(out), "--jobs", "2",
+           "--shard-size", str(SHARD)]  # fmt: skip
+    return subprocess.Popen(cmd, env={**os.environ, "MISBEHAVE": how}, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, **popen)  # fmt: skip
+
+
+def _children() -> dict[int, list[int]]:
+    kids: dict[int, list[int]] = {}
+    for entry in os.listdir("/proc"):
+        if entry.isdigit():
+            try:
+                stat = Path(f"/proc/{entry}/stat").read_text()
+            except OSError:
+                continue
+            kids.setdefault(int(stat[stat.rfind(")") + 2 :].split()[1]), []).append(int(entry))
+    return kids
+
+
+def _descendants(pid: int) -> list[int]:
+    kids, out, todo = _children(), [], [pid]
+    while todo:
+        for child in kids.get(todo.pop(), []):
+            out.append(child)
+            todo.append(child)
+    return out
+
+
+def _alive(pid: int) -> bool:
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return False
+    return stat[stat.rfind(")") + 2] != "Z"  # a zombie has exited
+
+
+def _wait_for(condition, proc: subprocess.Popen, seconds: float = 120) -> None:
+    deadline = time.monotonic() + seconds
+    while not condition():
+        assert proc.poll() is None, proc.communicate()
+        assert time.monotonic() < deadline
+        time.sleep(0.02)
+
+
+def test_a_dead_worker_is_one_line_naming_its_shard_and_a_rerun_completes(reference, tmp_path):
+    # It was "internal error: BrokenProcessPool: A process in the process pool was
+    # terminated abruptly while the future was running or pending." (exit 1).
+    out = tmp_path / "ds"
+    proc = _driver(tmp_path, "die", out)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 2, err
+    assert err == ("scenegen: error: a worker process died (SIGKILL, as when the system runs out "
+                   "of memory: fewer --jobs use less) while making shard-00001.h5 (sequences "
+                   "2-3); run the same command again to resume (finished work is kept)\n")
+    assert not json.loads((out / "manifest.json").read_text())["complete"]
+    assert not [p.name for p in out.iterdir() if p.name.startswith(".")]  # no temporary file
+    rerun = [sys.executable, "-m", "scenegen.cli", "dataset", str(tmp_path / "tiny.json"),
+             "-o", str(out), "--jobs", "2", "--shard-size", str(SHARD)]  # fmt: skip
+    again = subprocess.run(rerun, capture_output=True, text=True)
+    assert again.returncode == 0, again.stderr
+    assert files(out) == files(reference)
+
+
+@pytest.mark.slow  # 9-11 s on a loaded 2-core machine, mostly starting the driver
+@pytest.mark.skipif(not os.path.isdir("/proc/self"), reason="reads /proc")
+def test_workers_die_with_a_killed_driver(tmp_path):
+    # The workers of a SIGKILLed `dataset --jobs 2` stayed alive, idle, for ever (they and
+    # the fork server held each other's pipes open).
+    proc = _driver(tmp_path, "sleep", tmp_path / "ds")
+    workers: list[int] = []
+    try:
+        def started() -> bool:
+            kids = _children()
+            servers = kids.get(proc.pid, [])
+            workers[:] = [w for s in servers for w in kids.get(s, [])]
+            return len(workers) == 2
+
+        _wait_for(started, proc)
+        time.sleep(0.5)  # the workers have run their initializer and sleep in make_shard
+        family = _descendants(proc.pid)
+        os.kill(proc.pid, signal.SIGKILL)
+        proc.wait()
+        deadline = time.monotonic() + 5
+        while any(_alive(p) for p in family) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert not [p for p in family if _alive(p)]
+    finally:
+        for p in _descendants(proc.pid) + workers:
+            with contextlib.suppress(OSError):
+                os.kill(p, signal.SIGKILL)
+
+
+@pytest.mark.skipif(not os.path.isdir("/proc/self"), reason="reads /proc")
+def test_ctrl_c_stops_running_shards_at_once_and_leaves_no_temporary_file(tmp_path):
+    # Ctrl-C waited for every running shard to finish (here 60 s).
+    out = tmp_path / "ds"
+    proc = _driver(tmp_path, "write", out, start_new_session=True)
+    try:
+        _wait_for(lambda: len(list(out.glob(".shard-*"))) == 2, proc)
+        os.killpg(proc.pid, signal.SIGINT)  # what Ctrl-C in a terminal does
+        _, err = proc.communicate(timeout=15)
+    finally:
+        with contextlib.suppress(OSError):
+            os.killpg(proc.pid, signal.SIGKILL)
+    assert (proc.returncode, err) == (130, "scenegen: interrupted\n")
+    assert sorted(p.name for p in out.iterdir()) == ["manifest.json"]

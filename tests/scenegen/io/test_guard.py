@@ -200,3 +200,44 @@ def test_a_forked_worker_starts_a_guard_after_its_parent_did(tmp_path):
     assert _read_frame_count(tmp_path / "a.h5") == 2  # the parent's guard starts its server
     with multiprocessing.get_context("fork").Pool(1) as pool:
         assert pool.apply(_read_frame_count, (tmp_path / "b.h5",)) == 2
+
+
+_READ_IN_A_FRESH_PROCESS = """
+import sys, tempfile
+from scenegen.cli import main
+from scenegen.io import guard
+if sys.argv[1] == "missing":
+    tempfile.tempdir = sys.argv[2]  # as a program may set it
+if sys.argv[1] == "none":
+    tempfile.tempdir = sys.argv[2]
+    guard._SYSTEM_TEMP_DIRS = ()  # and /tmp, /var/tmp unusable too
+sys.exit(main(["validate", sys.argv[3]]))
+"""
+
+
+@pytest.mark.parametrize("case", ["missing", "long"])
+def test_a_bad_temporary_folder_does_not_stop_a_guarded_read(tmp_path, case):
+    # With tempfile.tempdir on a folder that cannot be written (missing here: root writes
+    # anywhere), or TMPDIR longer than a Unix socket path allows, the fork server could not
+    # listen: "internal error: FileNotFoundError: [Errno 2] No such file or directory:
+    # '/.../pymp-...'", or "internal error: OSError: AF_UNIX path too long" (exit 1).
+    long = tmp_path / ("x" * 100)
+    long.mkdir()
+    env = {**os.environ, "TMPDIR": str(long)} if case == "long" else dict(os.environ)
+    done = subprocess.run([sys.executable, "-c", _READ_IN_A_FRESH_PROCESS, case,
+                           str(tmp_path / "missing"), FIXTURE],
+                          capture_output=True, text=True, env=env, timeout=120)  # fmt: skip
+    assert (done.returncode, done.stderr) == (0, "")
+
+
+def test_no_usable_temporary_folder_is_one_line_naming_tmpdir(tmp_path):
+    env = {**os.environ, "TMPDIR": str(tmp_path / "missing")}
+    done = subprocess.run([sys.executable, "-c", _READ_IN_A_FRESH_PROCESS, "none",
+                           str(tmp_path / "missing"), FIXTURE],
+                          capture_output=True, text=True, env=env, timeout=120)  # fmt: skip
+    assert done.returncode == 2
+    assert done.stderr == (
+        "scenegen: error: no usable temporary folder to start child processes in (TMPDIR="
+        f"{str(tmp_path / 'missing')!r}; {tmp_path / 'missing'}: No such file or directory): "
+        "set TMPDIR to a writable folder with a short path\n"
+    )

@@ -120,12 +120,12 @@ def test_experiment_all_starts_its_workers_once(tmp_path, monkeypatch):
 
     started = []
 
-    class Counting(runner.ProcessPoolExecutor):
-        def __init__(self, *args, **kwargs):
-            started.append(kwargs.get("max_workers"))
-            super().__init__(*args, **kwargs)
+    class Counting(runner.LocalPool):
+        def __init__(self, n, **kwargs):
+            started.append(n)
+            super().__init__(n, **kwargs)
 
-    monkeypatch.setattr(runner, "ProcessPoolExecutor", Counting)
+    monkeypatch.setattr(runner, "LocalPool", Counting)
     monkeypatch.setattr(report, "names", lambda: ["shm-depth", "kams-accuracy"])
     plan = {"shm-depth": (1, 1, True), "kams-accuracy": (1, 1, True)}
     report.run_all(tmp_path / "two", jobs=2, plan=plan)
@@ -547,3 +547,54 @@ def test_clustered_claims_count_scenes_not_runs():
                              30.0, "A", "B", ("t", scenes), delta_source="stated")
         assert out[0]["effect"] == pytest.approx(60.0)
         assert out[0]["verdict"] == verdict, out[0]
+
+
+_DRIVER = """
+import os, signal, sys
+
+import scenegen.lab.experiments.runner as runner
+
+_run = runner.run_batch
+
+
+def run_batch(tasks):
+    if tasks[0].scene == 1:  # the fork server and the workers import this script
+        os.kill(os.getpid(), signal.SIGKILL)  # as the out-of-memory killer does
+    return _run(tasks)
+
+
+runner.run_batch = run_batch
+
+if __name__ == "__main__":
+    from scenegen.cli import main
+
+    sys.exit(main(sys.argv[1:]))
+"""
+
+
+def test_a_dead_worker_is_one_line_naming_its_runs_and_a_rerun_completes(reference, tmp_path):
+    # It was "internal error: BrokenProcessPool: A process in the process pool was
+    # terminated abruptly while the future was running or pending." (exit 1).
+    import subprocess
+    import sys
+
+    script = tmp_path / "driver.py"
+    script.write_text(_DRIVER)
+    out = tmp_path / "out"
+    args = ["experiment", NAME, "--runs", "1", "--scenes", "2", "--quick", "--jobs", "2",
+            "--method", "nonps", "--method", "dps", "-o", str(out)]  # fmt: skip
+    died = subprocess.run([sys.executable, str(script), *args], capture_output=True, text=True)
+    first = plan_tasks(get(NAME), runs=1, scenes=2, seed=0, quick=True, methods=METHODS)
+    first = [t for t in first if t.scene == 1][0]
+    assert died.returncode == 2, died.stderr
+    assert died.stderr.splitlines()[0] == (
+        "scenegen: error: a worker process died (SIGKILL, as when the system runs out of "
+        f"memory: fewer --jobs use less) while running 2 runs of {NAME} on {first.preset} "
+        f"scene 1 (from {first.filename()}); run the same command again to resume (finished "
+        "work is kept)"
+    )
+    again = subprocess.run([sys.executable, "-m", "scenegen.cli", *args], capture_output=True,
+                           text=True)  # fmt: skip
+    assert again.returncode == 0, again.stderr
+    runs = sorted(p.name for p in (out / "runs").iterdir())
+    assert runs == sorted(p.name for p in (reference / "runs").iterdir())
