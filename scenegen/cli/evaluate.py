@@ -68,8 +68,10 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
     DataError
         If either file is invalid, or the result does not fit the sequence (frame count,
         target count or ids), naming the mismatch and the files.
+    ConfigError
+        If ``--tracker`` is given with a MOTChallenge tracker file (it would be ignored).
     """
-    from scenegen.errors import DataError
+    from scenegen.errors import ConfigError, DataError
     from scenegen.evaluation.evaluate import (
         check_options,
         evaluate,
@@ -91,6 +93,11 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
     }
     result = Path(args.result)
     if not _is_hdf5(result):
+        if args.tracker is not None:  # it would be ignored: a tracker file holds one tracker
+            raise ConfigError(
+                f"--tracker does not apply to a MOTChallenge tracker file ({result}); leave "
+                "it out"
+            )
         ids, boxes, rank = read_mot_tracker_rows(result, seq.n_frames)
         report = evaluate_tracks(seq, boxes, ids, tracker=result.stem, rank=rank, **options)
         print(report.to_json() if args.json else format_table(report))

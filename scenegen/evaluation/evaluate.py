@@ -345,7 +345,7 @@ def evaluate_tracks(
     Raises
     ------
     DataError
-        If the frame count differs from the sequence's.
+        If the frame count differs from the sequence's, or ``track_ids`` repeat an id.
     """
     check_options(gt_mode, visibility_threshold, otb_average, iou_threshold)
     est = np.asarray(boxes, dtype=np.float64)
@@ -358,6 +358,10 @@ def evaluate_tracks(
         raise DataError(f"tracks span {est.shape[0]} frames but sequence {name!r} has {t_n}")
     if rank is not None and np.shape(rank) != est.shape[:2]:
         raise DataError(f"rank must have shape {est.shape[:2]}, got {np.shape(rank)}")
+    # One column per track, as a tracker file has one id per track: two columns of one id
+    # would be scored as two tracks (and paired with two targets) where TrackEval sees one.
+    if rep := repeated_ids(ids, "track_ids", "one column per track: merge its boxes"):
+        raise DataError(rep)
     idx = np.asarray(sequence.target_indices())
     idx = idx[np.asarray(sequence.gt.present)[:, idx].any(axis=0)]
     return _report(

@@ -216,12 +216,12 @@ def read_mot_tracker_rows(
     Raises
     ------
     DataError
-        Naming the file and line of a malformed row (fewer than 6 columns, a ``_`` in a
-        number, a frame or id that is not an integer, an id beyond ``MAX_TRACK_ID``, a box
-        value that is not a finite number or whose right or bottom edge is not, a negative
-        width or height), a
-        frame out of range, or a track id that appears twice in a frame; a path that is
-        not a regular file (a FIFO, a device).
+        Naming the file and line of a malformed row (fewer than 6 comma-separated
+        columns, a ``_`` in a number, a frame or id that is not an integer, an id beyond
+        ``MAX_TRACK_ID``, a box value that is not a finite number or whose right or bottom
+        edge is not, a negative width or height), a frame out of range, or a track id that
+        appears twice in a frame; a file that is not UTF-8 text (a byte-order mark is
+        allowed); a path that is not a regular file (a FIFO, a device).
     """
     p = Path(path)
     special = describe_special_file(p)
@@ -230,17 +230,21 @@ def read_mot_tracker_rows(
     try:
         if p.stat().st_size > MAX_TRACKER_FILE_BYTES:
             raise DataError(f"{p}: larger than {MAX_TRACKER_FILE_BYTES} bytes; not a tracker file")
-        text = p.read_text()
+        # utf-8-sig: a byte-order mark (Notepad, Excel's "CSV UTF-8", PowerShell) is not
+        # part of the first frame number; without it the text is read as plain UTF-8.
+        text = p.read_text(encoding="utf-8-sig")
     except (OSError, UnicodeDecodeError) as err:
         raise DataError(f"{p}: cannot read as a MOTChallenge tracker file: {err}") from None
     rows: list[tuple[int, int, int, float, float, float, float]] = []
     for n, line in enumerate(text.splitlines(), 1):
         if not line.strip():
             continue
-        cells = line.replace(" ", "").split(",")
+        # Spaces around a value are allowed (``1, 1, 2``); within one they are not: "20 1"
+        # is two numbers, not 201.
+        cells = [c.strip() for c in line.split(",")]
         try:
             if len(cells) < 6:
-                raise ValueError("fewer than 6 columns")
+                raise ValueError("fewer than 6 comma-separated columns")
             if any("_" in c for c in cells[:6]):  # Python's int and float read 1_0 as 10
                 raise ValueError("'_' is not part of a number")
             frame, ident = _integer(cells[0]), _integer(cells[1])

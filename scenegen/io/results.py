@@ -120,15 +120,17 @@ def bad_probabilities(prob: ArrayLike) -> str:
             f"{t}: {a[bad][0]:g})")  # fmt: skip
 
 
-def repeated_ids(ids: ArrayLike) -> str:
-    """The problem with ``target_ids`` (M,) that repeat an id ("" if none does): each
-    target is tracked once, so one id twice is a damaged or wrong result."""
+def repeated_ids(
+    ids: ArrayLike, name: str = "target_ids", why: str = "each target is tracked once"
+) -> str:
+    """The problem with ids (M,) that repeat one ("" if none does), naming the array
+    ``name`` and saying ``why`` each id is there once: by default a result's
+    ``target_ids``, where one id twice is a damaged or wrong result."""
     a = np.asarray(ids).reshape(-1)
     values, counts = np.unique(a, return_counts=True)
     if not (counts > 1).any():
         return ""
-    return (f"target_ids repeat id {values[counts > 1][0].item()} (each target is tracked "
-            "once)")  # fmt: skip
+    return f"{name} repeat id {values[counts > 1][0].item()} ({why})"
 
 
 def write_result(path: str | Path, *results: TrackerResult) -> None:

@@ -328,3 +328,55 @@ def test_an_underscore_in_a_number_is_refused(tmp_path, row):
     path.write_text(f"1,1,1,1,5,5\n{row}\n")
     with pytest.raises(DataError, match=r"t.txt:2: not a MOTChallenge row \('_' is not part"):
         read_mot_tracker(path, 20)
+
+
+def test_a_byte_order_mark_and_windows_line_ends_are_read(tmp_path, capsys):
+    # A file saved with a UTF-8 byte-order mark (Notepad, Excel's "CSV UTF-8", PowerShell)
+    # was refused: "could not convert string to float: '\ufeff1'" on line 1.
+    seq_file = FIXTURES / "full-occlusion.h5"
+    rows = "1,1,2,3,4,5,0.9,-1,-1,-1\r\n2,1,3,3,4,5,0.9,-1,-1,-1\r\n\r\n"
+    plain, bom = tmp_path / "plain.txt", tmp_path / "bom.txt"
+    plain.write_bytes(rows.encode())
+    bom.write_bytes(b"\xef\xbb\xbf" + rows.encode())
+    ids, boxes = read_mot_tracker(bom, 14)
+    assert ids.tolist() == [1] and boxes[1, 0].tolist() == [2.0, 2.0, 4.0, 5.0]
+    code, out, err = run(capsys, "evaluate", seq_file, bom, "--json")
+    assert code == 0, err
+    assert json.loads(out)["overall"] == json.loads(run(capsys, "evaluate", seq_file, plain,
+                                                        "--json")[1])["overall"]  # fmt: skip
+
+
+def test_a_row_not_separated_by_commas_is_named_as_such(tmp_path, capsys):
+    # np.savetxt's default: ten columns separated by spaces were "fewer than 6 columns".
+    bad = tmp_path / "spaces.txt"
+    bad.write_text("1 1 2 3 4 5 1 -1 -1 -1\n")
+    code, _, err = run(capsys, "evaluate", FIXTURES / "full-occlusion.h5", bad)
+    assert code == 1 and err.strip() == (f"scenegen: error: {bad}:1: not a MOTChallenge row "
+                                         "(fewer than 6 comma-separated columns): "
+                                         "'1 1 2 3 4 5 1 -1 -1 -1'")  # fmt: skip
+
+
+def test_evaluate_refuses_tracker_with_a_tracker_file(tmp_path, capsys):
+    # --tracker was ignored without a word for a MOTChallenge file (exit 0, the report
+    # named the file's stem).
+    txt = tmp_path / "mine.txt"
+    txt.write_text("1,1,2,3,4,5\n")
+    code, out, err = run(capsys, "evaluate", FIXTURES / "full-occlusion.h5", txt,
+                         "--tracker", "kalman")  # fmt: skip
+    assert (code, out) == (2, "") and err.strip() == (
+        f"scenegen: error: --tracker does not apply to a MOTChallenge tracker file ({txt}); "
+        "leave it out"
+    )
+
+
+@pytest.mark.parametrize("row, cell", [("1,1,2,3,4,5 1,-1,-1,-1", "5 1"),
+                                       ("1 0,1,2,3,4,5", "1 0"), ("1,1,2 0,3,4,5", "2 0")])
+def test_a_space_within_a_value_is_refused(tmp_path, row, cell):
+    # Every space was deleted before splitting: "5 1" (a comma left out) was read as a
+    # height of 51 and "1 0" as frame 10, and the file was scored.
+    path = tmp_path / "t.txt"
+    path.write_text(f"1, 1, 1, 1, 5, 5\n{row}\n")  # spaces around values are fine
+    with pytest.raises(DataError) as err:
+        read_mot_tracker(path, 20)
+    assert str(err.value) == (f"{path}:2: not a MOTChallenge row (could not convert string "
+                              f"to float: {cell!r}): {row!r}")  # fmt: skip

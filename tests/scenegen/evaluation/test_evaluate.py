@@ -175,6 +175,13 @@ def test_repeated_target_ids_are_refused_everywhere(seq, tmp_path):
     dup = np.array([1, 1])
     with pytest.raises(DataError, match="target_ids repeat id 1"):
         evaluate(seq, est, dup)
+    # Tracks too: two columns of track 1 were scored as two tracks, each paired with a
+    # target (both rows said track 1), where TrackEval sees one track.
+    from scenegen.evaluation import evaluate_tracks
+
+    with pytest.raises(DataError, match=r"^track_ids repeat id 1 \(one column per track: "
+                                        r"merge its boxes\)$"):  # fmt: skip
+        evaluate_tracks(seq, est, dup)
     bad = TrackerResult("kalman", {}, 0, seq.name, dup, est.astype(np.float32))
     assert bad.problems() == ["target_ids repeat id 1 (each target is tracked once)"]
     path = tmp_path / "res.h5"
