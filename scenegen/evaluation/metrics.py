@@ -358,15 +358,23 @@ def otb_curves(
     Returns
     -------
     OtbCurves
+
+    Raises
+    ------
+    ValueError
+        For ``est`` and ``gt`` of different shapes, ``n_overlap`` < 2 or a negative
+        ``max_error``.
     """
     if n_overlap < 2:
         raise ValueError(f"n_overlap must be >= 2, got {n_overlap}")
     if not max_error >= 0:
         raise ValueError(f"max_error must be >= 0, got {max_error}")
-    g = _boxes(gt)
+    e, g = _boxes(est), _boxes(gt)
+    if e.shape != g.shape:  # a broadcast would score one box against every frame
+        raise ValueError(f"est has shape {e.shape} and gt {g.shape}: one box per frame each")
     has_gt = np.all(np.isfinite(g), axis=-1)
-    ov = np.nan_to_num(iou(est, g), nan=0.0)[has_gt]
-    err = np.nan_to_num(centre_error(est, g), nan=np.inf)[has_gt]
+    ov = np.nan_to_num(iou(e, g), nan=0.0)[has_gt]
+    err = np.nan_to_num(centre_error(e, g), nan=np.inf)[has_gt]
     ths = np.linspace(0.0, 1.0, n_overlap)
     eths = np.arange(0.0, np.floor(float(max_error)) + 1.0, 1.0)
     if ov.size == 0:

@@ -113,6 +113,15 @@ def test_otb_curves_hand_worked():
     assert c2.auc == pytest.approx(0.3)
 
 
+def test_otb_curves_refuse_boxes_that_would_broadcast():
+    """One estimated box is not scored against every frame, and too few frames are named
+    (a numpy broadcast error before)."""
+    gt = np.array([[0, 0, 10, 10.0], [50, 0, 10, 10.0], [100, 0, 10, 10.0]])
+    for est in (gt[:1], gt[:2], gt[None]):
+        with pytest.raises(ValueError, match=r"est has shape .* and gt \(3, 4\)"):
+            m.otb_curves(est, gt)
+
+
 def test_otb_precision_thresholds_stop_at_max_error():
     """The centre-error thresholds are whole pixels up to ``max_error``, never beyond it (a
     fractional ``max_error`` gave a threshold past it); a negative one is refused."""
