@@ -48,7 +48,7 @@ from scenegen.evaluation.report import (
     format_table,
 )
 from scenegen.io.mot import visible_enough
-from scenegen.io.results import repeated_ids
+from scenegen.io.results import bad_box_rows, repeated_ids
 
 __all__ = [
     "DEFAULT_RECOVER_FRAMES",
@@ -212,17 +212,19 @@ def evaluate(
     DataError
         If the result's frame count differs from the sequence's, its target count differs
         from the number of targets present at frame 0 (those ``scenegen track`` follows),
-        or a target id is not one of those targets.
+        a target id is not one of those targets or not an integer, or a box row is neither
+        a box (finite, w, h >= 0) nor all NaN.
     ConfigError
         If an option is out of range.
     """
     check_options(gt_mode, visibility_threshold, otb_average, iou_threshold)
     est = np.asarray(boxes, dtype=np.float64)
-    ids = np.asarray(target_ids).astype(np.int64).reshape(-1)
+    ids = _int_ids(target_ids, "target_ids")
     name = str(getattr(sequence, "name", ""))
     t_n = int(np.asarray(sequence.gt.box).shape[0])
     if est.ndim != 3 or est.shape[2] != 4:
         raise DataError(f"result boxes must have shape (T, M, 4), got {est.shape}")
+    _check_boxes(est, "result boxes")
     if est.shape[0] != t_n:
         raise DataError(f"result has {est.shape[0]} frames but sequence {name!r} has {t_n} frames")
     if est.shape[1] != ids.shape[0]:
@@ -306,6 +308,34 @@ def _pair_tracks(
     return pair
 
 
+def _int_ids(values: ArrayLike, name: str) -> NDArray[np.int64]:
+    """``values`` as int64 ids, shape (N,); a fractional or non-finite id is a DataError
+    (it was truncated: 7.6 scored as track 7)."""
+    raw = np.asarray(values).reshape(-1)
+    if raw.dtype.kind not in "iub":
+        try:
+            num = raw.astype(np.float64)
+        except (TypeError, ValueError):
+            raise DataError(f"{name} must be integers, got {raw[:5].tolist()}") from None
+        bad = ~np.isfinite(num) | (num != np.round(num)) | (np.abs(num) >= 2.0**63)
+        if bad.any():
+            raise DataError(f"{name} must be integers, got {num[bad][0]!r}")
+        return num.astype(np.int64)
+    return raw.astype(np.int64)
+
+
+def _check_boxes(est: NDArray[np.float64], what: str) -> None:
+    """Refuse rows that are neither a box (finite, w, h >= 0) nor all NaN, as the result
+    and tracker-file readers do (:func:`scenegen.io.results.bad_box_rows`)."""
+    bad = np.argwhere(bad_box_rows(est))
+    if bad.size:
+        t, m = (int(v) for v in bad[0])
+        raise DataError(
+            f"{what} at frame {t}, column {m}: {est[t, m].tolist()} is neither a box "
+            "(finite, width and height >= 0) nor all NaN"
+        )
+
+
 def evaluate_tracks(
     sequence: Any,
     boxes: ArrayLike,
@@ -345,15 +375,18 @@ def evaluate_tracks(
     Raises
     ------
     DataError
-        If the frame count differs from the sequence's, or ``track_ids`` repeat an id.
+        If the frame count differs from the sequence's, ``track_ids`` repeat an id or
+        hold one that is not an integer, or a box row is neither a box (finite, w, h >= 0)
+        nor all NaN (as the tracker-file reader refuses).
     """
     check_options(gt_mode, visibility_threshold, otb_average, iou_threshold)
     est = np.asarray(boxes, dtype=np.float64)
-    ids = np.asarray(track_ids).astype(np.int64).reshape(-1)
+    ids = _int_ids(track_ids, "track_ids")
     name = str(getattr(sequence, "name", ""))
     t_n = int(np.asarray(sequence.gt.box).shape[0])
     if est.ndim != 3 or est.shape[2] != 4 or est.shape[1] != ids.shape[0]:
         raise DataError(f"track boxes must have shape (T, {ids.shape[0]}, 4), got {est.shape}")
+    _check_boxes(est, "track boxes")
     if est.shape[0] != t_n:
         raise DataError(f"tracks span {est.shape[0]} frames but sequence {name!r} has {t_n}")
     if rank is not None and np.shape(rank) != est.shape[:2]:

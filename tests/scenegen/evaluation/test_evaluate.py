@@ -192,6 +192,27 @@ def test_repeated_target_ids_are_refused_everywhere(seq, tmp_path):
     assert any("target_ids repeat id 1" in p for p in check_file(path))
 
 
+def test_fractional_ids_and_broken_boxes_are_refused_from_python(seq):
+    # 7.6 was truncated to 7 and scored; a negative width, which the file readers refuse,
+    # was scored from Python.
+    from scenegen.evaluation import evaluate_tracks
+
+    est = np.asarray(seq.gt.box[:, seq.target_indices()], dtype=np.float64)
+    ids = seq.target_ids().astype(np.float64)
+    for call, name in ((evaluate, "target_ids"), (evaluate_tracks, "track_ids")):
+        assert call(seq, est, ids).targets  # integral floats are ids
+        for bad in (ids + 0.6, np.where(np.arange(ids.size) == 0, np.nan, ids)):
+            with pytest.raises(DataError, match=rf"^{name} must be integers, got "):
+                call(seq, est, bad)
+        broken = est.copy()
+        broken[3, 1, 2] = -2.0
+        with pytest.raises(DataError, match=r"boxes at frame 3, column 1: .* is neither a box"):
+            call(seq, broken, ids)
+        broken[3, 1] = [np.nan, 1.0, 2.0, 3.0]  # partly NaN
+        with pytest.raises(DataError, match=r"boxes at frame 3, column 1: "):
+            call(seq, broken, ids)
+
+
 def test_failure_frame_is_a_frame_of_the_sequence():
     from scenegen.evaluation import evaluate_tracks
 
