@@ -47,7 +47,7 @@ from scenegen.evaluation.report import (
     TargetScores,
     format_table,
 )
-from scenegen.io.mot import visible_enough
+from scenegen.io.mot import check_gt_mode, visible_enough
 from scenegen.io.results import bad_box_rows, repeated_ids
 
 __all__ = [
@@ -142,13 +142,11 @@ def _finite(x: float) -> float | None:
 def check_options(
     gt_mode: str, visibility_threshold: float, otb_average: str, iou_threshold: float = 0.5
 ) -> None:
-    """Raise ConfigError naming an unknown ``gt_mode`` / ``otb_average`` or a bad threshold."""
+    """Raise ConfigError naming an unknown ``gt_mode`` / ``otb_average`` or a bad threshold
+    (:func:`scenegen.io.mot.check_gt_mode`: one definition with the exports)."""
     if not 0.0 < iou_threshold <= 1.0:
         raise ConfigError(f"iou_threshold must be in (0, 1], got {iou_threshold}")
-    if gt_mode not in GT_MODES:
-        raise ConfigError(f"gt_mode must be one of {', '.join(GT_MODES)}; got {gt_mode!r}")
-    if not 0.0 <= visibility_threshold < 1.0:
-        raise ConfigError(f"visibility_threshold must be in [0, 1), got {visibility_threshold}")
+    check_gt_mode(gt_mode, visibility_threshold)
     if otb_average not in OTB_AVERAGES:
         raise ConfigError(
             f"otb_average must be one of {', '.join(OTB_AVERAGES)}; got {otb_average!r}"

@@ -65,11 +65,18 @@ def _num(v: float) -> str:
 
 
 def check_gt_mode(gt_mode: str, visibility_threshold: float) -> None:
-    """Raise ConfigError for an unknown mode or a threshold outside [0, 1)."""
+    """Raise ConfigError for an unknown mode, a threshold outside [0, 1), or a threshold
+    other than 0 in ``amodal`` mode (which counts every frame a target is in the scene,
+    so it would be recorded in the report and ignored)."""
     if gt_mode not in GT_MODES:
         raise ConfigError(f"gt_mode must be one of {', '.join(GT_MODES)}; got {gt_mode!r}")
     if not 0.0 <= visibility_threshold < 1.0:
-        raise ConfigError(f"visibility threshold must be in [0, 1), got {visibility_threshold}")
+        raise ConfigError(f"visibility_threshold must be in [0, 1), got {visibility_threshold}")
+    if gt_mode == "amodal" and visibility_threshold != 0.0:
+        raise ConfigError(
+            f"visibility_threshold ({visibility_threshold}) applies to gt_mode 'visible' "
+            "only: amodal counts every frame a target is in the scene"
+        )
 
 
 def visible_enough(visibility: ArrayLike, threshold: float) -> NDArray[np.bool_]:

@@ -380,3 +380,20 @@ def test_a_space_within_a_value_is_refused(tmp_path, row, cell):
         read_mot_tracker(path, 20)
     assert str(err.value) == (f"{path}:2: not a MOTChallenge row (could not convert string "
                               f"to float: {cell!r}): {row!r}")  # fmt: skip
+
+
+def test_a_visibility_threshold_in_amodal_mode_is_refused(tmp_path, capsys):
+    # It was accepted, recorded in the report and ignored (amodal counts every frame).
+    seq_file = FIXTURES / "full-occlusion.h5"
+    txt = tmp_path / "mine.txt"
+    txt.write_text("1,1,2,3,4,5\n")
+    needle = "visibility_threshold (0.5) applies to gt_mode 'visible' only"
+    for argv in (("evaluate", seq_file, txt, "--visibility-threshold", "0.5"),
+                 ("export", seq_file, "--format", "mot", "--visibility-threshold", "0.5",
+                  "-o", tmp_path / "mot")):  # fmt: skip
+        code, _, err = run(capsys, *argv)
+        assert code == 2 and err.count("\n") == 1 and needle in err, err
+    assert not (tmp_path / "mot").exists()
+    code, _, err = run(capsys, "evaluate", seq_file, txt, "--gt-mode", "visible",
+                       "--visibility-threshold", "0.5")  # fmt: skip
+    assert code == 0, err
