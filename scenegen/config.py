@@ -20,6 +20,7 @@ Example
 from __future__ import annotations
 
 import dataclasses
+import functools
 import json
 import math
 import re
@@ -34,6 +35,7 @@ from scenegen.errors import ConfigError
 
 __all__ = [
     "AR2",
+    "BACKGROUND_FIELDS",
     "MAX_BLUR",
     "MAX_COLORS",
     "MAX_FRAMES",
@@ -42,6 +44,8 @@ __all__ = [
     "MAX_PATH",
     "MAX_SIDE",
     "MAX_TEMPLATE_PIXELS",
+    "MAX_VALUES",
+    "PATTERN_FIELDS",
     "Appearance",
     "Background",
     "Camera",
@@ -52,6 +56,7 @@ __all__ = [
     "SKIMAGE_NAMES",
     "SceneConfig",
     "Variation",
+    "dump_yaml",
     "from_dict",
     "load_config",
     "load_data",
@@ -149,6 +154,46 @@ def check_source(source: str) -> None:
         )
 
 
+_DRAWN = ("solid", "rings", "sectors", "stripes", "bands", "checker", "texture", "perlin")
+PATTERN_FIELDS: dict[str, tuple[str, ...]] = {
+    "colors": _DRAWN,
+    "texture_sigma": ("texture",),
+    "noise_scale": ("perlin",),
+    "source": ("image",),
+    "crop": ("image",),
+    "fit": ("image",),
+    "tint": ("image",),
+}
+"""The :class:`Appearance` fields that only some patterns use, with those patterns: on any
+other pattern such a field must keep its default, else the config is refused naming the
+field and the pattern (``appearance.crop: not used by pattern 'solid' (it applies to
+pattern: image)``). ``stripe_width`` (used by ``stripes`` and ``checker``) is tolerated on
+every pattern: the regression fixtures, scaled down, record it on every pattern."""
+BACKGROUND_FIELDS: dict[str, tuple[str, ...]] = {
+    "color": ("uniform", "texture", "perlin", "image"),
+    "low": ("noise", "texture", "perlin"),
+    "high": ("noise", "texture", "perlin"),
+    "source": ("image",),
+    "fit": ("image",),
+}
+"""The :class:`Background` fields that only some kinds use, as :data:`PATTERN_FIELDS`.
+``scale`` (used by ``texture`` and ``perlin``) is tolerated on every kind: the regression
+fixtures, scaled down, record it on every kind."""
+
+
+def _check_unused(obj: Any, kind: str, users: dict[str, tuple[str, ...]]) -> None:
+    """Refuse a field that the chosen ``kind`` (an appearance's ``pattern``, a background's
+    ``kind``) does not use, unless it holds its default: it would be silently ignored.
+
+    ``users`` maps each kind-specific field of ``obj`` to the kinds that use it."""
+    chosen = getattr(obj, kind)
+    defaults = {f.name: f.default for f in dataclasses.fields(obj)}
+    for name, kinds in users.items():
+        if chosen not in kinds and getattr(obj, name) != defaults[name]:
+            where = " | ".join(kinds)
+            _fail(name, f"not used by {kind} {chosen!r} (it applies to {kind}: {where})")
+
+
 def _new(default: Any) -> Any:
     """A field added after the first release: left out of :func:`to_dict` while it holds
     its default, so configs written before it existed still compare equal."""
@@ -231,7 +276,9 @@ class Appearance:
     ``shape`` masks every pattern. ``tint`` multiplies ``image`` pixels per channel
     (``[255, 140, 0]`` turns a grey texture orange). A relative file ``source`` is
     relative to the config file's folder when the config is read from a file (and then
-    recorded absolute: :func:`load_config`), else to the current directory.
+    recorded absolute: :func:`load_config`), else to the current directory. A field that
+    the pattern does not use (``crop`` on a ``solid`` pattern, ``colors`` on an ``image``)
+    is refused unless it holds its default: :data:`PATTERN_FIELDS`.
     """
 
     shape: Shape = "rect"
@@ -247,6 +294,8 @@ class Appearance:
     noise_scale: float = _new(8.0)
 
     def __post_init__(self) -> None:
+        if self.pattern == "image" and self.source is None:
+            _fail("source", "is required by the image pattern")
         self._check_image()
         if self.size[0] < 1 or self.size[1] < 1:
             _fail("size", f"width and height must be >= 1, got {_short(list(self.size))}")
@@ -262,13 +311,10 @@ class Appearance:
             _fail("texture_sigma", f"must be >= 0, got {_short(self.texture_sigma)}")
         if not 1 <= self.noise_scale <= MAX_SIDE:
             _fail("noise_scale", f"must be in 1..{MAX_SIDE}, got {_short(self.noise_scale)}")
+        _check_unused(self, "pattern", PATTERN_FIELDS)
 
     def _check_image(self) -> None:
-        if self.pattern == "image" and self.source is None:
-            _fail("source", "is required by the image pattern")
         if self.source is not None:
-            if self.pattern != "image":
-                _fail("source", f"needs pattern: image (the pattern is {self.pattern!r})")
             try:
                 check_source(self.source)
             except ConfigError as err:
@@ -428,7 +474,9 @@ class Background:
     by ``fit``: ``stretch`` resizes, ``tile`` repeats, ``crop`` scales to cover and takes
     the centre; multiplied per channel by ``color`` / 255, so the default white leaves it
     unchanged; a relative file path as for :class:`Appearance`). With a :class:`Camera`
-    the background is larger than the frame by the camera's ``extent`` on every side."""
+    the background is larger than the frame by the camera's ``extent`` on every side. A
+    field that the kind does not use (``low`` on ``uniform``, ``color`` on ``noise``) is
+    refused unless it holds its default: :data:`BACKGROUND_FIELDS`."""
 
     kind: Literal["uniform", "noise", "texture", "perlin", "image"] = "uniform"
     color: Color = (255, 255, 255)
@@ -442,8 +490,6 @@ class Background:
         if self.kind == "image" and self.source is None:
             _fail("source", "is required by kind: image")
         if self.source is not None:
-            if self.kind != "image":
-                _fail("source", f"needs kind: image (the kind is {self.kind!r})")
             try:
                 check_source(self.source)
             except ConfigError as err:
@@ -454,6 +500,7 @@ class Background:
                          f"high={_short(self.high)}")
         if not 0 < self.scale <= MAX_BLUR:
             _fail("scale", f"must be in (0, {MAX_BLUR:g}], got {_short(self.scale)}")
+        _check_unused(self, "kind", BACKGROUND_FIELDS)
 
 
 def _check_keyframes(name: str, keys: tuple[tuple[int, float, float], ...]) -> None:
@@ -473,14 +520,20 @@ class Camera:
     *scene* coordinates, which equal frame coordinates when the camera is at rest; the
     frame shows the scene shifted by the camera offset (dx, dy), a whole number of pixels
     with ``|dx| <= ex``, ``|dy| <= ey``. The offset follows ``x`` and ``y`` (AR2 from 0 with
-    initial ``velocity``; their boundary applies at the extent; ``margin`` is ignored) or
-    the scripted ``keyframes`` ((frame, dx, dy), linear in between and held after the
-    last; an offset beyond the extent is refused). Every ground-truth field is in the
-    coordinates of the rendered frame.
+    initial ``velocity``; their boundary, ``reflect`` or ``clamp``, applies at the extent;
+    ``margin`` is ignored) or the scripted ``keyframes`` ((frame, dx, dy), linear in
+    between and held after the last; an offset beyond the extent is refused). Every
+    ground-truth field is in the coordinates of the rendered frame.
 
     ``zoom`` (AR2 of the log zoom from 0; ``margin`` bounds ``|log zoom|``, 0 means the
-    limits 1/2 and 2) magnifies the view about the frame centre: a scene point p appears
-    at ``c + zoom * (p - d - c)`` with c the frame centre and d the offset. The background
+    limits 1/2 and 2; ``reflect`` or ``clamp``) magnifies the view about the frame centre:
+    a scene point p appears at ``c + zoom * (p - d - c)`` with c the frame centre and d
+    the offset.
+
+    ``boundary: free`` is refused on a camera AR2: the view cannot leave the background,
+    nor the zoom its limits, so a free path would leave the view stuck at the limit while
+    it went on beyond (until it came back, if ever). Within the limits ``reflect`` and
+    ``clamp`` move exactly as ``free`` would. With a zoom the background
     is then resampled per frame (bilinear, mirrored beyond its edge) and every entity,
     static ones included, is drawn per frame at ``scale * zoom`` (nearest neighbour, as
     for any scale change), so labels stay exact.
@@ -496,6 +549,15 @@ class Camera:
     def __post_init__(self) -> None:
         if not (0 <= self.extent[0] <= MAX_SIDE and 0 <= self.extent[1] <= MAX_SIDE):
             _fail("extent", f"must be in 0..{MAX_SIDE}, got {_short(list(self.extent))}")
+        for axis in ("x", "y", "zoom"):
+            ar = getattr(self, axis)
+            if ar is not None and ar.boundary == "free":
+                limits = "its limits" if axis == "zoom" else f"the extent {list(self.extent)}"
+                _fail(
+                    f"{axis}.boundary",
+                    f"free is not allowed on a camera: the view cannot go beyond {limits} "
+                    "and would stick there while the path went on; use reflect or clamp",
+                )
         if self.keyframes and (self.x is not None or self.y is not None):
             _fail("keyframes", "cannot be combined with x or y motion")
         _check_keyframes("keyframes", self.keyframes)
@@ -823,21 +885,6 @@ def _is_number(value: Any) -> bool:
     return _is_integer(value) or isinstance(value, (float, np.floating))
 
 
-_YAML11_EXPONENT = re.compile(r"([-+]?)(\d+)(?:\.(\d*))?[eE]([-+]?)(\d+)")
-
-
-def _yaml_number_hint(value: Any) -> str:
-    """For a string such as ``'1e9'``, which YAML 1.1 (PyYAML) reads as text since its
-    floats need a dot and a signed exponent: how to write the number instead."""
-    short = isinstance(value, str) and len(value) <= 40
-    m = _YAML11_EXPONENT.fullmatch(value) if short else None
-    if m is None:
-        return ""
-    sign, whole, frac, esign, exp = m.groups()
-    spelled = f"{sign}{whole}.{frac or 0}e{esign or '+'}{exp}"
-    return f" (a string: YAML reads {value} as text; write {spelled})"
-
-
 def _convert(value: Any, tp: Any, path: str) -> Any:
     origin = get_origin(tp)
     if origin is typing.Union or origin is types.UnionType:
@@ -875,13 +922,13 @@ def _convert(value: Any, tp: Any, path: str) -> Any:
         return value
     if tp is int:
         if not _is_number(value):
-            _fail(path, f"must be an integer, got {_short(value)}{_yaml_number_hint(value)}")
+            _fail(path, f"must be an integer, got {_short(value)}")
         if not _is_integer(value) and not float(value).is_integer():
             _fail(path, f"must be an integer, got {_short(value)}")
         return int(value)
     if tp is float:
         if not _is_number(value):
-            _fail(path, f"must be a number, got {_short(value)}{_yaml_number_hint(value)}")
+            _fail(path, f"must be a number, got {_short(value)}")
         if _is_integer(value) and abs(int(value)) > MAX_MAGNITUDE:
             _fail(path, f"must be at most {MAX_MAGNITUDE:g} in magnitude, got {_short(value)}")
         if not math.isfinite(value):
@@ -894,6 +941,17 @@ def _convert(value: Any, tp: Any, path: str) -> Any:
     _fail(path, f"cannot read a value of type {_type_name(tp)}")
 
 
+def _check_count(path: str, value: Any) -> None:
+    """Refuse a list of more entities or clutter groups than a scene may hold before its
+    items are read (a million of them would take minutes and gigabytes to refuse)."""
+    if isinstance(value, (list, tuple)) and len(value) > _MAX_ENTITIES:
+        _fail(
+            path,
+            f"at most {_MAX_ENTITIES} items, got {len(value):,} (a scene holds at most "
+            f"{_MAX_ENTITIES} entities)",
+        )
+
+
 def _normalise_depth(value: Any) -> Any:
     # A single number is shorthand for a constant depth from frame 0.
     if _is_number(value):
@@ -901,10 +959,16 @@ def _normalise_depth(value: Any) -> Any:
     return value
 
 
+@functools.cache
+def _hints(cls: type) -> dict[str, Any]:
+    """The field types of a config dataclass (resolving them costs more than a field)."""
+    return typing.get_type_hints(cls)
+
+
 def _build(cls: type, data: Any, path: str) -> Any:
     if not isinstance(data, dict):
         _fail(path, f"must be a mapping, got {_short(data)}")
-    hints = typing.get_type_hints(cls)
+    hints = _hints(cls)
     fields = {f.name: f for f in dataclasses.fields(cls)}
     for key in data:
         if key not in fields:
@@ -922,6 +986,8 @@ def _build(cls: type, data: Any, path: str) -> Any:
         value = data[name]
         if cls is EntitySpec and name == "depth":
             value = _normalise_depth(value)
+        if cls is SceneConfig and name in ("entities", "clutter"):
+            _check_count(sub, value)
         kwargs[name] = _convert(value, hints[name], sub)
     try:
         return cls(**kwargs)
@@ -1000,22 +1066,131 @@ MAX_ALIASES = 1000
 MAX_NODES = 100_000
 """Most YAML nodes that aliases may add to a config once expanded: a few hundred bytes of
 nested aliases ("billion laughs") would otherwise expand to billions of values. A document
-without aliases is bounded by :data:`MAX_CONFIG_BYTES` alone, as a JSON one is."""
+without aliases is bounded by :data:`MAX_CONFIG_BYTES` and :data:`MAX_VALUES` alone, as a
+JSON one is."""
+
+
+MAX_VALUES = 250_000
+"""Most values (mappings, lists, keys and scalars) in one config or family file, YAML or
+JSON alike, counted as the file is read: a file of a million list items is refused up
+front rather than taking a minute and a gigabyte to read (a YAML value costs about a
+kilobyte while it is read). The largest preset has under 1,000."""
+
+_YAML_CORE = (
+    ("bool", r"true|True|TRUE|false|False|FALSE", "tTfF"),
+    ("int", r"[-+]?[0-9]+|0o[0-7]+|0x[0-9a-fA-F]+", "-+0123456789"),
+    ("float", r"[-+]?(?:\.[0-9]+|[0-9]+(?:\.[0-9]*)?)(?:[eE][-+]?[0-9]+)?"
+              r"|[-+]?\.(?:inf|Inf|INF)|\.(?:nan|NaN|NAN)", "-+0123456789."),
+    ("null", r"~|null|Null|NULL|", "~nN"),
+)  # fmt: skip
+"""The plain scalars that are not strings in the YAML 1.2 core schema (tag, pattern, first
+characters; an empty scalar is also null): ``010`` is 10, ``0o10`` 8, ``1e9`` a float,
+and ``yes``, ``no``, ``on``, ``off``, ``1_000``, ``1:30`` and ``2024-01-01`` are strings
+(YAML 1.1, PyYAML's default, reads them as booleans, numbers and dates)."""
+
+
+@functools.cache
+def _yaml_core() -> tuple[type, type]:
+    """The YAML loader and dumper of configs: PyYAML's safe ones with the implicit scalars
+    of the YAML 1.2 core schema (:data:`_YAML_CORE`). The dumper quotes a string that
+    either YAML 1.1 or 1.2 would read as something else, so what it writes reads back the
+    same here and in any YAML reader."""
+    import yaml
+
+    class CoreLoader(yaml.SafeLoader):
+        pass
+
+    class CoreDumper(yaml.SafeDumper):
+        pass
+
+    # YAML 1.1's implicit booleans, numbers, dates and '=' go; merge keys ('<<') stay.
+    CoreLoader.yaml_implicit_resolvers = {
+        first: [(tag, rx) for tag, rx in resolvers if tag == "tag:yaml.org,2002:merge"]
+        for first, resolvers in yaml.SafeLoader.yaml_implicit_resolvers.items()
+    }
+    for name, pattern, first in _YAML_CORE:
+        rx = re.compile(f"^(?:{pattern})$")
+        starts = [*first, ""] if name == "null" else list(first)
+        for cls in (CoreLoader, CoreDumper):
+            cls.add_implicit_resolver(f"tag:yaml.org,2002:{name}", rx, starts)
+
+    def construct_int(loader: Any, node: Any) -> int:
+        text = loader.construct_scalar(node)
+        if text[:2] in ("0o", "0x"):
+            return int(text[2:], 8 if text[1] == "o" else 16)
+        return int(text, 10)  # a leading zero is decimal: 010 is 10
+
+    CoreLoader.add_constructor("tag:yaml.org,2002:int", construct_int)
+    return CoreLoader, CoreDumper
+
+
+def dump_yaml(data: Any) -> str:
+    """``data`` (plain data, as :func:`to_dict` gives) as YAML text that :func:`load_data`
+    reads back equal: a string such as ``'1e9'``, ``'no'`` or ``'010'`` is quoted."""
+    import yaml
+
+    return yaml.dump(data, Dumper=_yaml_core()[1], sort_keys=False)
+
+
+def _too_many_values() -> ConfigError:
+    return ConfigError(f"more than {MAX_VALUES:,} values (lists, mappings, keys, scalars)")
+
+
+def _count_values(data: Any) -> None:
+    """Raise :func:`_too_many_values` if ``data`` (as JSON gives it) holds more than
+    :data:`MAX_VALUES` values, counted as a YAML file's are."""
+    count, stack = 0, [data]
+    while stack:
+        value = stack.pop()
+        count += 1
+        if count > MAX_VALUES:
+            raise _too_many_values()
+        if isinstance(value, dict):
+            count += len(value)  # the keys
+            stack.extend(value.values())
+        elif isinstance(value, list):
+            stack.extend(value)
+
+
+def _count_yaml_values(text: str) -> None:
+    """Refuse a YAML document of more than :data:`MAX_VALUES` values before it is read:
+    libyaml's streaming parser (when PyYAML has it) counts a million values in a second
+    and a few megabytes, where composing them would take half a minute and a kilobyte
+    each. The composer counts them again in any case; a syntax error is left to it."""
+    import yaml
+
+    if not getattr(yaml, "__with_libyaml__", False):
+        return
+    count = 0
+    try:
+        for event in yaml.parse(text.encode("utf-8"), Loader=yaml.CSafeLoader):
+            if isinstance(event, (yaml.ScalarEvent, yaml.CollectionStartEvent)):
+                count += 1
+                if count > MAX_VALUES:
+                    raise _too_many_values()
+    except yaml.YAMLError:
+        return
 
 
 def _load_yaml(text: str) -> Any:
-    """``yaml.safe_load`` with the alias count and the expansion bounded, and duplicate keys
-    refused."""
+    """The data of a YAML document read with the YAML 1.2 core schema (:func:`_yaml_core`),
+    at most :data:`MAX_VALUES` values, the alias count and the expansion bounded, and
+    duplicate keys refused."""
     import yaml
 
-    class Loader(yaml.SafeLoader):
+    class Loader(_yaml_core()[0]):  # type: ignore[misc]
         aliases = 0
+        values = 0
 
         def compose_node(self, parent: Any, index: Any) -> Any:
             if self.check_event(yaml.AliasEvent):
                 Loader.aliases += 1
                 if Loader.aliases > MAX_ALIASES:
                     raise ConfigError(f"more than {MAX_ALIASES} YAML aliases")
+            else:
+                Loader.values += 1
+                if Loader.values > MAX_VALUES:
+                    raise _too_many_values()
             return super().compose_node(parent, index)
 
         def construct_mapping(self, node: Any, deep: bool = False) -> Any:
@@ -1034,6 +1209,7 @@ def _load_yaml(text: str) -> Any:
                         pass
             return super().construct_mapping(node, deep=deep)
 
+    _count_yaml_values(text)
     loader = Loader(text)
     try:
         node = loader.get_single_node()
@@ -1115,10 +1291,13 @@ def _parser_message(err: Exception) -> str:
 def load_data(path: str | Path, what: str = "config") -> Any:
     """The plain data of a YAML (``.yaml``/``.yml``) or JSON (``.json``) file, unvalidated.
 
-    The file must be UTF-8 text of at most :data:`MAX_CONFIG_BYTES`; YAML aliases are
+    The file must be UTF-8 text (a byte-order mark is allowed, in JSON too) of at most
+    :data:`MAX_CONFIG_BYTES` holding at most :data:`MAX_VALUES` values; YAML aliases are
     bounded (:data:`MAX_ALIASES`, :data:`MAX_NODES`) and a key given twice in one mapping
-    is refused, in YAML and JSON alike. Scenario configs (:func:`load_config`) and family
-    files (:func:`scenegen.datasets.load_family`) are read by it.
+    is refused, in YAML and JSON alike. YAML is read with the YAML 1.2 core schema
+    (:data:`_YAML_CORE`): ``010`` is 10 and ``no`` a string, where YAML 1.1 read 8 and
+    false. Scenario configs (:func:`load_config`) and family files
+    (:func:`scenegen.datasets.load_family`) are read by it.
 
     Parameters
     ----------
@@ -1130,8 +1309,9 @@ def load_data(path: str | Path, what: str = "config") -> Any:
     ------
     ConfigError
         One line naming the file: not a regular file (a FIFO, a device), unreadable, too
-        big, not UTF-8, another extension, not valid YAML/JSON (the parser's problem and
-        its line and column), an alias bomb or a duplicate key.
+        big, not UTF-8, another extension, empty, not valid YAML/JSON (the parser's problem
+        and its line and column), more than :data:`MAX_VALUES` values, an alias bomb or a
+        duplicate key.
     """
     from scenegen.io.atomic import describe_special_file
 
@@ -1144,16 +1324,21 @@ def load_data(path: str | Path, what: str = "config") -> Any:
             raise ConfigError(
                 f"{p}: {what} is {p.stat().st_size:,} bytes, more than {MAX_CONFIG_BYTES:,}"
             )
-        text = p.read_text(encoding="utf-8")
+        text = p.read_text(encoding="utf-8-sig")  # a byte-order mark (Notepad's) is dropped
     except OSError as err:
         raise ConfigError(f"{p}: cannot read {what}: {err.strerror or err}") from None
     except UnicodeDecodeError as err:
         raise ConfigError(f"{p}: {what} is not UTF-8 text ({err.reason})") from None
     try:
         if p.suffix.lower() in (".yaml", ".yml"):
-            return _load_yaml(text)
+            data = _load_yaml(text)
+            if data is None:  # no document, or only comments, or a bare null
+                raise ConfigError(f"{what} is empty (a YAML mapping of fields is expected)")
+            return data
         if p.suffix.lower() == ".json":
-            return json.loads(text, object_pairs_hook=json_object)
+            data = json.loads(text, object_pairs_hook=json_object)
+            _count_values(data)
+            return data
         raise ConfigError(f"{p}: {what} must be .yaml, .yml or .json, got {_short(p.suffix)}")
     except ConfigError as err:
         raise ConfigError(str(err) if str(err).startswith(f"{p}: ") else f"{p}: {err}") from None

@@ -215,6 +215,8 @@ def jitter_colors(app: Appearance, std: float, *, rng: np.random.Generator) -> A
         return app
     cols = np.asarray(app.colors, dtype=np.float64)
     cols = np.clip(np.rint(cols + rng.standard_normal(cols.shape) * std), 0, 255).astype(int)
+    if app.pattern == "image":  # no colours to jitter; the draws keep the stream's place
+        return app
     return replace(app, colors=tuple(tuple(int(v) for v in c) for c in cols))
 
 

@@ -575,9 +575,12 @@ def _clutter(cfg: SceneConfig, seed: int) -> list[tuple[str, NDArray[np.uint8], 
         for j in range(n):
             size = (max(1, int(round(bw * frac[j]))), max(1, int(round(bh * frac[j]))))
             if textured:
-                colors = tuple(tuple(int(v) for v in c) for c in pal[cols[j]])
+                item = app
+                if app.pattern == "perlin":  # an image has no colours
+                    colors = tuple(tuple(int(v) for v in c) for c in pal[cols[j]])
+                    item = replace(app, colors=colors)
                 tpl = draw_template(
-                    replace(app, colors=colors), rng=rng, size=size,
+                    item, rng=rng, size=size,
                     field=f"clutter[{i}].appearance",
                 )  # fmt: skip
                 items.append((f"{spec.name}-{j}", tpl, float(cx[j]), float(cy[j])))

@@ -197,14 +197,12 @@ def _draw_appearance(draw: Any, sizes_w: tuple[int, int], sizes_h: tuple[int, in
     size = (draw(st.integers(*sizes_w)), draw(st.integers(*sizes_h)))
     pattern = draw(st.sampled_from(_PATTERNS))
     colors = tuple(draw(st.lists(st.sampled_from(_COLORS), min_size=1, max_size=4)))
-    return Appearance(
-        shape=shape,
-        size=size,
-        pattern=pattern,
-        colors=colors,
-        stripe_width=draw(st.integers(1, 6)),
-        texture_sigma=_hundredths(draw, 0, 40),
-    )
+    app = Appearance(shape=shape, size=size, pattern=pattern, colors=colors)
+    if pattern in ("stripes", "checker"):
+        app = replace(app, stripe_width=draw(st.integers(1, 6)))
+    if pattern == "texture":  # a field another pattern does not use is refused
+        app = replace(app, texture_sigma=_hundredths(draw, 0, 40))
+    return app
 
 
 # --------------------------------------------------------------------------------------
@@ -560,6 +558,8 @@ def _draw_background(draw: Any, noise: bool) -> Background:
         return Background(kind="uniform", color=color)
     low = draw(st.integers(0, 255))
     high = draw(st.integers(low, 255))
+    if kind == "noise":  # neither tinted nor smoothed: a colour would be refused
+        return Background(kind="noise", low=low, high=high)
     scale = _hundredths(draw, 0.5, 8)
     return Background(kind=kind, color=color, low=low, high=high, scale=scale)
 
@@ -673,11 +673,19 @@ def _textured(draw: Any, app: Appearance) -> Appearance:
     kind = draw(st.sampled_from(("keep", "image", "perlin")))
     if kind == "keep":
         return app
+    # The fields the new pattern does not use go back to their defaults (else refused).
+    plain = Appearance()
     if kind == "perlin":
-        return replace(app, pattern="perlin", noise_scale=_hundredths(draw, 1, 16))
+        return replace(
+            app, pattern="perlin", noise_scale=_hundredths(draw, 1, 16),
+            texture_sigma=plain.texture_sigma, stripe_width=plain.stripe_width,
+        )  # fmt: skip
     tint = draw(st.sampled_from((None, *_COLORS)))
     return replace(
         app,
+        colors=plain.colors,
+        texture_sigma=plain.texture_sigma,
+        stripe_width=plain.stripe_width,
         pattern="image",
         source=draw(st.sampled_from(_IMAGE_SOURCES)),
         fit=draw(st.sampled_from(_FITS)),
@@ -742,12 +750,10 @@ def example_file(config: SceneConfig) -> tuple[str, Path]:
     import hashlib
     import tempfile
 
-    import yaml
-
-    from scenegen.config import to_dict
+    from scenegen.config import dump_yaml, to_dict
     from scenegen.io.atomic import write_text
 
-    text = yaml.safe_dump(to_dict(config), sort_keys=False)
+    text = dump_yaml(to_dict(config))
     digest = hashlib.sha256(text.encode()).hexdigest()[:12]
     path = Path(tempfile.gettempdir()) / "scenegen-examples" / f"scene-{digest}.yaml"
     if not path.exists():

@@ -177,23 +177,19 @@ def test_numpy_scalars_are_numbers():
             from_dict({**base(), field: value})
 
 
-def test_a_yaml_1_1_exponent_without_a_dot_says_how_to_write_the_number(tmp_path):
-    # PyYAML reads 1e9 (no dot, unsigned exponent) as a string: before, the message was
-    # only "must be a number, got '1e9'", for what the user wrote as a number.
+def test_yaml_exponents_without_a_dot_are_numbers(tmp_path):
+    # YAML 1.2 (the core schema the loader follows): 2e-1 and 1E2 are floats. PyYAML's
+    # YAML 1.1 read them as strings, and the config was refused ("must be a number").
     path = tmp_path / "e.yaml"
-    path.write_text("width: 40\nheight: 30\nn_frames: 5\nsensor_noise: 2e-1\n")
-    with pytest.raises(ConfigError, match=r"^\S+e\.yaml: sensor_noise: must be a number, "
-                       r"got '2e-1' \(a string: YAML reads 2e-1 as text; write 2\.0e-1\)$"):
-        load_config(path)
-    path.write_text("width: 40\nheight: 30\nn_frames: 1E2\n")
-    with pytest.raises(ConfigError, match=r"n_frames: must be an integer, got '1E2' "
-                       r"\(a string: YAML reads 1E2 as text; write 1\.0e\+2\)$"):
-        load_config(path)
+    path.write_text("width: 40\nheight: 30\nn_frames: 1E2\nsensor_noise: 2e-1\n")
+    assert (load_config(path).n_frames, load_config(path).sensor_noise) == (100, 0.2)
     path.write_text("width: 40\nheight: 30\nn_frames: 1.0e+2\nsensor_noise: 2.0e-1\n")
     assert (load_config(path).n_frames, load_config(path).sensor_noise) == (100, 0.2)
-    # A string that is no such number gets no hint.
+    # A string stays a string: no number is made of it.
     with pytest.raises(ConfigError, match=r"^sensor_noise: must be a number, got 'x'$"):
         from_dict({**base(), "sensor_noise": "x"})
+    with pytest.raises(ConfigError, match=r"^sensor_noise: must be a number, got '1e9'$"):
+        from_dict({**base(), "sensor_noise": "1e9"})
 
 
 @pytest.mark.parametrize(
@@ -232,3 +228,109 @@ def test_yaml_merge_keys_may_be_overridden(tmp_path):
     path = tmp_path / "m.yaml"
     path.write_text("<<: {width: 40, height: 30, n_frames: 3}\nwidth: 20\n")
     assert load_config(path) == from_dict({"width": 20, "height": 30, "n_frames": 3})
+
+
+def _app(**fields) -> dict:
+    return mutate(["entities", 0, "appearance"], {"size": [9, 9], **fields})
+
+
+@pytest.mark.parametrize(
+    ("data", "message"),
+    [
+        (_app(crop=[0, 0, 4, 4]), "entities[0].appearance.crop: not used by pattern 'solid' "
+                                  "(it applies to pattern: image)"),
+        (_app(pattern="stripes", fit="tile"), "entities[0].appearance.fit: not used by "
+                                              "pattern 'stripes' (it applies to pattern: image)"),
+        (_app(pattern="rings", tint=[255, 0, 0]), "entities[0].appearance.tint: not used by "
+                                                  "pattern 'rings'"),
+        (_app(noise_scale=4), "entities[0].appearance.noise_scale: not used by pattern "
+                              "'solid' (it applies to pattern: perlin)"),
+        (_app(pattern="perlin", texture_sigma=5), "entities[0].appearance.texture_sigma: not "
+                                                  "used by pattern 'perlin'"),
+        (_app(source="skimage:coffee"), "entities[0].appearance.source: not used by pattern "
+                                        "'solid' (it applies to pattern: image)"),
+        (_app(pattern="image", source="skimage:coffee", colors=[[0, 255, 0]]),
+         "entities[0].appearance.colors: not used by pattern 'image' (it applies to pattern: "
+         "solid | rings | sectors | stripes | bands | checker | texture | perlin)"),
+        (mutate(["clutter"], [{"count": 1, "appearance": {"crop": [0, 0, 2, 2]}}]),
+         "clutter[0].appearance.crop: not used by pattern 'solid'"),
+        (mutate(["background"], {"kind": "uniform", "low": 10}),
+         "background.low: not used by kind 'uniform' (it applies to kind: noise | texture | "
+         "perlin)"),
+        (mutate(["background"], {"kind": "noise", "color": [9, 9, 9]}),
+         "background.color: not used by kind 'noise'"),
+        (mutate(["background"], {"kind": "texture", "fit": "tile"}),
+         "background.fit: not used by kind 'texture' (it applies to kind: image)"),
+    ],
+)  # fmt: skip
+def test_a_field_the_pattern_does_not_use_is_refused(tmp_path, capsys, data, message):
+    # It was silently ignored: a crop on a solid pattern drew the solid colour.
+    from scenegen.cli import main
+
+    with pytest.raises(ConfigError) as info:
+        from_dict(data)
+    assert str(info.value).startswith(message)
+    path = tmp_path / "c.yaml"
+    path.write_text(yaml.safe_dump(data))
+    assert main(["generate", "--config", str(path), "-o", str(tmp_path / "o.h5")]) == 2
+    err = capsys.readouterr().err
+    assert len(err.splitlines()) == 1 and message in err and not (tmp_path / "o.h5").exists()
+
+
+def test_an_unused_field_at_its_default_and_stripe_width_are_accepted():
+    # Nothing is ignored that would change the frames; the fixtures record a scaled
+    # stripe_width (and background scale) on every pattern, so they stay valid.
+    data = _app(fit="stretch", noise_scale=8.0, tint=None, texture_sigma=20, stripe_width=2)
+    data["background"] = {"kind": "noise", "color": [255, 255, 255], "fit": "crop", "scale": 2}
+    cfg = from_dict(data)
+    assert cfg.entities[0].appearance.stripe_width == 2 and cfg.background.scale == 2.0
+    assert from_dict(to_dict(cfg)) == cfg
+
+
+def test_yaml_follows_the_core_schema_of_yaml_1_2(tmp_path):
+    # YAML 1.1 (PyYAML's default) read 010 as 8, and no/yes/on/off as booleans.
+    path = tmp_path / "c.yaml"
+    path.write_text("width: 0x40\nheight: 010\nn_frames: +3\nname: no\n"
+                    "entities:\n  - {name: on, role: target, position: [1e1, 2.], depth: 0o7}\n"
+                    "clutter:\n  - {count: 0, name: 2024-01-01}\n")  # fmt: skip
+    cfg = load_config(path)
+    assert (cfg.width, cfg.height, cfg.n_frames, cfg.name) == (64, 10, 3, "no")
+    assert cfg.entities[0].name == "on" and cfg.entities[0].position == (10.0, 2.0)
+    assert cfg.entities[0].depth == ((0, 7),) and cfg.clutter[0].name == "2024-01-01"
+    # A value whose type is then wrong for its field: the field is named.
+    for text, message in (
+        ("sensor_noise: yes\nn_frames: 1", "sensor_noise: must be a number, got 'yes'"),
+        ("n_frames: 1_000", "n_frames: must be an integer, got '1_000'"),
+        ("n_frames: 1:30", "n_frames: must be an integer, got '1:30'"),
+    ):
+        path.write_text(f"width: 8\nheight: 8\n{text}\n")
+        with pytest.raises(ConfigError, match=f"^{path}: {message}$"):
+            load_config(path)
+    # A family file is read by the same loader.
+    from scenegen.datasets import load_family
+
+    fam = tmp_path / "f.yaml"
+    fam.write_text("name: no\nbase: kams-a\nseed: 010\ncount: 2\n")
+    family = load_family(fam)
+    assert (family.name, family.seed) == ("no", 10)
+
+
+def test_dump_yaml_quotes_what_either_yaml_would_misread(tmp_path):
+    from scenegen.config import dump_yaml
+
+    cfg = from_dict({**base(), "name": "1e9", "clutter": [
+        {"count": 0, "name": name} for name in ("no", "010", "0o7", "yes", "1_000", "null")]})
+    text = dump_yaml(to_dict(cfg))
+    path = tmp_path / "c.yaml"
+    path.write_text(text)
+    assert load_config(path) == cfg
+    assert yaml.safe_load(text) == to_dict(cfg)  # and by a YAML 1.1 reader
+
+
+def test_a_byte_order_mark_is_allowed_in_json_as_in_yaml(tmp_path):
+    # Notepad writes one; the JSON was refused ("Unexpected UTF-8 BOM (decode using
+    # utf-8-sig)"), the same config in YAML read.
+    for suffix, text in ((".json", json.dumps(base())), (".yaml", yaml.safe_dump(base()))):
+        path = tmp_path / f"c{suffix}"
+        path.write_bytes(b"\xef\xbb\xbf" + text.encode())
+        assert load_config(path) == from_dict(base())

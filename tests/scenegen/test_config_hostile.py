@@ -290,3 +290,56 @@ def test_a_large_document_without_aliases_reads_as_its_json_does(tmp_path):
     assert 400_000 < as_yaml.stat().st_size < 4 * 2**20
     assert load_config(as_yaml) == load_config(as_json)
     assert len(load_config(as_yaml).entities[0].depth) == 40_000
+
+
+@pytest.mark.parametrize("suffix", [".yaml", ".json"])
+def test_a_million_list_items_are_refused_up_front(tmp_path, suffix, capsys):
+    # 3 MB of "{}" items: the YAML took 90 s and 1.2 GB to compose before the first item
+    # was found wanting; now both formats stop at MAX_VALUES, in seconds.
+    from scenegen.config import MAX_VALUES
+
+    path = tmp_path / f"c{suffix}"
+    items = ",".join(["{}"] * 10**6)
+    path.write_text(f'{{"width": 40, "height": 30, "n_frames": 3, "entities": [{items}]}}')
+    start = time.perf_counter()
+    with pytest.raises(ConfigError) as err:
+        load_config(path)
+    # libyaml counts the YAML's values in a second; PyYAML alone composes 250,000 first.
+    assert time.perf_counter() - start < (20 if yaml.__with_libyaml__ else 120)
+    needle = f"more than {MAX_VALUES:,} values (lists, mappings, keys, scalars)"
+    assert str(err.value) == f"{path}: {needle}"
+    assert main(["generate", "--config", str(path), "-o", str(tmp_path / "o.h5")]) == 2
+    assert len(capsys.readouterr().err.splitlines()) == 1
+
+
+def test_the_value_limit_is_counted_while_composing_too(monkeypatch):
+    # Without libyaml the composer's own count refuses it (the fast count is a shortcut).
+    import scenegen.config as config
+
+    monkeypatch.setattr(config, "MAX_VALUES", 50)
+    monkeypatch.setattr(config, "_count_yaml_values", lambda text: None)
+    with pytest.raises(ConfigError, match="^more than 50 values"):
+        config._load_yaml("a: [" + ",".join(["1"] * 60) + "]")
+    assert config._load_yaml("a: [" + ",".join(["1"] * 40) + "]") == {"a": [1] * 40}
+
+
+def test_a_million_entities_from_python_are_refused_before_they_are_read():
+    start = time.perf_counter()
+    for field in ("entities", "clutter"):
+        with pytest.raises(ConfigError, match=rf"^{field}: at most 65535 items, got 1,000,000 "):
+            from_dict({**SMALL, field: [{"name": "a", "role": "target"}] * 10**6})
+    assert time.perf_counter() - start < 5
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [("", "config is empty (a YAML mapping of fields is expected)"),
+     ("# only a comment\n", "config is empty (a YAML mapping of fields is expected)"),
+     ("- 1\n- 2\n", "must be a mapping, got [1, 2]")],
+)  # fmt: skip
+def test_an_empty_file_or_a_list_is_one_line(tmp_path, text, message):
+    path = tmp_path / "c.yaml"
+    path.write_text(text)
+    with pytest.raises(ConfigError) as err:
+        load_config(path)
+    assert str(err.value) == f"{path}: {message}"

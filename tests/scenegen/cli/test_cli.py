@@ -91,9 +91,10 @@ def test_generate_from_yaml_config(tmp_path, capsys):
                                    "scale": {"a1": 0, "a2": -30, "sigma": 0.1,
                                              "boundary": "free"}}}]},
          "entities[0].motion.scale: the AR2 path reaches"),
+        # A free camera axis is refused outright (its view would stick at the extent).
         ({"width": 30, "height": 10, "n_frames": 50,
           "camera": {"extent": [4, 4], "x": {"a1": 1000, "sigma": 1, "boundary": "free"}}},
-         "camera.x: the AR2 path reaches"),
+         "camera.x.boundary: free is not allowed on a camera"),
         ({"width": 30, "height": 10, "n_frames": 50,
           "photometric": {"gain": {"a1": 1000, "sigma": 0.1, "boundary": "free"}}},
          "photometric.gain: the AR2 path reaches"),

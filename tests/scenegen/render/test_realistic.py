@@ -273,6 +273,22 @@ def test_camera_extent_is_bounded():
 
 
 
+@pytest.mark.parametrize("axis", ["x", "y", "zoom"])
+def test_a_free_camera_axis_is_refused(axis):
+    # The offset (zoom) was clipped to the extent (its limits) while the free path went on:
+    # a pan at 1 px a frame stuck at the extent for good, a random walk until it came back.
+    camera = {"extent": [4, 4], axis: {"boundary": "free"}, "velocity": [1, 1]}
+    data = {"width": 40, "height": 30, "n_frames": 20, "camera": camera}
+    with pytest.raises(ConfigError, match=rf"^camera\.{axis}\.boundary: free is not allowed on "
+                                          r"a camera: the view cannot go beyond"):  # fmt: skip
+        from_dict(data)
+    # Within the extent, clamp moves as free would, and stops at the extent.
+    data["camera"][axis] = {"boundary": "clamp"}
+    if axis != "zoom":
+        scn = plan(from_dict(data), 0)
+        assert (scn.cam_x if axis == "x" else scn.cam_y).tolist() == [*range(5), *[4] * 15]
+
+
 def test_scripted_pan_beyond_the_extent_is_refused():
     # It was clipped to the extent without a word: the scripted pan was not the one drawn.
     data = {"width": 40, "height": 30, "n_frames": 4,
