@@ -210,17 +210,18 @@ class AR2:
 
     ``boundary`` (required) says what happens at the frame border: ``reflect`` mirrors the
     coordinate and its previous value (so the velocity reverses) about the limit, ``clamp``
-    stops it at the limit with zero velocity, ``free`` lets the entity leave the frame.
-    The limits keep the entity's centre at least ``margin`` pixels plus half its size inside
-    the frame (for ``scale`` the limits are ``[-margin, margin]`` around the mean in log
-    units, and a margin of 0 means unbounded). An entity's ``reflect``/``clamp`` axis
-    needs 2 x margin + its size <= the frame's side, else its config is refused. The
-    limits hold from frame 1 on: a ``position`` outside them (nearer the border than
-    ``margin`` plus half the size) is taken as given at frame 0, and at frame 1
-    ``reflect`` mirrors it about the limit (a jump of twice its distance outside) and
-    ``clamp`` puts it on the limit. Such starts are allowed (an entity may enter from
-    outside the frame); give one inside ``[margin + size / 2, side - margin - size / 2]``
-    for a path without that jump.
+    stops it at the limit with zero velocity, ``free`` lets the entity leave the frame. The
+    limits keep the entity's centre at least ``margin`` pixels plus half its size inside the
+    frame (for ``scale`` the limits are ``[-margin, margin]`` around the mean in log units,
+    and a margin of 0 means no limit on the path; whatever the path, the scale an entity is
+    drawn at, and its boxes, stay within 1/20 to 20 times its size, so a ``free`` log scale
+    beyond log 20 draws and boxes it at that limit). An entity's ``reflect``/``clamp`` axis
+    needs 2 x margin + its size <= the frame's side, else its config is refused. The limits
+    hold from frame 1 on: a ``position`` outside them (nearer the border than ``margin``
+    plus half the size) is taken as given at frame 0, and at frame 1 ``reflect`` mirrors it
+    about the limit (a jump of twice its distance outside) and ``clamp`` puts it on the
+    limit. Such starts are allowed (an entity may enter from outside the frame); give one
+    inside ``[margin + size / 2, side - margin - size / 2]`` for a path without that jump.
 
     Any ``a1, a2`` is accepted, including explosive ones (roots of ``z^2 - a1 z - a2``
     outside the unit circle; ``a1 = 2, a2 = -1`` has a double root at 1, a random walk of
