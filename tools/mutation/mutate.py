@@ -167,6 +167,7 @@ MODULES: dict[str, Module] = {
          "tests/scenegen/evaluation/test_metrics_oracle.py",
          "tests/scenegen/evaluation/test_trackeval_oracle.py",
          "tests/scenegen/evaluation/test_evaluate.py"),
+        _NO_SHRINK,
     ),
     "stats": Module(
         "scenegen/lab/experiments/stats.py",
