@@ -41,6 +41,7 @@ from scenegen.sequence import Sequence
 __all__ = [
     "GT_MODES",
     "MOT_CLASS",
+    "check_number_text",
     "gt_keep",
     "gt_rows",
     "read_mot_tracker",
@@ -181,6 +182,24 @@ def read_mot_tracker(
     return ids, boxes
 
 
+_NUMBER = re.compile(
+    r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?|[+-]?(?:nan|inf|infinity)",
+    re.IGNORECASE,
+)
+
+
+def check_number_text(cell: str) -> None:
+    """Raise ValueError unless ``cell`` is a number as text files write one: ASCII digits,
+    sign, point and exponent (``nan``/``inf`` pass here, for a later, clearer refusal).
+    Python's ``int`` and ``float`` also read ``1_0`` as 10 and any script's digits
+    (``１`` fullwidth, ``١`` Arabic-Indic) as numbers, which no tool writes."""
+    if _NUMBER.fullmatch(cell):
+        return
+    if "_" in cell:
+        raise ValueError("'_' is not part of a number")
+    raise ValueError(f"{cell[:20]!r} is not a number (ASCII digits, sign, point, exponent)")
+
+
 def _integer(cell: str) -> int:
     """A frame or id cell as an exact integer: ``12``, or ``12.0`` below 2**53 (a float
     above that may stand for several integers)."""
@@ -252,8 +271,8 @@ def read_mot_tracker_rows(
         try:
             if len(cells) < 6:
                 raise ValueError("fewer than 6 comma-separated columns")
-            if any("_" in c for c in cells[:6]):  # Python's int and float read 1_0 as 10
-                raise ValueError("'_' is not part of a number")
+            for c in cells[:6]:
+                check_number_text(c)
             frame, ident = _integer(cells[0]), _integer(cells[1])
             if abs(ident) >= MAX_TRACK_ID:
                 raise ValueError(f"id beyond ±{MAX_TRACK_ID - 1}")

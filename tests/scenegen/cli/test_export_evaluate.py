@@ -330,6 +330,25 @@ def test_an_underscore_in_a_number_is_refused(tmp_path, row):
         read_mot_tracker(path, 20)
 
 
+@pytest.mark.parametrize(
+    ("row", "cell"),
+    [("\uff11,1,1,1,5,5", "\uff11"), ("1,\u0661,1,1,5,5", "\u0661"),
+     ("1,1,\u0967\u0966,1,5,5", "\u0967\u0966"), ("1,1,1,1,5,\u00b2", "\u00b2")],
+)  # fmt: skip
+def test_digits_of_other_scripts_are_refused(tmp_path, row, cell):
+    # Python's int() and float() read fullwidth, Arabic-Indic or Devanagari digits: the
+    # row was scored as frame 1, id 1, ... (no tool writes them).
+    path = tmp_path / "t.txt"
+    path.write_text(f"1,1,1,1,5,5\n{row}\n", encoding="utf-8")
+    with pytest.raises(DataError) as err:
+        read_mot_tracker(path, 20)
+    assert f"t.txt:2: not a MOTChallenge row ({cell!r} is not a number (ASCII digits, " \
+           "sign, point, exponent))" in str(err.value)  # fmt: skip
+    path.write_text("1,1,1.5e1,-.5,+5.,5E+0,-1,-1,-1,-1\n2,2,nan,1,5,5\n")
+    with pytest.raises(DataError, match=r"t.txt:2: .*a box value is not a finite number"):
+        read_mot_tracker(path, 20)  # ASCII forms still read; nan refused as before
+
+
 def test_a_byte_order_mark_and_windows_line_ends_are_read(tmp_path, capsys):
     # A file saved with a UTF-8 byte-order mark (Notepad, Excel's "CSV UTF-8", PowerShell)
     # was refused: "could not convert string to float: '\ufeff1'" on line 1.
@@ -378,8 +397,8 @@ def test_a_space_within_a_value_is_refused(tmp_path, row, cell):
     path.write_text(f"1, 1, 1, 1, 5, 5\n{row}\n")  # spaces around values are fine
     with pytest.raises(DataError) as err:
         read_mot_tracker(path, 20)
-    assert str(err.value) == (f"{path}:2: not a MOTChallenge row (could not convert string "
-                              f"to float: {cell!r}): {row!r}")  # fmt: skip
+    assert str(err.value) == (f"{path}:2: not a MOTChallenge row ({cell!r} is not a number "
+                              f"(ASCII digits, sign, point, exponent)): {row!r}")  # fmt: skip
 
 
 def test_a_visibility_threshold_in_amodal_mode_is_refused(tmp_path, capsys):
