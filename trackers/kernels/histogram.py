@@ -392,6 +392,53 @@ def _scatter_unit(hist, row, c0, c1, base, unit):
     return (c1 - c0) * unit
 
 
+# The support path of ``region_distances``' direct evaluation: a reference whose bands
+# each have at most _SMALL_SUPPORT bins with q > 0 (flat-coloured targets: 1-3 bins) needs
+# only those bins' counts and each band's total, not the whole histogram. Each row then
+# costs one vectorised pass per two support bins (the weight of the pixels of either
+# colour, and of all pixels), over the row's columns padded to a multiple of 8 with
+# zero-weight pixels (so no scalar remainder), instead of one scattered add per pixel.
+# The sums are the same integers as the scattered histogram's (integer adds in any order),
+# so both paths give the same bits; measured on dps-synthetic and dps-occlusion frames, a
+# box of a flat target about 2x faster.
+_SMALL_SUPPORT = 8
+_PAD = 8
+# A dx² no fixed-point row weight reaches (at most _ONE): padding columns weigh 0.
+_FAR = np.int64(1) << 40
+
+
+@njit(cache=True)
+def _pair_sums(kbuf, seg, ca, cb):
+    """(Σ kbuf[i], Σ kbuf[i] [seg[i] = ca], Σ kbuf[i] [seg[i] = cb]) over i < len(seg)
+    (vectorised loop; a colour of −1 matches nothing)."""
+    tot = 0
+    sa = 0
+    sb = 0
+    for i in range(seg.shape[0]):
+        k = kbuf[i]
+        v = seg[i]
+        tot += k
+        sa += k if v == ca else 0
+        sb += k if v == cb else 0
+    return tot, sa, sb
+
+
+@njit(cache=True)
+def _epanechnikov_pair_sums(tbuf, wr, seg, ca, cb):
+    """``_pair_sums`` with the Epanechnikov weights max(wr − tbuf[i], 0) computed in the
+    loop (``_epanechnikov_weights``)."""
+    tot = 0
+    sa = 0
+    sb = 0
+    for i in range(seg.shape[0]):
+        k = max(wr - tbuf[i], 0)
+        v = seg[i]
+        tot += k
+        sa += k if v == ca else 0
+        sb += k if v == cb else 0
+    return tot, sa, sb
+
+
 @njit(cache=True)
 def _level_rects(x, y, w, h, fracs, rows, cols, rects):
     """rects[l] = (r0, r1, c0, c1): the pixels of rectangle l of the box kernel (the box
@@ -527,6 +574,101 @@ def _accumulate(bin_img, x, y, w, h, n_bins, kernel, n_parts, hist, lanes, total
 
 
 @njit(cache=True)
+def _accumulate_support(bin_img, x, y, w, h, kernel, n_parts, colours, nz_start, sums,
+                        totals, tbuf, kbuf, fracs, a_fixed, rects):
+    """As ``_accumulate``, but only the weights of the support colours: band j's support
+    bins t in [nz_start[j], nz_start[j + 1]) (colour ``colours[t]`` of the band) get their
+    fixed-point weight in ``sums[t]``, each band its total in ``totals[j]`` (the support
+    path, see ``_SMALL_SUPPORT``). ``tbuf`` and ``kbuf`` (W + 2 + _PAD,) are scratch."""
+    rows, cols = bin_img.shape
+    r0, r1 = _pixel_range(y, h, rows)
+    c0, c1 = _pixel_range(x, w, cols)
+    for j in range(n_parts):
+        totals[j] = 0
+    for t in range(nz_start[n_parts]):
+        sums[t] = 0
+    if r0 >= r1 or c0 >= c1:
+        return
+    n = c1 - c0
+    # Columns [s0, s0 + m) hold [c0, c1) and m is a multiple of _PAD (when the frame is that
+    # wide); the added columns weigh 0.
+    m = (n + _PAD - 1) // _PAD * _PAD
+    if m <= cols:
+        s0 = min(c0, cols - m)
+    else:
+        s0 = c0
+        m = n
+    off = c0 - s0
+    cx = x + 0.5 * w
+    cy = y + 0.5 * h
+    inv_hw = 2.0 / w
+    inv_hh = 2.0 / h
+    band = h / n_parts
+    fused = kernel == KERNEL_EPANECHNIKOV
+    if fused:
+        for i in range(m):
+            tbuf[i] = _FAR
+        for c in range(c0, c1):
+            dx = (c + 0.5 - cx) * inv_hw
+            tbuf[c - s0] = np.int64(dx * dx * _ONE + 0.5)
+    else:
+        for i in range(m):
+            kbuf[i] = 0
+        if kernel == KERNEL_UNIFORM:
+            unit = np.int64(_ONE)
+            for i in range(off, off + n):
+                kbuf[i] = unit
+        elif kernel == KERNEL_BOX:
+            _level_rects(x, y, w, h, fracs, rows, cols, rects)
+    kcols = kbuf[off:]
+    wr = np.int64(0)
+    change = r0
+    for r in range(r0, r1):
+        py = r + 0.5
+        part = int((py - y) / band)
+        if part >= n_parts:
+            part = n_parts - 1
+        if kernel == KERNEL_BOX:
+            if r >= change:
+                _box_row_weights(kcols, n, c0, r, rects, a_fixed)
+                change = _next_change(rects, r, r1)
+        elif kernel != KERNEL_UNIFORM:
+            dy = (py - cy) * inv_hh
+            dy2 = dy * dy
+            if dy2 >= 1.0:
+                continue
+            if fused:
+                wr = np.int64((1.0 - dy2) * _ONE + 0.5)
+            else:
+                _cone_weights(kcols, c0, c1, cx, inv_hw, dy2)
+        seg = bin_img[r, s0:s0 + m]
+        # One pass per two support colours (−1 matches nothing); the first also totals.
+        ta = nz_start[part]
+        tb = nz_start[part + 1]
+        ca = colours[ta] if ta < tb else -1
+        cb = colours[ta + 1] if ta + 1 < tb else -1
+        if fused:
+            row_tot, sa, sb = _epanechnikov_pair_sums(tbuf, wr, seg, ca, cb)
+        else:
+            row_tot, sa, sb = _pair_sums(kbuf, seg, ca, cb)
+        totals[part] += row_tot
+        if ta < tb:
+            sums[ta] += sa
+        if ta + 1 < tb:
+            sums[ta + 1] += sb
+        for t in range(ta + 2, tb, 2):
+            ca = colours[t]
+            cb = colours[t + 1] if t + 1 < tb else -1
+            if fused:
+                row_tot, sa, sb = _epanechnikov_pair_sums(tbuf, wr, seg, ca, cb)
+            else:
+                row_tot, sa, sb = _pair_sums(kbuf, seg, ca, cb)
+            sums[t] += sa
+            if t + 1 < tb:
+                sums[t + 1] += sb
+
+
+@njit(cache=True)
 def _region_histograms(bin_img, boxes, n_bins, kernel, n_parts, lanes, fracs, a_fixed):
     n_boxes = boxes.shape[0]
     dim = n_parts * n_bins
@@ -570,22 +712,46 @@ def _band_rho(hist, dim, lanes, sqrt_q, nz, i0, i1, scale):
 
 
 @njit(cache=True)
+def _sums_rho(sums, sqrt_q, nz, i0, i1, scale):
+    """``_band_rho`` of the support path: the counts of support bins i0 … i1 − 1 are
+    ``sums[i0:i1]``."""
+    acc = 0.0
+    for i in range(i0, i1):
+        acc += np.sqrt(sums[i] * scale) * sqrt_q[nz[i]]
+    return acc
+
+
+@njit(cache=True)
 def _direct_distance(bin_img, box, sqrt_q, nz, nz_start, empty_rho, n_bins, kernel,
-                     n_parts, hist, lanes, totals, tbuf, kbuf, fracs, a_fixed, rects):
-    """Bhattacharyya distance of one box to one reference by accumulating its pixels."""
+                     n_parts, hist, lanes, totals, tbuf, kbuf, fracs, a_fixed, rects,
+                     colours, sums, small):
+    """Bhattacharyya distance of one box to one reference by accumulating its pixels:
+    the whole histogram, or (``small``) only the reference's support bins, whose band
+    colours are ``colours`` (the support path, ``_SMALL_SUPPORT``). Both give the same
+    bits: the same fixed-point counts, read in the same order."""
     dim = n_parts * n_bins
-    _accumulate(bin_img, box[0], box[1], box[2], box[3], n_bins, kernel, n_parts, hist,
-                lanes, totals, tbuf, kbuf, fracs, a_fixed, rects)
+    if small:
+        _accumulate_support(bin_img, box[0], box[1], box[2], box[3], kernel, n_parts,
+                            colours, nz_start, sums, totals, tbuf, kbuf, fracs, a_fixed,
+                            rects)
+    else:
+        _accumulate(bin_img, box[0], box[1], box[2], box[3], n_bins, kernel, n_parts, hist,
+                    lanes, totals, tbuf, kbuf, fracs, a_fixed, rects)
     rho = 0.0
     for j in range(n_parts):
         if totals[j] > 0:
             # Bins where the reference is 0 add nothing: only its support is read.
-            rho += _band_rho(hist, dim, lanes, sqrt_q, nz, nz_start[j], nz_start[j + 1],
-                             1.0 / (totals[j] * n_parts))
+            scale = 1.0 / (totals[j] * n_parts)
+            if small:
+                rho += _sums_rho(sums, sqrt_q, nz, nz_start[j], nz_start[j + 1], scale)
+            else:
+                rho += _band_rho(hist, dim, lanes, sqrt_q, nz, nz_start[j], nz_start[j + 1],
+                                 scale)
         else:
             # Uniform band (module docstring).
             rho += empty_rho[j]
-    hist[:] = 0
+    if not small:
+        hist[:] = 0
     one_minus = 1.0 - rho
     return np.sqrt(one_minus) if one_minus > 0.0 else 0.0
 
@@ -864,11 +1030,14 @@ def _integral_group(bin_img, boxes, members, sqrt_refs, nz, nz_start, empty_rho,
 
 @njit(cache=True, parallel=True)
 def _region_distances(bin_img, boxes, sqrt_refs, ref_index, nz, nz_start, empty_rho,
-                      n_bins, kernel, n_parts, lanes, method, fracs, a_fixed, n_chunks):
+                      n_bins, kernel, n_parts, lanes, method, fracs, a_fixed, n_chunks,
+                      max_support):
     """Distances of every box to its reference, in parallel over references (integral
     path) and over chunks of boxes (direct path). Every box is computed alone from zeroed
     scratch, with sums in a fixed order, so the result does not depend on the number of
-    threads or on how the boxes are chunked."""
+    threads or on how the boxes are chunked. The direct path of a reference with at most
+    ``max_support`` support bins in every band counts only those (``_SMALL_SUPPORT``; the
+    same bits as the whole histogram)."""
     n_boxes = boxes.shape[0]
     cols = bin_img.shape[1]
     out = np.empty(n_boxes)
@@ -886,20 +1055,33 @@ def _region_distances(bin_img, boxes, sqrt_refs, ref_index, nz, nz_start, empty_
                 for m in members:
                     direct[m] = False
     dim = n_parts * n_bins
+    # Per reference: its support bins' colours within their band, and whether every band
+    # has few enough of them for the support path (``_SMALL_SUPPORT``).
+    n_refs = nz.shape[0]
+    colours = np.empty_like(nz)
+    small = np.empty(n_refs, dtype=np.bool_)
+    for q in range(n_refs):
+        small[q] = True
+        for j in range(n_parts):
+            if nz_start[q, j + 1] - nz_start[q, j] > max_support:
+                small[q] = False
+            for t in range(nz_start[q, j], nz_start[q, j + 1]):
+                colours[q, t] = nz[q, t] - j * n_bins
     n_chunks = max(min(n_chunks, n_boxes), 1)
     for ch in prange(n_chunks):
         hist = np.zeros(lanes * dim, dtype=np.int64)
         totals = np.empty(n_parts, dtype=np.int64)
-        tbuf = np.empty(cols + 2, dtype=np.int64)
-        kbuf = np.empty(cols + 2, dtype=np.int64)
+        tbuf = np.empty(cols + 2 + _PAD, dtype=np.int64)
+        kbuf = np.empty(cols + 2 + _PAD, dtype=np.int64)
         rects = np.empty((n_levels, 4), dtype=np.int64)
+        sums = np.empty(dim, dtype=np.int64)
         for p in range(ch * n_boxes // n_chunks, (ch + 1) * n_boxes // n_chunks):
             if direct[p]:
                 ref = ref_index[p]
                 out[p] = _direct_distance(bin_img, boxes[p], sqrt_refs[ref], nz[ref],
                                           nz_start[ref], empty_rho[ref], n_bins, kernel,
                                           n_parts, hist, lanes, totals, tbuf, kbuf, fracs,
-                                          a_fixed, rects)
+                                          a_fixed, rects, colours[ref], sums, small[ref])
     return out
 
 
@@ -1022,7 +1204,9 @@ def region_distances(
 
     - *direct*: each box's pixels are accumulated into one reused scratch histogram, and
       only the bins where the reference is positive are read back (the others add
-      nothing to Σ sqrt(p q)); cost ∝ the boxes' total area.
+      nothing to Σ sqrt(p q)); for a reference with few such bins in every band, only
+      their counts are accumulated (the same integers, so the same bits); cost ∝ the
+      boxes' total area.
     - *integral* (uniform and box kernels): per reference, the integral histogram
       (Porikli 2005) of the reference's support bins over the union of its boxes; each
       box then costs four reads per support bin (per level, for the box kernel) whatever
@@ -1184,7 +1368,8 @@ def prepared_distances(
     return _region_distances(bin_img, bx, prepared.sqrt_refs, idx, prepared.nz,
                              prepared.nz_start, prepared.empty_rho, prepared.n_bins,
                              int(kernel), prepared.n_parts, _lanes(prepared.refs.shape[1]),
-                             METHODS[method], fracs, a_fixed, numba.get_num_threads())
+                             METHODS[method], fracs, a_fixed, numba.get_num_threads(),
+                             _SMALL_SUPPORT)
 
 
 

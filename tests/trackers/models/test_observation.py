@@ -8,9 +8,14 @@ from hypothesis import strategies as st
 from skimage.color import rgb2hsv
 
 from trackers.kernels.histogram import (
+    KERNEL_BOX,
     KERNEL_CONE,
     KERNEL_EPANECHNIKOV,
     KERNEL_UNIFORM,
+    METHODS,
+    _lanes,
+    _level_args,
+    _region_distances,
     bhattacharyya_distance,
     hsv_n_bins,
     prepare_references,
@@ -377,3 +382,54 @@ def test_a_saturation_of_exactly_s_min_is_coloured():
     px3 = np.array([[[100, 70, 70], [250, 176, 176]]], np.uint8)  # S = 3/10, 74/250
     q = quantize_hsv(px3, s_min=0.3).tolist()[0]
     assert q[0] < 100 and q[1] >= 100
+
+
+@settings(max_examples=60)
+@given(seed=st.integers(0, 2**32 - 1), width=st.integers(1, 70), n_parts=st.integers(1, 3),
+       kernel=st.sampled_from([*KERNELS, KERNEL_BOX]))
+def test_support_path_is_bit_identical_to_the_whole_histogram(seed, width, n_parts, kernel):
+    """The trackers' bin images (int32); other integer types in the slow suite (each
+    costs numba a compilation of the kernel, about 40 s on a cold cache)."""
+    _check_support_path(seed, width, n_parts, kernel, np.int32)
+
+
+@pytest.mark.slow
+@settings(max_examples=60)
+@given(seed=st.integers(0, 2**32 - 1), width=st.integers(1, 70), n_parts=st.integers(1, 3),
+       kernel=st.sampled_from([*KERNELS, KERNEL_BOX]),
+       dtype=st.sampled_from([np.uint8, np.uint16]))
+def test_support_path_is_bit_identical_for_other_bin_image_types(seed, width, n_parts, kernel,
+                                                                 dtype):
+    _check_support_path(seed, width, n_parts, kernel, dtype)
+
+
+def _check_support_path(seed, width, n_parts, kernel, dtype):
+    """References with few support bins per band are scored from those bins' counts alone
+    (``_SMALL_SUPPORT``): the same bits as from the whole scattered histogram, for 0 to 10
+    support bins in a band, boxes cut by every border and frames narrower than the
+    padding."""
+    rng = np.random.default_rng(seed)
+    n_bins, height, n_refs = 12, 23, 11
+    coarse = rng.integers(0, n_bins, (height // 3 + 1, width // 3 + 1))
+    bin_img = np.ascontiguousarray(np.kron(coarse, np.ones((3, 3), dtype=np.int64))
+                                   [:height, :width], dtype=dtype)
+    refs = rng.random((n_refs, n_parts * n_bins))
+    for r in range(n_refs):  # reference r has r - 1 support bins per band (all for r = 0)
+        for j in range(n_parts):
+            if r:
+                refs[r, j * n_bins + rng.permutation(n_bins)[r - 1:]] = 0.0
+    refs[:, 0] += (refs.sum(axis=1) == 0)  # r = 1: no support at all but one bin
+    refs /= refs.sum(axis=1, keepdims=True)
+    boxes = np.column_stack([rng.uniform(-12, width + 2, 150), rng.uniform(-12, height + 2, 150),
+                             rng.uniform(0.3, 40, 150), rng.uniform(0.3, 30, 150)])
+    index = rng.integers(0, n_refs, 150)
+    prepared = prepare_references(refs, n_parts)
+    fracs, a_fixed = _level_args(kernel, 3)
+    args = (bin_img, boxes, prepared.sqrt_refs, index, prepared.nz, prepared.nz_start,
+            prepared.empty_rho, n_bins, kernel, n_parts, _lanes(n_parts * n_bins),
+            METHODS["direct"], fracs, a_fixed, 1)
+    whole = _region_distances(*args, -1)
+    support = _region_distances(*args, n_bins)
+    np.testing.assert_array_equal(support, whole)
+    np.testing.assert_array_equal(
+        region_distances(bin_img, boxes, refs, index, kernel, n_parts, method="direct"), whole)
