@@ -1,9 +1,11 @@
-"""The ``evaluate`` verb: score a tracker result (scenegen .h5 or MOTChallenge .txt)."""
+"""The ``evaluate`` verb: score a tracker result (scenegen .h5, MOTChallenge .txt, or a
+single-object OTB / GOT-10k result with ``--format``)."""
 
 from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import Any
 
 from scenegen.cli.options import picked_by
 
@@ -13,12 +15,30 @@ __all__ = ["cmd_evaluate", "register"]
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "evaluate",
-        help="score a tracker result (.h5 or MOTChallenge .txt) against the ground truth",
+        help="score a tracker result (.h5, MOTChallenge .txt, or an OTB / GOT-10k "
+        "single-object .txt) against the ground truth",
     )
     p.add_argument("file", help="scenegen .h5 file holding the sequence")
     p.add_argument(
         "result",
-        help="result .h5 file written by `scenegen track`, or a MOTChallenge tracker .txt file",
+        help="result .h5 file written by `scenegen track`, or a text result file: a "
+        "MOTChallenge tracker file (default) or, with --format otb|got10k, a single-object one",
+    )
+    p.add_argument(
+        "--format",
+        choices=["mot", "otb", "got10k"],
+        default=None,
+        help="how to read a text result: mot (MOTChallenge tracker file, the default); otb "
+        "or got10k: one x,y,w,h line per frame for one target, 1-based (otb) or 0-based "
+        "(got10k), 0,0,0,0 or NaN for no box (what `export --format otb|got10k` writes)",
+    )
+    p.add_argument(
+        "--target",
+        type=int,
+        default=None,
+        metavar="ID",
+        help="--format otb|got10k: entity id of the target the result follows (default: "
+        "the sequence's only target present at frame 0)",
     )
     p.add_argument("--sequence", default=None, help="sequence name if the file holds several")
     p.add_argument("--tracker", default=None, help="tracker name if the result holds several")
@@ -60,6 +80,24 @@ def _is_hdf5(path: Path) -> bool:
         return False
 
 
+def _read_mot(path: Path, n_frames: int) -> tuple[Any, Any, Any]:
+    """:func:`scenegen.io.mot.read_mot_tracker_rows`; a first line of 4 values (an OTB or
+    GOT-10k result read as a MOTChallenge file) gets a hint to use ``--format``."""
+    from scenegen.errors import DataError
+    from scenegen.io.benchmarks import first_box_values
+    from scenegen.io.mot import read_mot_tracker_rows
+
+    try:
+        return read_mot_tracker_rows(path, n_frames)
+    except DataError as err:
+        if ":1: " not in str(err) or first_box_values(path) != 4:
+            raise
+        raise DataError(
+            f"{err}; a single-object result (x,y,w,h per frame)? read it with --format otb "
+            "(1-based) or got10k (0-based)"
+        ) from None
+
+
 def cmd_evaluate(args: argparse.Namespace) -> int:
     """Print the metrics of ``args.result`` on ``args.file``; 0 on success.
 
@@ -69,17 +107,20 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
         If either file is invalid, or the result does not fit the sequence (frame count,
         target count or ids), naming the mismatch and the files.
     ConfigError
-        If ``--tracker`` is given with a MOTChallenge tracker file (it would be ignored).
+        If ``--tracker`` is given with a text result file, ``--target`` with anything but
+        ``--format otb|got10k`` (either would be ignored), ``--format`` with an HDF5
+        result, or ``--target`` is missing or not a target present at frame 0.
     """
     from scenegen.errors import ConfigError, DataError
     from scenegen.evaluation.evaluate import (
         check_options,
         evaluate,
+        evaluate_target,
         evaluate_tracks,
         format_table,
+        pick_target,
     )
     from scenegen.io import read, read_result
-    from scenegen.io.mot import read_mot_tracker_rows
     from scenegen.io.validate import require_valid
 
     require_valid(args.file)  # no computing on a damaged or inconsistent file
@@ -92,16 +133,33 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
         "otb_average": args.otb_average,
     }
     result = Path(args.result)
+    fmt = args.format
+    if args.target is not None and fmt not in ("otb", "got10k"):  # it would be ignored
+        raise ConfigError(
+            "--target applies to a single-object result (--format otb or got10k); leave it out"
+        )
     if not _is_hdf5(result):
-        if args.tracker is not None:  # it would be ignored: a tracker file holds one tracker
-            raise ConfigError(
-                f"--tracker does not apply to a MOTChallenge tracker file ({result}); leave "
-                "it out"
-            )
-        ids, boxes, rank = read_mot_tracker_rows(result, seq.n_frames)
-        report = evaluate_tracks(seq, boxes, ids, tracker=result.stem, rank=rank, **options)
+        what = {"otb": "an OTB result file", "got10k": "a GOT-10k result file"}.get(
+            fmt or "mot", "a MOTChallenge tracker file"
+        )
+        if args.tracker is not None:  # it would be ignored: a text file holds one tracker
+            raise ConfigError(f"--tracker does not apply to {what} ({result}); leave it out")
+        if fmt in ("otb", "got10k"):
+            from scenegen.io.benchmarks import read_benchmark_result
+
+            target = pick_target(seq, args.target, "--target")
+            boxes = read_benchmark_result(result, seq.n_frames, fmt)
+            report = evaluate_target(seq, boxes, target, tracker=result.stem, **options)
+        else:
+            ids, tracks, rank = _read_mot(result, seq.n_frames)
+            report = evaluate_tracks(seq, tracks, ids, tracker=result.stem, rank=rank, **options)
         print(report.to_json() if args.json else format_table(report))
         return 0
+    if fmt is not None:
+        raise ConfigError(
+            f"--format {fmt} reads a text result file, but {result} is an HDF5 result "
+            "file; leave --format out"
+        )
     require_valid(result)
     with picked_by("--tracker"):
         res = read_result(result, args.tracker)

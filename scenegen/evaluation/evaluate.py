@@ -2,7 +2,8 @@
 
 :func:`evaluate` scores a scenegen result (boxes of shape (T, M, 4) for given target ids);
 :func:`evaluate_tracks` scores any tracks (e.g. read from a MOTChallenge tracker file),
-pairing each target with a track. Both return a typed
+pairing each target with a track; :func:`evaluate_target` scores a single-object
+tracker's boxes (T, 4) for one target (an OTB or GOT-10k result file). All return a typed
 :class:`~scenegen.evaluation.report.SequenceReport` (per target and overall);
 :func:`format_table` renders it for a terminal and :func:`to_json` as one JSON document.
 A result that does not fit its sequence raises :class:`~scenegen.errors.DataError` naming
@@ -58,10 +59,12 @@ __all__ = [
     "SequenceReport",
     "TargetScores",
     "evaluate",
+    "evaluate_target",
     "evaluate_tracks",
     "failure_threshold",
     "format_table",
     "frame_measures",
+    "pick_target",
     "to_json",
 ]
 
@@ -270,6 +273,124 @@ def evaluate(
     return replace(report, overall=replace(report.overall, depth_order_accuracy=acc))
 
 
+def pick_target(sequence: Any, target_id: int | None = None, option: str = "target_id") -> int:
+    """The entity id of the target a single-object result follows.
+
+    Parameters
+    ----------
+    sequence : scenegen.Sequence
+    target_id : int, optional
+        The target's entity id; it must be a target present at frame 0 (where a
+        single-object tracker is started). Default: the only such target.
+    option : str
+        How the caller names ``target_id`` in messages (``"--target"`` on the command line).
+
+    Returns
+    -------
+    int
+
+    Raises
+    ------
+    ConfigError
+        If ``target_id`` is not a target present at frame 0, or it is None and several
+        targets are, naming them.
+    DataError
+        If no target is present at frame 0.
+    """
+    idx = np.asarray(sequence.target_indices())
+    idx = idx[np.asarray(sequence.gt.present)[0, idx]]
+    ids = [int(i) for i in np.asarray(sequence.entities.id)[idx]]
+    name = str(getattr(sequence, "name", ""))
+    listed = ", ".join(str(i) for i in ids)
+    if not ids:
+        raise DataError(f"sequence {name!r} has no target present at frame 0")
+    if target_id is None:
+        if len(ids) > 1:
+            raise ConfigError(
+                f"sequence {name!r} has {len(ids)} targets present at frame 0 (ids {listed}): "
+                f"choose the one the result follows with {option}"
+            )
+        return ids[0]
+    if target_id not in ids:
+        raise ConfigError(
+            f"{option} {target_id} is not a target present at frame 0 of sequence {name!r}, "
+            f"where a single-object tracker starts (ids {listed})"
+        )
+    return int(target_id)
+
+
+def evaluate_target(
+    sequence: Any,
+    boxes: ArrayLike,
+    target_id: int | None = None,
+    *,
+    tracker: str = "",
+    recover_frames: int = DEFAULT_RECOVER_FRAMES,
+    persist: int = 10,
+    iou_threshold: float = 0.5,
+    gt_mode: str = "amodal",
+    visibility_threshold: float = 0.0,
+    otb_average: str = "sequence",
+) -> SequenceReport:
+    """Scores of a single-object tracker's boxes for one target (an OTB or GOT-10k result).
+
+    The sequence is scored as the single-object exports see it, with that target alone:
+    the report has its row, and the overall row (CLEAR MOT, IDF1 and HOTA too) covers
+    that target only. On a sequence with one target present at frame 0 this is
+    :func:`evaluate` of ``boxes[:, None]`` for that target; with several, the target's
+    row is the one :func:`evaluate` gives it in a result holding every target (in
+    ``gt_mode`` "visible" a box is dropped when matched to a distractor, here against
+    this one track).
+
+    Parameters
+    ----------
+    sequence : scenegen.Sequence
+    boxes : array_like of shape (T, 4)
+        The tracker's box per frame (NaN rows where it has none), in scenegen's 0-based
+        pixels (:func:`scenegen.io.benchmarks.read_benchmark_result`).
+    target_id : int, optional
+        The entity id of the target followed (:func:`pick_target`: a target present at
+        frame 0; default the only one).
+    tracker, recover_frames, persist, iou_threshold, gt_mode, visibility_threshold, otb_average
+        As in :func:`evaluate`.
+
+    Returns
+    -------
+    SequenceReport
+        One row, for the target.
+
+    Raises
+    ------
+    DataError
+        If the frame count differs from the sequence's, or a box row is neither a box
+        (finite, w, h >= 0) nor all NaN.
+    ConfigError
+        If an option is out of range, or ``target_id`` as :func:`pick_target` says.
+
+    Example
+    -------
+    >>> boxes = read_benchmark_result("otb.txt", seq.n_frames, "otb")  # doctest: +SKIP
+    >>> print(format_table(evaluate_target(seq, boxes, 1)))            # doctest: +SKIP
+    """
+    check_options(gt_mode, visibility_threshold, otb_average, iou_threshold)
+    est = np.asarray(boxes, dtype=np.float64)
+    name = str(getattr(sequence, "name", ""))
+    t_n = int(np.asarray(sequence.gt.box).shape[0])
+    if est.ndim != 2 or est.shape[1] != 4:
+        raise DataError(f"single-object boxes must have shape (T, 4), got {est.shape}")
+    if est.shape[0] != t_n:
+        raise DataError(f"result has {est.shape[0]} frames but sequence {name!r} has {t_n} frames")
+    _check_boxes(est[:, None], "result boxes")
+    ident = pick_target(sequence, target_id)
+    k = int(np.flatnonzero(np.asarray(sequence.entities.id).astype(np.int64) == ident)[0])
+    return _report(
+        sequence, est[:, None], np.array([ident], dtype=np.int64), [k], [0], tracker=tracker,
+        recover_frames=recover_frames, persist=persist, iou_threshold=iou_threshold,
+        gt_mode=gt_mode, visibility_threshold=visibility_threshold, otb_average=otb_average,
+        rank=None, mot_rows=[k],
+    )  # fmt: skip
+
+
 def _sequence_frame(index: int, scored: NDArray[np.bool_]) -> int:
     """The sequence frame of the ``index``-th scored frame (``scored`` (T,)); -1 stays."""
     return int(np.flatnonzero(scored)[index]) if index >= 0 else -1
@@ -407,11 +528,12 @@ def _report(
     sequence: Any, est: NDArray[np.float64], track_ids: NDArray[np.int64], rows: list[int],
     pair: list[int] | None, *, tracker: str, recover_frames: int, persist: int,
     iou_threshold: float, gt_mode: str, visibility_threshold: float, otb_average: str,
-    rank: ArrayLike | None,
+    rank: ArrayLike | None, mot_rows: list[int] | None = None,
 ) -> SequenceReport:  # fmt: skip
     """The report of tracks ``est`` (T, H, 4); row ``rows[m]`` (entity index) pairs ``pair[m]``
     (None: paired by :func:`_pair_tracks` on the scored ground truth and tracks, those of
-    ``gt_mode``); ``rank`` (T, H) or None as in :func:`evaluate_tracks`."""
+    ``gt_mode``); ``rank`` (T, H) or None as in :func:`evaluate_tracks`; the overall
+    multi-object scores cover the entities ``mot_rows`` (None: every target)."""
     gt_box = np.asarray(sequence.gt.box, dtype=np.float64)
     present = np.asarray(sequence.gt.present, dtype=bool)
     keep = present.copy()
@@ -431,8 +553,8 @@ def _report(
     if pair is None:
         pair = _pair_tracks(gt_all[:, rows], est_scored, entity_ids[rows], track_ids,
                             iou_threshold)  # fmt: skip
-    # Multi-object scores over every target of the sequence.
-    targets_all = np.flatnonzero(roles == "target")
+    # Multi-object scores over every target of the sequence (evaluate_target: its own).
+    targets_all = np.flatnonzero(roles == "target") if mot_rows is None else np.array(mot_rows)
     overall_mot = MotSummary.from_scores(
         score_all(mot_frames(gt_all[:, targets_all], est_scored, est_rank=rank),
                   threshold=iou_threshold)

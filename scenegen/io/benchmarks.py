@@ -28,25 +28,49 @@ VOT (Kristan et al., the ``vot`` toolkit; short-term rectangle format)
     visible"), per-frame tags ``occlusion.tag`` (1 where less than the whole target is
     visible, absent frames included) and ``sequence`` metadata (``channels.color``,
     ``fps``, ``format``, ``name``).
+
+A single-object tracker's result in the OTB or GOT-10k convention (one ``x,y,w,h`` line
+per frame, what OpenCV, pysot and got10k trackers write) is read by
+:func:`read_benchmark_result`, the inverse of the annotation export: the export's
+``groundtruth_rect.txt`` (or ``groundtruth.txt``) read as a result gives back the
+amodal boxes, with no box where the target is out of the scene.
 """
 
 from __future__ import annotations
 
+import math
 import os
 import re
 from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import NDArray
 
-from scenegen.errors import ConfigError
+from scenegen.errors import ConfigError, DataError
+from scenegen.io.atomic import describe_special_file
 from scenegen.io.export import encode_frame, write_folder
+from scenegen.io.mot import MAX_TRACKER_FILE_BYTES, check_number_text
 from scenegen.sequence import Sequence
 
-__all__ = ["BENCHMARKS", "cover_level", "export_benchmark"]
+__all__ = [
+    "BENCHMARKS",
+    "RESULT_KINDS",
+    "cover_level",
+    "export_benchmark",
+    "first_box_values",
+    "read_benchmark_result",
+]
 
 BENCHMARKS = ("otb", "got10k", "vot")
 _DEFAULT_IMAGE = {"otb": "jpg", "got10k": "jpg", "vot": "png"}
+#: Pixel coordinate of the top-left pixel in each layout's boxes (OTB's toolkit is MATLAB).
+_ORIGIN = {"otb": 1.0, "got10k": 0.0, "vot": 0.0}
+_LABEL = {"otb": "OTB", "got10k": "GOT-10k", "vot": "VOT"}
+
+RESULT_KINDS = ("otb", "got10k")
+"""Single-object result files :func:`read_benchmark_result` reads (VOT's result files
+mark initialisations and failures with codes, a different format)."""
 
 
 #: Lower edges of GOT-10k's cover levels 2..7 (level 1 is (0, 15 %), 8 is fully visible),
@@ -82,13 +106,14 @@ def _annotations(kind: str, seq: Sequence, k: int, fps: int, ext: str) -> dict[s
     box = np.asarray(seq.gt.box[:, k], dtype=np.float64)
     present = np.asarray(seq.gt.present[:, k], dtype=bool)
     vis = np.asarray(seq.gt.visibility[:, k], dtype=np.float64)
+    off = _ORIGIN[kind]
     lines = []
     for t in range(seq.n_frames):
         x, y, w, h = box[t]
         if not present[t]:
             lines.append("nan,nan,nan,nan" if kind == "vot" else "0,0,0,0")
-        elif kind == "otb":
-            lines.append(f"{_num(x + 1)},{_num(y + 1)},{_num(w)},{_num(h)}")
+        elif off:
+            lines.append(f"{_num(x + off)},{_num(y + off)},{_num(w)},{_num(h)}")
         else:
             lines.append(f"{_num(x)},{_num(y)},{_num(w)},{_num(h)}")
     name = "groundtruth_rect.txt" if kind == "otb" else "groundtruth.txt"
@@ -209,3 +234,128 @@ def export_benchmark(
 
     write_folder(out, fill)
     return names
+
+
+#: One value separator: a comma (spaces around it allowed), or a run of tabs and spaces.
+_SEPARATOR = re.compile(r"[ \t]*,[ \t]*|[ \t]+")
+
+
+def _box_line(line: str) -> tuple[float, float, float, float] | None:
+    """The box ``x, y, w, h`` of one result line, None for no box (``0,0,0,0`` or four
+    NaN); ValueError saying what is wrong otherwise."""
+    cells = _SEPARATOR.split(line.strip())
+    if len(cells) != 4:
+        raise ValueError(
+            f"{len(cells)} values; a line is x, y, w, h separated by commas, tabs or spaces"
+        )
+    for c in cells:  # as MOT files: ASCII digits, sign, point and exponent only
+        check_number_text(c)
+    x, y, w, h = (float(c) for c in cells)
+    if all(math.isnan(v) for v in (x, y, w, h)):
+        return None
+    if not all(math.isfinite(v) for v in (x, y, w, h)):
+        raise ValueError("a box value is not a finite number (four NaN: no box)")
+    if not (math.isfinite(x + w) and math.isfinite(y + h)):
+        raise ValueError("the box's right or bottom edge overflows to infinity")
+    if w < 0 or h < 0:
+        raise ValueError("width and height must not be negative")
+    if x == y == w == h == 0:
+        return None
+    return x, y, w, h
+
+
+def first_box_values(path: str | Path) -> int | None:
+    """How many values the first line of a text file holds, split as
+    :func:`read_benchmark_result` splits a line (4 for an OTB or GOT-10k result); None
+    if the file cannot be read as text. Reads at most the first 4 kB."""
+    if describe_special_file(path) is not None:  # a FIFO would wait for a writer
+        return None
+    try:
+        with open(path, encoding="utf-8-sig", errors="strict") as f:
+            first = f.read(4096).splitlines()
+    except (OSError, UnicodeDecodeError, ValueError):
+        return None
+    return len(_SEPARATOR.split(first[0].strip())) if first and first[0].strip() else None
+
+
+def read_benchmark_result(
+    path: str | Path, n_frames: int, kind: str = "otb"
+) -> NDArray[np.float64]:
+    """Read a single-object tracker's result file in the OTB or GOT-10k convention.
+
+    The inverse of the annotation files :func:`export_benchmark` writes: one line per
+    frame of the sequence, the first for frame 0 (the initial box), each ``x, y, w, h``
+    with its values separated by commas, tabs or spaces. OTB boxes are 1-based (``x + 1,
+    y + 1``; the result of a tracker started on ``groundtruth_rect.txt``), GOT-10k boxes
+    0-based. A line ``0,0,0,0`` (what the export writes where the target is out of the
+    scene) or ``nan,nan,nan,nan`` (what got10k's ``np.savetxt`` writes for a missing box)
+    is no box: it is scored as a lost target (IoU 0, centre error infinite), not as a
+    box at the corner. Blank lines at the end are ignored; a byte-order mark and any line
+    ending are allowed.
+
+    Parameters
+    ----------
+    path : str or Path
+    n_frames : int
+        Frames of the sequence the result was made on: the file must have this many lines.
+    kind : {"otb", "got10k"}
+        The convention (:data:`RESULT_KINDS`).
+
+    Returns
+    -------
+    ndarray of shape (n_frames, 4)
+        Boxes ``[x, y, w, h]`` in scenegen's 0-based pixels, NaN rows where there is no box.
+
+    Raises
+    ------
+    DataError
+        Naming the file and line of a malformed line (not 4 values, a value that is not
+        a number in ASCII (:func:`scenegen.io.mot.check_number_text`), a NaN or infinite
+        value in a box, an edge that
+        overflows, a negative width or height, an empty line before the last box); naming
+        the file and both counts if it has not ``n_frames`` lines; a file that is not
+        UTF-8 text or not a regular file.
+    ConfigError
+        For a ``kind`` not in :data:`RESULT_KINDS`.
+
+    Example
+    -------
+    >>> boxes = read_benchmark_result("out/crossing_target/groundtruth_rect.txt",
+    ...                               seq.n_frames)  # doctest: +SKIP
+    """
+    if kind not in RESULT_KINDS:
+        raise ConfigError(f"result kind must be one of {', '.join(RESULT_KINDS)}; got {kind!r}")
+    label = _LABEL[kind]
+    p = Path(path)
+    special = describe_special_file(p)
+    if special is not None:  # a FIFO waits for a writer; /dev/zero never ends
+        raise DataError(special)
+    try:
+        if p.stat().st_size > MAX_TRACKER_FILE_BYTES:
+            raise DataError(f"{p}: larger than {MAX_TRACKER_FILE_BYTES} bytes; not a result file")
+        text = p.read_text(encoding="utf-8-sig")  # a byte-order mark is not part of x
+    except (OSError, UnicodeDecodeError) as err:
+        raise DataError(f"{p}: cannot read as {label} results: {err}") from None
+    lines = text.splitlines()
+    while lines and not lines[-1].strip():
+        lines.pop()
+    off = _ORIGIN[kind]
+    boxes = np.full((len(lines), 4), np.nan)
+    for n, line in enumerate(lines, 1):
+        try:
+            if not line.strip():  # skipping it would shift every later frame by one
+                raise ValueError("an empty line; a frame without a box is 0,0,0,0")
+            box = _box_line(line)
+        except ValueError as err:
+            raise DataError(
+                f"{p}:{n}: not a box line of {label} results ({err}): {line[:80]!r}"
+            ) from None
+        if box is not None:
+            x, y, w, h = box
+            boxes[n - 1] = (x - off, y - off, w, h)
+    if len(lines) != n_frames:
+        raise DataError(
+            f"{p}: {len(lines)} lines, but the sequence has {n_frames} frames ({label} "
+            "results have one line per frame, the first for frame 0)"
+        )
+    return boxes
