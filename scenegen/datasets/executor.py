@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import contextlib
 import ctypes
+import multiprocessing.util
 import os
 import signal
 from collections.abc import Callable, Hashable, Sequence
@@ -328,8 +329,13 @@ def _start_worker(parent: int, notes: Any, count: Any) -> None:
 
 def _on_sigterm(signum: int, frame: Any) -> None:
     """Exit at once, removing the temporary file of a write in progress (the pool stops:
-    Ctrl-C in the parent, or another worker died)."""
+    Ctrl-C in the parent, or another worker died). Multiprocessing's exit finalizers run
+    first: they release the named semaphores this worker made (numba's thread-pool lock),
+    which ``os._exit`` would leave to the resource tracker's "leaked semaphore" warning
+    after the one-line error."""
     discard_temp_files()
+    with contextlib.suppress(Exception):
+        multiprocessing.util._run_finalizers(0)  # what a normal exit runs
     os._exit(128 + signum)
 
 
