@@ -50,7 +50,7 @@ from numpy.typing import NDArray
 from scenegen.errors import ConfigError, DataError
 from scenegen.io.atomic import describe_special_file
 from scenegen.io.export import encode_frame, write_folder
-from scenegen.io.mot import MAX_TRACKER_FILE_BYTES, check_number_text
+from scenegen.io.mot import check_number_text, read_result_text
 from scenegen.sequence import Sequence
 
 __all__ = [
@@ -327,15 +327,7 @@ def read_benchmark_result(
         raise ConfigError(f"result kind must be one of {', '.join(RESULT_KINDS)}; got {kind!r}")
     label = _LABEL[kind]
     p = Path(path)
-    special = describe_special_file(p)
-    if special is not None:  # a FIFO waits for a writer; /dev/zero never ends
-        raise DataError(special)
-    try:
-        if p.stat().st_size > MAX_TRACKER_FILE_BYTES:
-            raise DataError(f"{p}: larger than {MAX_TRACKER_FILE_BYTES} bytes; not a result file")
-        text = p.read_text(encoding="utf-8-sig")  # a byte-order mark is not part of x
-    except (OSError, UnicodeDecodeError) as err:
-        raise DataError(f"{p}: cannot read as {label} results: {err}") from None
+    text = read_result_text(p, "result file", f"{label} results")
     lines = text.splitlines()
     while lines and not lines[-1].strip():
         lines.pop()

@@ -42,6 +42,7 @@ __all__ = [
     "GT_MODES",
     "MOT_CLASS",
     "check_number_text",
+    "read_result_text",
     "gt_keep",
     "gt_rows",
     "read_mot_tracker",
@@ -188,6 +189,29 @@ _NUMBER = re.compile(
 )
 
 
+def read_result_text(path: str | Path, kind: str, read_as: str) -> str:
+    """The text of a tracker's result file: UTF-8, a byte-order mark allowed (Notepad,
+    Excel's "CSV UTF-8", PowerShell write one; it is not part of the first number).
+
+    Raises
+    ------
+    DataError
+        One line naming ``path``: a FIFO or a device (a FIFO waits for a writer,
+        /dev/zero never ends), more than :data:`MAX_TRACKER_FILE_BYTES` ("not a
+        ``kind``"), unreadable or not UTF-8 ("cannot read as ``read_as``").
+    """
+    p = Path(path)
+    special = describe_special_file(p)
+    if special is not None:
+        raise DataError(special)
+    try:
+        if p.stat().st_size > MAX_TRACKER_FILE_BYTES:
+            raise DataError(f"{p}: larger than {MAX_TRACKER_FILE_BYTES} bytes; not a {kind}")
+        return p.read_text(encoding="utf-8-sig")
+    except (OSError, UnicodeDecodeError) as err:
+        raise DataError(f"{p}: cannot read as {read_as}: {err}") from None
+
+
 def check_number_text(cell: str) -> None:
     """Raise ValueError unless ``cell`` is a number as text files write one: ASCII digits,
     sign, point and exponent (``nan``/``inf`` pass here, for a later, clearer refusal).
@@ -250,17 +274,7 @@ def read_mot_tracker_rows(
         allowed); a path that is not a regular file (a FIFO, a device).
     """
     p = Path(path)
-    special = describe_special_file(p)
-    if special is not None:  # a FIFO waits for a writer; /dev/zero never ends
-        raise DataError(special)
-    try:
-        if p.stat().st_size > MAX_TRACKER_FILE_BYTES:
-            raise DataError(f"{p}: larger than {MAX_TRACKER_FILE_BYTES} bytes; not a tracker file")
-        # utf-8-sig: a byte-order mark (Notepad, Excel's "CSV UTF-8", PowerShell) is not
-        # part of the first frame number; without it the text is read as plain UTF-8.
-        text = p.read_text(encoding="utf-8-sig")
-    except (OSError, UnicodeDecodeError) as err:
-        raise DataError(f"{p}: cannot read as a MOTChallenge tracker file: {err}") from None
+    text = read_result_text(p, "tracker file", "a MOTChallenge tracker file")
     rows: list[tuple[int, int, int, float, float, float, float]] = []
     for n, line in enumerate(text.splitlines(), 1):
         if not line.strip():
