@@ -27,6 +27,7 @@ from numpy.typing import NDArray
 
 from trackers.base import Estimate, Tracker
 from trackers.filters.kalman import KalmanFilter, MotionModel
+from trackers.models.dynamics import check_ar2_coefficients
 from trackers.models.layered import LayeredMatcher, check_matcher_params
 from trackers.params import TrackerParams, check_choice, check_integer, check_number
 
@@ -34,10 +35,20 @@ __all__ = ["MOTIONS", "KalmanParams", "KalmanTracker"]
 
 MOTIONS = ("cv", "ar2")
 
-#: Upper bounds of the motion parameters (pixels; AR2 coefficients): far above any use, and
-#: low enough that no accepted value overflows the filter.
+#: Upper bound of the motion noise stds (pixels): far above any use, and low enough that no
+#: accepted value overflows the filter. The AR2 coefficients must not be explosive
+#: (``trackers.models.dynamics.check_ar2_coefficients``, as for the particle trackers):
+#: a bound of 100 on each still let the covariance grow without bound (NaN boxes).
 MAX_STD = 1e6
-MAX_AR = 100.0
+
+#: Bounds of the measurement variance (px²): ``r_floor`` in [MIN_R_FLOOR, MAX_R] and
+#: ``r_gain`` in [0, MAX_R], so that R = r_floor + r_gain e (e <= 255²) is at most about
+#: 6.5e16 px² and the innovation covariance S >= r_floor is invertible. r_gain = 1e308
+#: overflowed R (NaN boxes at the first frame); r_floor = 1e-310 left S singular (NaN
+#: boxes, and a LinAlgError in "shm-fast", at the second). Both are far beyond any use:
+#: 1e-6 px² is a measurement std of 0.001 px, 1e12 px² one of 1e6 px.
+MIN_R_FLOOR = 1e-6
+MAX_R = MAX_STD**2
 
 
 def motion_model(
@@ -93,11 +104,12 @@ class KalmanParams(TrackerParams):
         check_choice(self, "motion", MOTIONS)
         # Bounded so that no accepted value overflows (1e300 did, in the squared noise).
         check_number(self, "process_std", low=0.0, high=MAX_STD)
-        check_number(self, "a1", low=-MAX_AR, high=MAX_AR)
-        check_number(self, "a2", low=-MAX_AR, high=MAX_AR)
+        a1, a2 = check_ar2_coefficients(self.a1, self.a2)
+        self._set("a1", a1)
+        self._set("a2", a2)
         check_number(self, "velocity_std", low=0.0, low_open=True, high=MAX_STD)
-        check_number(self, "r_gain", low=0.0)
-        check_number(self, "r_floor", low=0.0, low_open=True)
+        check_number(self, "r_gain", low=0.0, high=MAX_R)
+        check_number(self, "r_floor", low=MIN_R_FLOOR, high=MAX_R)
         # Integral floats (12.0, as --param may give them) are stored as int first.
         check_integer(self, "search_radius", low=1, high=200)
         check_integer(self, "step", low=1, high=8)
@@ -125,15 +137,18 @@ class KalmanTracker(Tracker):
     motion : {"cv", "ar2"}
         Motion model (see the module docstring).
     process_std : float
-        Process noise std: acceleration (cv) or AR2 noise, px/frame².
+        Process noise std: acceleration (cv) or AR2 noise, px/frame², in [0, 1e6].
     a1, a2 : float
-        AR2 coefficients (``motion="ar2"`` only).
+        AR2 coefficients (used by ``motion="ar2"`` only, checked whatever the motion),
+        not explosive: |a2| <= 1 and |a1| <= 1 − a2
+        (``trackers.models.dynamics.check_ar2_coefficients``, as for the particle trackers).
     velocity_std : float
-        Initial velocity std, px/frame (objects start at rest).
+        Initial velocity std, px/frame (objects start at rest), in (0, 1e6].
     r_gain : float
-        Measurement variance per unit of mean squared difference, px²/intensity².
+        Measurement variance per unit of mean squared difference, px²/intensity², in
+        [0, 1e12].
     r_floor : float
-        Smallest measurement variance, px².
+        Smallest measurement variance, px², in [1e-6, 1e12].
     search_radius : int
         Search window half-size around the predicted position, px.
     step : int

@@ -101,6 +101,16 @@ def transition_matrix(n_orderings: int, p_stay: float) -> NDArray[np.float64]:
 
 EVIDENCES = ("union", "objects")
 
+#: Bounds of the evidence parameters: ``lam`` in [0, MAX_LAM], ``mse_floor`` >=
+#: MIN_MSE_FLOOR (intensity²), so that the log evidence −lam Σ e / ē (e <= 255², at most 4
+#: objects) stays finite, below about 2.6e17 in magnitude. lam = 1e308 overflowed it (NaN
+#: boxes and ordering probabilities on ``shm-crossing``), and so did mse_floor = 5e-324
+#: (e / ē = inf after an exact match; times lam = 0 it was NaN). Both are far beyond any
+#: use: at lam = 1e6, orderings whose means differ by 1e-4 ē differ in evidence by a
+#: factor e^100.
+MAX_LAM = 1e6
+MIN_MSE_FLOOR = 1e-6
+
 
 class _OrderingEvidence:
     """Markov prior and squared-difference evidence of the orderings (§2.2, §3.3)."""
@@ -159,9 +169,9 @@ class FastShmParams(KalmanParams):
         super().__post_init__()
         check_choice(self, "evidence", EVIDENCES)
         check_number(self, "p_stay", low=0.0, high=1.0, low_open=True)
-        check_number(self, "lam", low=0.0)
+        check_number(self, "lam", low=0.0, high=MAX_LAM)
         check_number(self, "mse_rate", low=0.0, high=1.0, low_open=True)
-        check_number(self, "mse_floor", low=0.0, low_open=True)
+        check_number(self, "mse_floor", low=MIN_MSE_FLOOR)
 
 
 @dataclass(frozen=True)
@@ -218,11 +228,12 @@ min_visible, support, blur
         ``shm-crossing`` seeds 0–7: depth-order accuracy 100% for 0.5 to 0.9; mean
         ``max |P − 1/L|`` on frames where the targets are apart 0.04 at 0.8, 0.11 at 0.9.
     lam : float
-        Sharpness of the squared-difference evidence ``exp(−lam e / ē)``.
+        Sharpness of the squared-difference evidence ``exp(−lam e / ē)``, in [0, 1e6].
     mse_rate : float
         Rate of the moving average ``ē`` of the best squared-difference mean, in (0, 1].
     mse_floor : float
-        Smallest ``ē``, intensity² (so exact synthetic matches do not give ē = 0).
+        Smallest ``ē``, intensity², >= 1e-6 (so exact synthetic matches do not give
+        ē = 0).
     evidence : {"union", "objects"}
         Which squared-difference mean is scored (module docstring).
     use_mse : bool

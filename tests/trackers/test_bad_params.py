@@ -23,14 +23,69 @@ import trackers
         ("condensation", {"n_parts": 10**12}, "n_parts must be an integer in [1, 1000000]"),
         ("condensation", {"rng": -1}, "rng must be a numpy Generator, a non-negative int"),
         ("kalman", {"process_std": 1e300}, "process_std must be in [0, 1e+06]"),  # Overflow
-        ("kalman", {"motion": "ar2", "a1": 1e300}, "a1 must be in [-100, 100]"),  # NaN boxes
+        # NaN boxes (a1 was bounded by 100, which still overflowed: see below).
+        ("kalman", {"motion": "ar2", "a1": 1e300}, "a1, a2 must not be explosive"),
         ("shm", {"velocity_std": 1e300}, "velocity_std must be in (0, 1e+06]"),
+        # Explosive AR2 (the particle trackers' check_ar2): the covariance grew without
+        # bound, the boxes ran to the frame's corner, and a1=100 gave NaN boxes at frame 157.
+        ("kalman", {"motion": "ar2", "a1": 2.5, "a2": -0.5},
+         "a1, a2 must not be explosive (|a2| <= 1 and |a1| <= 1 - a2), got a1=2.5, a2=-0.5"),
+        ("kalman", {"motion": "ar2", "a1": 100.0, "a2": 0.0}, "a1, a2 must not be explosive"),
+        ("shm", {"motion": "ar2", "a1": 0.0, "a2": -1.5}, "a1, a2 must not be explosive"),
+        ("shm-fast", {"motion": "ar2", "a1": -2.5, "a2": -0.5}, "a1, a2 must not be explosive"),
+        ("shm-fast", {"motion": "ar2", "a2": float("nan")}, "a2 must be finite, got nan"),
+        # R = r_floor + r_gain e overflowed (NaN boxes at the first frame) ...
+        ("kalman", {"r_gain": 1e308}, "r_gain must be in [0, 1e+12], got 1e+308"),
+        ("shm", {"r_gain": 1e305}, "r_gain must be in [0, 1e+12]"),
+        ("shm-fast", {"r_floor": 1e308}, "r_floor must be in [1e-06, 1e+12], got 1e+308"),
+        # ... or a subnormal floor made S singular: NaN boxes, LinAlgError in shm-fast.
+        ("kalman", {"r_floor": 1e-310}, "r_floor must be in [1e-06, 1e+12], got 1e-310"),
+        ("shm-fast", {"r_floor": 5e-324}, "r_floor must be in [1e-06, 1e+12]"),
+        # The evidence -lam sum(e / mse scale) overflowed: NaN boxes and order_prob.
+        ("shm", {"lam": 1e308}, "lam must be in [0, 1e+06], got 1e+308"),
+        ("shm-fast", {"lam": 1e7}, "lam must be in [0, 1e+06]"),
+        ("shm", {"mse_floor": 5e-324}, "mse_floor must be finite and >= 1e-06, got 5e-324"),
     ],
 )
 def test_bad_values_name_the_parameter(name, params, needle):
     with pytest.raises(ValueError) as info:
         trackers.make(name, **params)
     assert needle in str(info.value)
+
+
+@pytest.mark.parametrize("name", ["kalman", "shm", "shm-fast"])
+@pytest.mark.parametrize(
+    "params",
+    [
+        # The most explosive accepted AR2s (a double root at -1, a unit root) at the
+        # largest noise.
+        {"motion": "ar2", "a1": -2.0, "a2": -1.0, "process_std": 1e6, "velocity_std": 1e6},
+        {"motion": "ar2", "a1": 0.0, "a2": 1.0, "process_std": 1e6},
+        # The smallest floors with nothing else in the noise (a subnormal r_floor gave NaN
+        # boxes at the second frame; a subnormal mse_floor NaN boxes after an exact match).
+        {"r_floor": 1e-6, "r_gain": 0.0, "process_std": 0.0, "mse_floor": 1e-6, "lam": 1e6},
+        {"r_floor": 1e12, "r_gain": 1e12, "mse_floor": 1e-6, "lam": 0.0},
+    ],
+)
+def test_accepted_extremes_stay_finite(name, params):
+    import warnings
+
+    rng = np.random.default_rng(0)
+    frame = rng.integers(0, 256, (80, 120, 3), dtype=np.uint8)
+    boxes = np.array([[20.0, 20.0, 24.0, 24.0], [70.0, 30.0, 20.0, 20.0]])
+    valid = trackers.registry.parameters(name)
+    tracker = trackers.make(name, **{k: v for k, v in params.items() if k in valid})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no overflow or invalid value on the way
+        tracker.init(frame, boxes)
+        for t in range(60):
+            f = frame
+            if t >= 3:  # exact matches first, then a slight change (e > 0 after e = 0)
+                f = frame.copy()
+                f[21:44, 20:44] = np.roll(frame[21:44, 20:44], t % 3, axis=1)
+            est = tracker.step(f)
+            assert np.all(np.isfinite(est.boxes)), (t, est.boxes)
+            assert np.all(np.isfinite(est.extras.get("order_prob", 0.0))), t
 
 
 def test_integral_floats_are_integers_for_the_matcher_too():

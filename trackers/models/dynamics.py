@@ -31,7 +31,7 @@ from numpy.typing import NDArray
 from trackers.base import MAX_BOX_VALUE
 
 __all__ = ["AR2", "MAX_SIGMA_A", "MAX_SIGMA_UV", "boxes_from_states", "check_ar2",
-           "states_from_boxes"]
+           "check_ar2_coefficients", "states_from_boxes"]
 
 MAX_SIGMA_UV = MAX_BOX_VALUE
 """Largest σ_u, σ_v (pixels per frame): a noise step beyond the largest box coordinate
@@ -52,7 +52,7 @@ def check_ar2(sigma: object, a1: object, a2: object
         One line naming the parameter and its value: ``sigma`` not three finite numbers
         in [0, :data:`MAX_SIGMA_UV`] (u, v) and [0, :data:`MAX_SIGMA_A`] (a); ``a1`` or
         ``a2`` not a finite number; ``a1, a2`` explosive (a root of z² − A1 z − A2
-        outside the unit circle).
+        outside the unit circle; :func:`check_ar2_coefficients`).
 
     Example
     -------
@@ -75,6 +75,33 @@ def check_ar2(sigma: object, a1: object, a2: object
     if max(sig[:2]) > MAX_SIGMA_UV or sig[2] > MAX_SIGMA_A:
         raise ValueError(f"sigma must be (u, v, a) with u, v <= {MAX_SIGMA_UV:g} px and "
                          f"a <= {MAX_SIGMA_A:.3g}, got {sigma!r}")
+    c1, c2 = check_ar2_coefficients(a1, a2)
+    return sig, c1, c2  # type: ignore[return-value]
+
+
+def check_ar2_coefficients(a1: object, a2: object) -> tuple[float, float]:
+    """Validate AR2 coefficients A1, A2 (finite, not explosive); return them as floats.
+
+    The one definition of "explosive" for every tracker with AR2 dynamics: the particle
+    trackers (through :func:`check_ar2`) and the Kalman and SHM trackers
+    (``trackers.kalman.KalmanParams``), whose covariance grew without bound (NaN boxes)
+    under an explosive model.
+
+    Raises
+    ------
+    ValueError
+        One line naming the parameter and its value: ``a1`` or ``a2`` not a finite
+        number; ``a1, a2`` explosive (a root of z² − A1 z − A2 outside the unit circle).
+
+    Example
+    -------
+    >>> check_ar2_coefficients(1.9, -0.9)
+    (1.9, -0.9)
+    >>> check_ar2_coefficients(2.5, -0.5)
+    Traceback (most recent call last):
+    ...
+    ValueError: a1, a2 must not be explosive (|a2| <= 1 and |a1| <= 1 - a2), got a1=2.5, ...
+    """
     coef = []
     for name, val in (("a1", a1), ("a2", a2)):
         try:
@@ -91,7 +118,7 @@ def check_ar2(sigma: object, a1: object, a2: object
         raise ValueError(f"a1, a2 must not be explosive (|a2| <= 1 and |a1| <= 1 - a2), "
                          f"got a1={c1:g}, a2={c2:g} (a root of z^2 - a1 z - a2 has modulus "
                          f"{radius:.3g})")
-    return sig, c1, c2  # type: ignore[return-value]
+    return c1, c2
 
 
 def states_from_boxes(boxes: NDArray[np.floating]) -> tuple[NDArray[np.float64],

@@ -48,6 +48,12 @@ def test_track_params_are_parsed_and_recorded(crossing, tmp_path, capsys):
         (["--tracker", "nope"], "unknown tracker 'nope'; valid trackers: condensation"),
         (["--tracker", "kalman", "--param", "bogus=1"], "unknown parameter 'bogus'"),
         (["--tracker", "kalman", "--param", "noequals"], "--param must be KEY=VALUE"),
+        # Accepted, these ran the boxes into a corner of the frame or gave NaN boxes.
+        (["--tracker", "kalman", "--param", "motion=ar2", "--param", "a1=2.5", "--param",
+          "a2=-0.5"], "a1, a2 must not be explosive (|a2| <= 1 and |a1| <= 1 - a2), got a1=2.5"),
+        (["--tracker", "shm", "--param", "motion=ar2", "--param", "a2=-1.5"],
+         "a1, a2 must not be explosive"),
+        (["--tracker", "shm-fast", "--param", "lam=1e308"], "lam must be in [0, 1e+06]"),
     ],
 )
 def test_track_bad_usage_exits_2(crossing, tmp_path, capsys, args, needle):
