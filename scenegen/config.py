@@ -19,6 +19,7 @@ Example
 
 from __future__ import annotations
 
+import contextvars
 import dataclasses
 import functools
 import json
@@ -35,7 +36,9 @@ from scenegen.errors import ConfigError
 
 __all__ = [
     "AR2",
+    "AR2_FIELDS",
     "BACKGROUND_FIELDS",
+    "CLUTTER_FIELDS",
     "MAX_BLUR",
     "MAX_COLORS",
     "MAX_FRAMES",
@@ -58,6 +61,7 @@ __all__ = [
     "Variation",
     "dump_yaml",
     "from_dict",
+    "from_stored",
     "load_config",
     "load_data",
     "relative_to",
@@ -113,6 +117,18 @@ presets use at most 154,500."""
 
 def _fail(path: str, msg: str) -> typing.NoReturn:
     raise ConfigError(f"{path}: {msg}" if path else msg)
+
+
+_STORED = contextvars.ContextVar("scenegen_config_stored", default=False)
+"""True while :func:`from_stored` builds a config read back from a file."""
+
+
+def _unused(path: str, msg: str) -> None:
+    """Refuse a field that holds a value the scene would silently ignore (``msg`` says
+    why), except in a config read back from a file (:func:`from_stored`): a file written
+    before the refusal existed keeps it ignored, as it was when the file was made."""
+    if not _STORED.get():
+        _fail(path, msg)
 
 
 def _check_color(path: str, c: Color) -> None:
@@ -179,19 +195,33 @@ BACKGROUND_FIELDS: dict[str, tuple[str, ...]] = {
 """The :class:`Background` fields that only some kinds use, as :data:`PATTERN_FIELDS`.
 ``scale`` (used by ``texture`` and ``perlin``) is tolerated on every kind: the regression
 fixtures, scaled down, record it on every kind."""
+CLUTTER_FIELDS: dict[str, tuple[str, ...]] = {
+    "palette": PATTERN_FIELDS["colors"],
+    "n_colors": PATTERN_FIELDS["colors"],
+}
+"""The :class:`ClutterSpec` fields that only some ``appearance.pattern`` values use (the
+patterns that take colours: an ``image`` item takes its pixels from the image), as
+:data:`PATTERN_FIELDS`."""
+AR2_FIELDS: dict[str, tuple[str, ...]] = {"margin": ("reflect", "clamp")}
+"""The :class:`AR2` fields that only some ``boundary`` rules use (``free`` has no limits
+for a margin to move), as :data:`PATTERN_FIELDS`."""
 
 
-def _check_unused(obj: Any, kind: str, users: dict[str, tuple[str, ...]]) -> None:
+def _check_unused(
+    obj: Any, kind: str, users: dict[str, tuple[str, ...]], *, chosen: Any = None
+) -> None:
     """Refuse a field that the chosen ``kind`` (an appearance's ``pattern``, a background's
     ``kind``) does not use, unless it holds its default: it would be silently ignored.
 
-    ``users`` maps each kind-specific field of ``obj`` to the kinds that use it."""
-    chosen = getattr(obj, kind)
+    ``users`` maps each kind-specific field of ``obj`` to the kinds that use it; ``chosen``
+    is the kind's value when it is not ``obj``'s own field ``kind`` (a clutter group's
+    ``appearance.pattern``)."""
+    chosen = getattr(obj, kind) if chosen is None else chosen
     defaults = {f.name: f.default for f in dataclasses.fields(obj)}
     for name, kinds in users.items():
         if chosen not in kinds and getattr(obj, name) != defaults[name]:
             where = " | ".join(kinds)
-            _fail(name, f"not used by {kind} {chosen!r} (it applies to {kind}: {where})")
+            _unused(name, f"not used by {kind} {chosen!r} (it applies to {kind}: {where})")
 
 
 def _new(default: Any) -> Any:
@@ -222,6 +252,8 @@ class AR2:
     about the limit (a jump of twice its distance outside) and ``clamp`` puts it on the
     limit. Such starts are allowed (an entity may enter from outside the frame); give one
     inside ``[margin + size / 2, side - margin - size / 2]`` for a path without that jump.
+    A ``free`` boundary has no limits: a ``margin`` on it is refused unless 0
+    (:data:`AR2_FIELDS`).
 
     Any ``a1, a2`` is accepted, including explosive ones (roots of ``z^2 - a1 z - a2``
     outside the unit circle; ``a1 = 2, a2 = -1`` has a double root at 1, a random walk of
@@ -244,6 +276,7 @@ class AR2:
             _fail("sigma", f"must be >= 0, got {_short(self.sigma)}")
         if self.margin < 0:
             _fail("margin", f"must be >= 0, got {_short(self.margin)}")
+        _check_unused(self, "boundary", AR2_FIELDS)
 
 
 @dataclass(frozen=True)
@@ -347,6 +380,10 @@ class Variation:
             _fail("shading", f"must be in [0, 1), got {_short(self.shading)}")
 
 
+_MIMIC_FIELDS = ("color_jitter", "mimic_offset")
+"""The :class:`EntitySpec` fields that only a mimic uses."""
+
+
 @dataclass(frozen=True)
 class EntitySpec:
     """One entity of the scene.
@@ -374,9 +411,17 @@ class EntitySpec:
         Two entities may never share a depth at the same frame.
     mimic : str or None
         Name of a target whose appearance this entity copies (distractors).
+    mimic_offset : (dx, dy)
+        Where a mimic without a ``position`` starts, relative to its model's centre.
     color_jitter : float
         Std of a per-channel colour offset applied to a mimicked appearance.
     variation : Variation or None
+
+    ``color_jitter`` and ``mimic_offset`` are used only by a mimic (and ``mimic_offset``
+    only without a ``position``; ``color_jitter`` only when the model's pattern has
+    colours, not on an ``image``): elsewhere they are refused unless they hold their
+    defaults, as they would be silently ignored. A mimic's own ``appearance`` is ignored
+    (it draws its model's), yet tolerated: a regression fixture records one.
     """
 
     name: str
@@ -417,6 +462,18 @@ class EntitySpec:
             _fail("position", "is required unless the entity mimics a target")
         if self.color_jitter < 0:
             _fail("color_jitter", f"must be >= 0, got {_short(self.color_jitter)}")
+        defaults = {f.name: f.default for f in dataclasses.fields(self)}
+        moved = [name for name in _MIMIC_FIELDS if getattr(self, name) != defaults[name]]
+        if self.mimic is None and moved:
+            _unused(
+                moved[0], "not used without mimic (it applies to an entity that mimics another)"
+            )
+        if self.mimic is not None and self.position is not None and "mimic_offset" in moved:
+            _unused(
+                "mimic_offset",
+                "not used with a position (a mimic starts at its position, or without one at "
+                "its model's centre plus mimic_offset)",
+            )
 
     def depth_at(self, t: int) -> int:
         """Depth value at frame ``t`` (the last keyframe at or before ``t``)."""
@@ -435,6 +492,11 @@ class ClutterSpec:
     ``[min_size, appearance.size]`` (keeping the aspect ratio) and ``n_colors`` colours
     drawn from ``palette``. ``placement`` is ``uniform`` (centres uniform over ``region``,
     default the whole frame) or ``grid`` (a jittered grid over ``region``).
+
+    The items' colours come from ``palette``, never from ``appearance.colors``: that is
+    ignored (tolerated, not refused: the regression fixture ``single-frame`` records one).
+    An ``image`` item takes its pixels from the image: ``palette`` and ``n_colors`` are
+    refused on it unless they hold their defaults (:data:`CLUTTER_FIELDS`).
     """
 
     count: int
@@ -463,6 +525,7 @@ class ClutterSpec:
             )
         if self.region is not None and (self.region[2] <= 0 or self.region[3] <= 0):
             _fail("region", f"width and height must be > 0, got {_short(list(self.region))}")
+        _check_unused(self, "pattern", CLUTTER_FIELDS, chosen=self.appearance.pattern)
 
 
 @dataclass(frozen=True)
@@ -521,10 +584,11 @@ class Camera:
     *scene* coordinates, which equal frame coordinates when the camera is at rest; the
     frame shows the scene shifted by the camera offset (dx, dy), a whole number of pixels
     with ``|dx| <= ex``, ``|dy| <= ey``. The offset follows ``x`` and ``y`` (AR2 from 0 with
-    initial ``velocity``; their boundary, ``reflect`` or ``clamp``, applies at the extent;
-    ``margin`` is ignored) or the scripted ``keyframes`` ((frame, dx, dy), linear in
-    between and held after the last; an offset beyond the extent is refused). Every
-    ground-truth field is in the coordinates of the rendered frame.
+    initial ``velocity``, refused on an axis without its AR2; their boundary, ``reflect``
+    or ``clamp``, applies at the extent; ``margin`` is ignored) or the scripted
+    ``keyframes`` ((frame, dx, dy), linear in between and held after the last; an offset
+    beyond the extent is refused). Every ground-truth field is in the coordinates of the
+    rendered frame.
 
     ``zoom`` (AR2 of the log zoom from 0; ``margin`` bounds ``|log zoom|``, 0 means the
     limits 1/2 and 2; ``reflect`` or ``clamp``) magnifies the view about the frame centre:
@@ -561,6 +625,13 @@ class Camera:
                 )
         if self.keyframes and (self.x is not None or self.y is not None):
             _fail("keyframes", "cannot be combined with x or y motion")
+        for i, axis in enumerate(("x", "y")):
+            if self.velocity[i] != 0 and getattr(self, axis) is None:
+                _unused(
+                    "velocity",
+                    f"the {axis} velocity is not used without {axis} motion (it starts the "
+                    f"camera's {axis} AR2), got {_short(list(self.velocity))}",
+                )
         _check_keyframes("keyframes", self.keyframes)
         for i, (_, dx, dy) in enumerate(self.keyframes):
             if abs(dx) > self.extent[0] or abs(dy) > self.extent[1]:
@@ -675,6 +746,15 @@ class SceneConfig:
                     _fail(f"entities[{i}].mimic", f"no entity named {_short(e.mimic)}")
                 if self.entities[names[e.mimic]].mimic is not None:
                     _fail(f"entities[{i}].mimic", f"{_short(e.mimic)} itself mimics another entity")
+                pattern = self.entities[names[e.mimic]].appearance.pattern
+                coloured = PATTERN_FIELDS["colors"]
+                if e.color_jitter != 0 and pattern not in coloured:
+                    _unused(
+                        f"entities[{i}].color_jitter",
+                        f"not used by pattern {pattern!r} of the mimicked {_short(e.mimic)}, "
+                        f"which has no colours to jitter (it applies to pattern: "
+                        f"{' | '.join(coloured)})",
+                    )
         cnames = [c.name for c in self.clutter]
         for j, c in enumerate(self.clutter):
             if c.name in names or cnames.index(c.name) != j:
@@ -1016,6 +1096,26 @@ def from_dict(data: Any, *, folder: str | Path | None = None) -> SceneConfig:
     """
     config = _build(SceneConfig, data, "")
     return config if folder is None else _sources_relative_to(config, Path(folder))
+
+
+def from_stored(data: Any) -> SceneConfig:
+    """:func:`from_dict` for a config read back from a file's ``config`` attribute.
+
+    A field that holds a value the scene ignores (``not used by ...``; refused in a new
+    config since it would be silently ignored) is tolerated here: files written before
+    such a refusal existed stay readable and valid, and render as they did. Every other
+    check applies.
+
+    Raises
+    ------
+    ConfigError
+        Naming the field path and the bad value.
+    """
+    token = _STORED.set(True)
+    try:
+        return _build(SceneConfig, data, "")
+    finally:
+        _STORED.reset(token)
 
 
 def relative_to(path: str | Path, folder: str | Path | None) -> Path:

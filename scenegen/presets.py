@@ -962,7 +962,9 @@ def dps_synthetic_real() -> SceneConfig:
     """
     base = _PRESETS["dps-synthetic"]()
     looks = iter(_REAL_LOOKS)
-    ents = [e if e.mimic is not None else replace(e, appearance=next(looks)) for e in base.entities]
+    # The distractor copies object 1's face: an image has no colours to jitter.
+    ents = [replace(e, color_jitter=0.0) if e.mimic is not None
+            else replace(e, appearance=next(looks)) for e in base.entities]  # fmt: skip
     return replace(
         base,
         name="dps-synthetic-real",

@@ -50,7 +50,7 @@ import h5py
 import numpy as np
 from numpy.typing import NDArray
 
-from scenegen.config import from_dict, to_dict
+from scenegen.config import from_stored, to_dict
 from scenegen.errors import ConfigError, DataError, NotInFile
 from scenegen.io import guard
 from scenegen.io.atomic import (
@@ -748,7 +748,7 @@ def _read_once(p: Path, name: str | None) -> Sequence:
             raise NotInFile(f"{p}: no sequence {name!r}; it holds {', '.join(seqs)}")
         try:
             g = f[f"sequences/{name}"]
-            config = from_dict(json.loads(g.attrs["config"]))
+            config = from_stored(json.loads(g.attrs["config"]))
             entities = Entities(
                 id=g["entities/id"][()].astype(np.int32),
                 role=_str_array(g["entities/role"]),

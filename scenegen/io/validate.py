@@ -30,7 +30,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy import ndimage
 
-from scenegen.config import from_dict
+from scenegen.config import from_stored
 from scenegen.errors import ConfigError, DataError
 from scenegen.io import describe_open_error, describe_read_error, describe_temp_file
 from scenegen.io.atomic import describe_special_file
@@ -243,7 +243,7 @@ def _layout(where: str, g: h5py.Group) -> tuple[list[str], tuple[int, int, int, 
                 problems.append(f"{where}: attribute {a} is not an integer: {g.attrs[a]!r}")
     if "config" in g.attrs:
         try:
-            cfg = from_dict(json.loads(g.attrs["config"]))
+            cfg = from_stored(json.loads(g.attrs["config"]))
         except (ValueError, TypeError, ConfigError) as err:
             problems.append(f"{where}: attribute config is not a valid config: {_one_line(err)}")
         else:
@@ -720,7 +720,7 @@ def _check_deep(p: Path, f: h5py.File) -> list[str]:
         if not where.startswith(f"{p}: sequence "):
             continue
         try:
-            cfg = from_dict(json.loads(as_text(g.attrs["config"])))
+            cfg = from_stored(json.loads(as_text(g.attrs["config"])))
             scn = plan(cfg, int(g.attrs["seed"]), preset=as_text(g.attrs["preset"]))
         except (*_READ_ERRORS, ConfigError) as err:
             problems.append(

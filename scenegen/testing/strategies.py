@@ -647,9 +647,9 @@ def _scene_configs(
     background = _draw_background(draw, noise)
     camera = photo = None
     if switches["realistic"] and draw(st.booleans()):
-        ordered = tuple(_realistic_entity(draw, e) for e in ordered)
+        ordered = _realistic_entities(draw, ordered)
         if clutter:
-            clutter = tuple(replace(c, appearance=_textured(draw, c.appearance)) for c in clutter)
+            clutter = tuple(_realistic_clutter(draw, c) for c in clutter)
         background = _draw_real_background(draw)
         camera = _draw_camera(draw, n_frames)
         photo = _draw_photometric(draw)
@@ -693,8 +693,23 @@ def _textured(draw: Any, app: Appearance) -> Appearance:
     )
 
 
-def _realistic_entity(draw: Any, e: EntitySpec) -> EntitySpec:
-    return e if e.mimic is not None else replace(e, appearance=_textured(draw, e.appearance))
+def _realistic_entities(draw: Any, ents: tuple[EntitySpec, ...]) -> tuple[EntitySpec, ...]:
+    """``ents`` with textured appearances; a mimic of an image keeps no colour jitter
+    (an image has no colours: it would be refused)."""
+    out = [e if e.mimic is not None else replace(e, appearance=_textured(draw, e.appearance))
+           for e in ents]  # fmt: skip
+    images = {e.name for e in out if e.appearance.pattern == "image"}
+    return tuple(replace(e, color_jitter=0.0) if e.mimic in images else e for e in out)
+
+
+def _realistic_clutter(draw: Any, c: ClutterSpec) -> ClutterSpec:
+    """``c`` with a textured appearance; image items keep the default palette and
+    ``n_colors`` (they take no colours: others would be refused)."""
+    app = _textured(draw, c.appearance)
+    if app.pattern != "image":
+        return replace(c, appearance=app)
+    plain = ClutterSpec(count=0)
+    return replace(c, appearance=app, palette=plain.palette, n_colors=plain.n_colors)
 
 
 def _draw_real_background(draw: Any) -> Background:

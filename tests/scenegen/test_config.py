@@ -5,11 +5,12 @@ from __future__ import annotations
 import copy
 import json
 
+import numpy as np
 import pytest
 import yaml
 
 import scenegen
-from scenegen.config import from_dict, load_config, to_dict
+from scenegen.config import from_dict, from_stored, load_config, to_dict
 from scenegen.errors import ConfigError
 
 
@@ -234,9 +235,19 @@ def _app(**fields) -> dict:
     return mutate(["entities", 0, "appearance"], {"size": [9, 9], **fields})
 
 
-@pytest.mark.parametrize(
-    ("data", "message"),
-    [
+def _image_clutter(**fields) -> dict:
+    app = {"size": [6, 6], "pattern": "image", "source": "skimage:brick"}
+    return mutate(["clutter"], [{"count": 3, "appearance": app, **fields}])
+
+
+def _image_mimic(**fields) -> dict:
+    """A distractor mimicking target ``a``, whose appearance is an image."""
+    d = _app(pattern="image", source="skimage:coffee")
+    d["entities"][1] = {"name": "m", "role": "distractor", "mimic": "a", "depth": 3, **fields}
+    return d
+
+
+_UNUSED_CASES = [
         (_app(crop=[0, 0, 4, 4]), "entities[0].appearance.crop: not used by pattern 'solid' "
                                   "(it applies to pattern: image)"),
         (_app(pattern="stripes", fit="tile"), "entities[0].appearance.fit: not used by "
@@ -261,8 +272,38 @@ def _app(**fields) -> dict:
          "background.color: not used by kind 'noise'"),
         (mutate(["background"], {"kind": "texture", "fit": "tile"}),
          "background.fit: not used by kind 'texture' (it applies to kind: image)"),
-    ],
-)  # fmt: skip
+        # Image clutter takes its pixels from the image, not colours from the palette.
+        (_image_clutter(palette=[[0, 0, 255]]),
+         "clutter[0].palette: not used by pattern 'image' (it applies to pattern: solid | "
+         "rings | sectors | stripes | bands | checker | texture | perlin)"),
+        (_image_clutter(n_colors=2), "clutter[0].n_colors: not used by pattern 'image'"),
+        # An image has no colours to jitter.
+        (_image_mimic(color_jitter=8),
+         "entities[1].color_jitter: not used by pattern 'image' of the mimicked 'a', which "
+         "has no colours to jitter (it applies to pattern: solid | rings | sectors | "),
+        # Only a mimic is jittered or offset from its model; one with a position starts there.
+        (mutate(["entities", 0, "color_jitter"], 5),
+         "entities[0].color_jitter: not used without mimic"),
+        (mutate(["entities", 1, "mimic_offset"], [3, 0]),
+         "entities[1].mimic_offset: not used without mimic"),
+        (_image_mimic(position=[40, 30], mimic_offset=[3, 0]),
+         "entities[1].mimic_offset: not used with a position"),
+        # A free axis has no limits for a margin to move.
+        (mutate(["entities", 0, "motion", "x"], {"boundary": "free", "margin": 2}),
+         "entities[0].motion.x.margin: not used by boundary 'free' (it applies to boundary: "
+         "reflect | clamp)"),
+        (mutate(["entities", 0, "motion", "scale"], {"boundary": "free", "margin": 0.5}),
+         "entities[0].motion.scale.margin: not used by boundary 'free'"),
+        # The camera's velocity starts its x / y AR2: keyframes or no AR2 never read it.
+        (mutate(["camera"], {"keyframes": [[0, 1, 1]], "velocity": [2, 0]}),
+         "camera.velocity: the x velocity is not used without x motion"),
+        (mutate(["camera"], {"x": {"boundary": "reflect"}, "velocity": [2, 1]}),
+         "camera.velocity: the y velocity is not used without y motion"),
+]  # fmt: skip
+"""Configs with a field their scene would silently ignore, and the start of the refusal."""
+
+
+@pytest.mark.parametrize(("data", "message"), _UNUSED_CASES)
 def test_a_field_the_pattern_does_not_use_is_refused(tmp_path, capsys, data, message):
     # It was silently ignored: a crop on a solid pattern drew the solid colour.
     from scenegen.cli import main
@@ -277,6 +318,33 @@ def test_a_field_the_pattern_does_not_use_is_refused(tmp_path, capsys, data, mes
     assert len(err.splitlines()) == 1 and message in err and not (tmp_path / "o.h5").exists()
 
 
+@pytest.mark.parametrize(("data", "message"), _UNUSED_CASES)
+def test_a_stored_config_keeps_an_unused_field_ignored(data, message):
+    # A file written before a refusal existed holds such a field: reading it back must
+    # not make it invalid; every other check still applies.
+    config = from_stored(data)
+    assert from_stored(to_dict(config)) == config
+    with pytest.raises(ConfigError, match=r"^n_frames: "):
+        from_stored({**copy.deepcopy(data), "n_frames": -1})
+    with pytest.raises(ConfigError) as info:
+        from_dict(to_dict(config))  # the refusal itself is unchanged for a new config
+    assert str(info.value).startswith(message)
+
+
+def test_a_file_with_a_field_refused_since_it_was_written_stays_valid(tmp_path):
+    # As a dps-synthetic-real file written with color_jitter 6 on its image mimic.
+    from scenegen.cli import main
+
+    data = {**_image_mimic(color_jitter=8), "n_frames": 3}
+    with pytest.raises(ConfigError):
+        from_dict(data)
+    path = tmp_path / "old.h5"
+    scenegen.write(path, scenegen.generate(from_stored(data), seed=3))
+    seq = scenegen.read(path)
+    assert seq.config.entities[1].color_jitter == 8 and seq.frames.shape[0] == 3
+    assert main(["validate", "--deep", str(path)]) == 0
+
+
 def test_an_unused_field_at_its_default_and_stripe_width_are_accepted():
     # Nothing is ignored that would change the frames; the fixtures record a scaled
     # stripe_width (and background scale) on every pattern, so they stay valid.
@@ -285,6 +353,33 @@ def test_an_unused_field_at_its_default_and_stripe_width_are_accepted():
     cfg = from_dict(data)
     assert cfg.entities[0].appearance.stripe_width == 2 and cfg.background.scale == 2.0
     assert from_dict(to_dict(cfg)) == cfg
+
+
+def test_mimic_clutter_ar2_and_camera_fields_at_their_defaults_are_accepted():
+    data = _image_mimic(color_jitter=0, mimic_offset=[0, 0], position=[40, 30])
+    data["entities"][0]["color_jitter"] = 0.0
+    data["entities"][0]["motion"]["x"] = {"boundary": "free", "margin": 0}
+    data["clutter"] = _image_clutter(palette=[[255, 0, 0], [0, 160, 0], [0, 0, 255],
+                                              [255, 200, 0]], n_colors=1)["clutter"]
+    data["camera"] = {"keyframes": [[0, 1, 1]], "velocity": [0, 0]}
+    cfg = from_dict(data)
+    assert from_dict(to_dict(cfg)) == cfg
+    # A mimic of a coloured pattern is jittered and offset; clutter of a coloured
+    # pattern takes its palette; a camera AR2 its velocity.
+    data = mutate(["entities", 1], {"name": "m", "role": "distractor", "mimic": "a",
+                                    "color_jitter": 8, "mimic_offset": [3, 0], "depth": 3})
+    data["clutter"] = [{"count": 3, "palette": [[0, 0, 255]], "n_colors": 2}]
+    data["camera"] = {"x": {"boundary": "reflect"}, "velocity": [2, 0]}
+    assert from_dict(data).entities[1].color_jitter == 8.0
+
+
+def test_clutter_appearance_colors_are_tolerated_though_unused():
+    # Clutter items take their colours from the palette; the single-frame regression
+    # fixture records appearance colours on its clutter, so they are accepted (ignored).
+    data = mutate(["clutter"], [{"count": 4, "appearance": {"colors": [[1, 2, 3]]}}])
+    plain = mutate(["clutter"], [{"count": 4}])
+    a, b = scenegen.generate(data, seed=2), scenegen.generate(plain, seed=2)
+    assert np.array_equal(a.frames, b.frames)
 
 
 def test_yaml_follows_the_core_schema_of_yaml_1_2(tmp_path):

@@ -56,9 +56,11 @@ def build_config(p: dict) -> SceneConfig:
                 else None
             )
             motion = Motion(
-                # A bounded axis needs 2 x margin + size <= the side (a config error else).
+                # A bounded axis needs 2 x margin + size <= the side (a config error else);
+                # a free one has no margin (refused). The draw is kept: same scenes else.
                 x=AR2(boundary=bound, sigma=sig,
-                      margin=float(rng.uniform(0, min(3.0, (w - size[0]) / 2)))),
+                      margin=float(rng.uniform(0, min(3.0, (w - size[0]) / 2)))
+                      * (bound != "free")),
                 y=AR2(boundary=bound, a1=1.5, a2=-0.5, sigma=sig),
                 scale=scale,
                 velocity=(float(rng.uniform(-4, 4)), float(rng.uniform(-4, 4))),

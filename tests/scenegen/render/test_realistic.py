@@ -277,7 +277,8 @@ def test_camera_extent_is_bounded():
 def test_a_free_camera_axis_is_refused(axis):
     # The offset (zoom) was clipped to the extent (its limits) while the free path went on:
     # a pan at 1 px a frame stuck at the extent for good, a random walk until it came back.
-    camera = {"extent": [4, 4], axis: {"boundary": "free"}, "velocity": [1, 1]}
+    velocity = {"x": [1, 0], "y": [0, 1], "zoom": [0, 0]}[axis]  # only an AR2 axis has one
+    camera = {"extent": [4, 4], axis: {"boundary": "free"}, "velocity": velocity}
     data = {"width": 40, "height": 30, "n_frames": 20, "camera": camera}
     with pytest.raises(ConfigError, match=rf"^camera\.{axis}\.boundary: free is not allowed on "
                                           r"a camera: the view cannot go beyond"):  # fmt: skip
