@@ -31,7 +31,7 @@ bench: $(STAMP)
 
 # Mutation score of the formula modules (cosmic-ray; long, not part of `make test`).
 # MODULES: a subset (resampling particle meanshift ms-trackers sok hybrid annealed shm
-# kalman metrics stats runner summary);
+# kalman metrics mot mot-io stats runner summary motion compose ground-truth);
 # SAMPLE: mutants per module (0: all). Results in build/mutate/<module>.txt.
 MODULES ?=
 SAMPLE ?= 60
