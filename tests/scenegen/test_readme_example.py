@@ -1,7 +1,6 @@
 """The README's "Testing your own tracker with scenegen" example runs as written.
 
-The example is read from README.md once the README holds that section, else from
-docs/testing-your-tracker.md (where the section is kept).
+The section lives in README.md only (a copy in docs/ had drifted from it).
 """
 
 import re
@@ -14,9 +13,7 @@ HEADING = "Testing your own tracker with scenegen"
 
 
 def _example() -> tuple[Path, str]:
-    readme = ROOT / "README.md"
-    text = readme.read_text(encoding="utf-8") if readme.exists() else ""
-    source = readme if HEADING in text else ROOT / "docs" / "testing-your-tracker.md"
+    source = ROOT / "README.md"
     text = source.read_text(encoding="utf-8")
     section = text[text.index(HEADING) :]
     match = re.search(r"```python\n(.*?)```", section, flags=re.DOTALL)
