@@ -888,3 +888,26 @@ EQUIVALENT["ground-truth"] = [  # noqa: F821
      "never tests absent entities, and _ground_truth replaces every value computed from "
      "it (box and centre by NaN, the silhouette's pixels by the guard 1)"),
 ]
+
+# 2026-12-03, every mutant of the MOTChallenge files (scenegen/io/mot.py, key mot-io):
+_IDS_1D = ("the ids are one-dimensional (reshape(-1) in write_mot_tracker, np.array of a "
+           "sorted list in read_mot_tracker_rows): shape[-1] is shape[0]")
+EQUIVALENT["mot-io"] = [  # noqa: F821
+    ("def write_mot_tracker(path: str | Path, boxes: ArrayLike, track_ids: ArrayLike) -> int:",
+     "def write_mot_tracker(path: str & Path, boxes: ArrayLike, track_ids: ArrayLike) -> int:",
+     _ANNOTATION),
+    ("path: str | Path, n_frames: int", "path: str & Path, n_frames: int",
+     "(read_mot_tracker, read_mot_tracker_rows) " + _ANNOTATION),
+    *[(line, line.replace("ids.shape[0]", "ids.shape[ -1]"), _IDS_1D) for line in (
+        "if b.ndim != 3 or b.shape[1:] != (ids.shape[0], 4):",
+        'raise ConfigError(f"boxes {b.shape} do not fit {ids.shape[0]} track ids")',
+        "boxes = np.full((n_frames, ids.shape[0], 4), np.nan)",
+        "rank = np.full((n_frames, ids.shape[0]), -1, dtype=np.int64)",
+    )],
+    *[("if not np.isnan(boxes[t, c, 0]):", f"if not np.isnan(boxes[t, c, {i}]):",
+       "a row sets a box's four values at once, each finite (checked as it is read): all "
+       "four are NaN or none is") for i in ("1", "-1")],
+    ("ids = np.asarray(track_ids).astype(np.int64).reshape(-1)",
+     "ids = np.asarray(track_ids).astype(np.int64).reshape(- 2)",
+     "numpy reads any negative size in reshape as the one unknown dimension"),
+]

@@ -169,6 +169,20 @@ MODULES: dict[str, Module] = {
          "tests/scenegen/evaluation/test_evaluate.py"),
         _NO_SHRINK,
     ),
+    # The MOTChallenge files (scenegen/io/mot.py; ``mot`` above is the scoring): the
+    # ground-truth rows and the boxes that count in each gt_mode, the tracker file
+    # written and read back (the 1-based pixels, the row order TrackEval breaks ties by,
+    # the rows a reader refuses). check_gt_mode is argument checking; read_result_text,
+    # writable and _write_errno turn operating-system errors into one line.
+    "mot-io": Module(
+        "scenegen/io/mot.py",
+        ("_num", "visible_enough", "gt_keep", "gt_rows", "write_mot_tracker",
+         "read_mot_tracker", "check_number_text", "_integer", "read_mot_tracker_rows"),
+        ("tests/scenegen/cli/test_export_evaluate.py",
+         "tests/scenegen/evaluation/test_trackeval_oracle.py",
+         "tests/scenegen/evaluation/test_otb_oracle.py",
+         "tests/scenegen/evaluation/test_evaluate.py"),
+    ),
     "stats": Module(
         "scenegen/lab/experiments/stats.py",
         ("norm_sf", "norm_ppf", "wilson", "newcombe_diff", "newcombe_paired_diff",

@@ -10,10 +10,16 @@ import numpy as np
 import pytest
 
 from scenegen.cli import _parser, main
-from scenegen.errors import DataError
+from scenegen.errors import ConfigError, DataError
 from scenegen.io import TrackerResult, read, write_result
 from scenegen.io.benchmarks import cover_level, export_benchmark
-from scenegen.io.mot import read_mot_tracker, write_mot_tracker
+from scenegen.io.mot import (
+    gt_keep,
+    gt_rows,
+    read_mot_tracker,
+    read_mot_tracker_rows,
+    write_mot_tracker,
+)
 
 FIXTURES = Path(__file__).resolve().parents[3] / "fixtures"
 
@@ -416,3 +422,120 @@ def test_a_visibility_threshold_in_amodal_mode_is_refused(tmp_path, capsys):
     code, _, err = run(capsys, "evaluate", seq_file, txt, "--gt-mode", "visible",
                        "--visibility-threshold", "0.5")  # fmt: skip
     assert code == 0, err
+
+
+# `make mutate MODULES=mot-io` (2026-12-03, every mutant of scenegen/io/mot.py): what the
+# reader and writer do at their edges; a mutant of each survived the tests above.
+
+
+def test_tracker_rows_are_read_at_their_edges(tmp_path):
+    # A blank line in the middle, the first and last frames, frames and ids written as
+    # floats below 2**53, ids of magnitude 2**63 - 1, zero and sub-pixel sizes, columns
+    # past the sixth that are not numbers (only six are read); the rank is each row's
+    # place among its frame's rows, -1 where a track has none.
+    big, exact = 2**63 - 1, 2**53 - 1
+    path = tmp_path / "t.txt"
+    path.write_text(f"3,7,1.5,2.5,0,0.5,1,-1,-1,-1\n\n3,2,11,21,3,4,\n1.0,-{big},1,1,0.25,0\n"
+                    f"1,{exact}.0,4,5,6,7\n5,{big},1,1,2,2\n")  # fmt: skip
+    ids, boxes, rank = read_mot_tracker_rows(path, 5)
+    assert ids.tolist() == [-big, 2, 7, exact, big]
+    want = np.full((5, 5, 4), np.nan)
+    want_rank = np.full((5, 5), -1)
+    for t, c, r, box in ((2, 2, 0, [0.5, 1.5, 0, 0.5]), (2, 1, 1, [10, 20, 3, 4]),
+                         (0, 0, 0, [0, 0, 0.25, 0]), (0, 3, 1, [3, 4, 6, 7]),
+                         (4, 4, 0, [0, 0, 2, 2])):  # fmt: skip
+        want[t, c], want_rank[t, c] = box, r
+    np.testing.assert_array_equal(boxes, want)
+    np.testing.assert_array_equal(rank, want_rank)
+
+
+@pytest.mark.parametrize(("row", "why"), [
+    ("1,1,1,1,5", "fewer than 6 comma-separated columns"),
+    ("1.5,1,1,1,5,5", "frame and id must be integers"),
+    ("1,9007199254740992.0,1,1,5,5", "9007199254740992.0 is written as a float beyond "
+                                     "2**53, which is not exact; write the integer"),
+    ("1,9223372036854775808,1,1,5,5", "id beyond ±9223372036854775807"),
+    ("1,-9223372036854775808,1,1,5,5", "id beyond ±9223372036854775807"),
+    ("1,1,1,1,-0.5,5", "width and height must not be negative"),
+    ("1,1,1,1,5,-0.5", "width and height must not be negative"),
+    ("1,1,1,1e308,5,1e308", "the box's right or bottom edge overflows to infinity"),
+    ("1,1,abcdefghijklmnopqrstuvwxyz,1,5,5",
+     "'abcdefghijklmnopqrst' is not a number (ASCII digits, sign, point, exponent)"),
+    ("1,1,1,1,-5,5," + ",".join(["-1"] * 40), "width and height must not be negative"),
+])  # fmt: skip
+def test_tracker_rows_refused_at_their_edges(tmp_path, row, why):
+    path = tmp_path / "t.txt"
+    path.write_text(f"1,1,1,1,5,5\n{row}\n")
+    with pytest.raises(DataError) as err:
+        read_mot_tracker_rows(path, 5)
+    # The message quotes the row's first 80 characters.
+    assert str(err.value) == f"{path}:2: not a MOTChallenge row ({why}): {row[:80]!r}"
+
+
+def test_tracker_frame_zero_is_refused(tmp_path):
+    path = tmp_path / "t.txt"
+    path.write_text("1,1,1,1,5,5\n0,1,1,1,5,5\n")
+    with pytest.raises(DataError) as err:
+        read_mot_tracker_rows(path, 5)
+    assert str(err.value) == f"{path}:2: frame 0 is outside 1..5"
+
+
+def test_tracker_file_written_row_by_row(tmp_path):
+    # A track without a box in a frame skips its row only, not the frame's other tracks;
+    # integral values are written without ".0"; no tracks is an empty file.
+    path = tmp_path / "t.txt"
+    boxes = np.array([[[np.nan, 0, 0, 0], [0.5, 1, 2, 3]], [[-1, 2.25, 0, 1e-3], [9, 9, 9, 9]]])
+    assert write_mot_tracker(path, boxes, [4, 1]) == 3
+    assert path.read_text() == ("1,1,1.5,2,2,3,1,-1,-1,-1\n2,4,0,3.25,0,0.001,1,-1,-1,-1\n"
+                                "2,1,10,10,9,9,1,-1,-1,-1\n")  # fmt: skip
+    ids, got = read_mot_tracker(path, 2)
+    assert ids.tolist() == [1, 4]
+    want = boxes[:, ::-1].copy()
+    want[0, 1] = np.nan  # all four values, as the row is left out
+    np.testing.assert_array_equal(got, want)
+    assert write_mot_tracker(path, np.zeros((3, 0, 4)), []) == 0 and path.read_text() == ""
+    with pytest.raises(ConfigError, match=r"^MOTChallenge track ids start at 1, got 0$"):
+        write_mot_tracker(path, np.zeros((1, 2, 4)), [1, 0])
+    with pytest.raises(ConfigError, match=r"^boxes \(1, 2, 4\) do not fit 1 track ids$"):
+        write_mot_tracker(path, np.zeros((1, 2, 4)), [1])
+
+
+def test_gt_keep_counts_the_rows_gt_rows_counts():
+    # gt_keep is the (T, K) form of the conf column of gt_rows: present boxes (amodal, the
+    # default), or present boxes visible above the threshold.
+    seq = read(FIXTURES / "distractor-on-target.h5")
+    present = np.asarray(seq.gt.present, dtype=bool)
+    ids = [int(i) for i in seq.entities.id]
+    targets = np.asarray(seq.entities.role).astype(str) == "target"
+    np.testing.assert_array_equal(gt_keep(seq), present)
+    for mode, threshold in (("amodal", 0.0), ("visible", 0.0), ("visible", 0.5)):
+        keep = gt_keep(seq, mode, threshold)
+        counted = np.zeros_like(present)
+        for t in range(seq.n_frames):
+            for row in gt_rows(seq, t, mode, threshold):
+                cell = row.split(",")
+                counted[t, ids.index(int(cell[1]))] = cell[6] == "1"
+        np.testing.assert_array_equal(keep[:, targets], counted[:, targets])
+    hidden = present & ~gt_keep(seq, "visible")
+    assert hidden[:, targets].any() and not gt_keep(seq, "visible", 0.5)[~present].any()
+
+
+def test_gt_rows_keep_the_targets_after_other_entities():
+    # Entities in file order: an occluder, a distractor and a clutter entity before the
+    # target. amodal writes the target's row only, visible the rows of every MOT class
+    # (clutter has none).
+    from scenegen.config import from_dict
+    from scenegen.render.plan import generate
+
+    ents = [{"name": role, "role": role, "position": [8 + 14 * i, 20], "depth": i,
+             "appearance": {"shape": "rect", "size": [6, 6]}}
+            for i, role in enumerate(("occluder", "distractor", "clutter", "target"))]
+    seq = generate(from_dict({"width": 80, "height": 40, "n_frames": 2,
+                              "background": {"kind": "noise"}, "entities": ents}), seed=0)
+    ids = [int(i) for i in seq.entities.id]
+    for mode, want in (("amodal", [(ids[3], 1, 1)]),
+                       ("visible", [(ids[0], 0, 9), (ids[1], 0, 8), (ids[3], 1, 1)])):
+        for t in range(2):
+            got = [tuple(int(c) for c in (r.split(",")[1], r.split(",")[6], r.split(",")[7]))
+                   for r in gt_rows(seq, t, mode)]
+            assert got == want, (mode, t)
