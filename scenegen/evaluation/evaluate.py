@@ -48,7 +48,7 @@ from scenegen.evaluation.report import (
     TargetScores,
     format_table,
 )
-from scenegen.io.mot import check_gt_mode, visible_enough
+from scenegen.io.mot import check_gt_mode, gt_keep
 from scenegen.io.results import bad_box_rows, repeated_ids
 
 __all__ = [
@@ -536,9 +536,7 @@ def _report(
     multi-object scores cover the entities ``mot_rows`` (None: every target)."""
     gt_box = np.asarray(sequence.gt.box, dtype=np.float64)
     present = np.asarray(sequence.gt.present, dtype=bool)
-    keep = present.copy()
-    if gt_mode == "visible":
-        keep &= visible_enough(sequence.gt.visibility, visibility_threshold)
+    keep = gt_keep(sequence, gt_mode, visibility_threshold)
     gt_all = np.where(keep[..., None], gt_box, np.nan)
     roles = np.asarray(sequence.entities.role).astype(str)
     entity_ids = np.asarray(sequence.entities.id).astype(np.int64)
