@@ -45,7 +45,15 @@ def _parser() -> argparse.ArgumentParser:
 class _OneLineParser(argparse.ArgumentParser):
     """argparse, with a usage error as one line (the contract: an error is one line on
     stderr) that points at the verb's ``--help`` instead of printing the usage block.
-    The verbs' parsers are of this class too (``add_subparsers`` makes its own kind)."""
+    The verbs' parsers are of this class too (``add_subparsers`` makes its own kind).
+
+    Flags must be spelt in full: argparse's prefix matching would read ``--gt`` as
+    ``--gt-mode`` today and refuse it as ambiguous once another ``--gt…`` flag exists, so a
+    script that relied on it would break with a new release."""
+
+    def __init__(self, *args: object, **kwargs: object) -> None:
+        kwargs.setdefault("allow_abbrev", False)
+        super().__init__(*args, **kwargs)  # type: ignore[arg-type]
 
     def error(self, message: str) -> NoReturn:
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")

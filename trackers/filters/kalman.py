@@ -29,6 +29,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from trackers.models.dynamics import check_ar2_coefficients
+
 __all__ = ["KalmanFilter", "MotionModel"]
 
 FloatArray = NDArray[np.float64]
@@ -106,14 +108,14 @@ class MotionModel:
         position (the AR2 mean c̄ of docs/algorithms.md §1.1 is the first position); with
         ``a1 + a2 = 1`` the mean drops out. ``a1 = 2, a2 = -1`` is constant velocity with
         acceleration noise. ``P0`` treats the previous position as the current one minus a
-        velocity of std ``velocity_std``.
+        velocity of std ``velocity_std``. Explosive coefficients (a root of
+        z² − a1 z − a2 outside the unit circle) are refused, as by every tracker with AR2
+        dynamics (``trackers.models.dynamics.check_ar2_coefficients``).
         """
         _check_positive("noise_std", noise_std, allow_zero=True)
         _check_positive("position_std", position_std)
         _check_positive("velocity_std", velocity_std)
-        for name, value in (("a1", a1), ("a2", a2)):
-            if not np.isfinite(value):
-                raise ValueError(f"{name} must be finite, got {value!r}")
+        a1, a2 = check_ar2_coefficients(a1, a2)
         f = np.zeros((4, 4))
         f[0, 0] = f[1, 1] = a1
         f[0, 2] = f[1, 3] = a2

@@ -121,6 +121,20 @@ def test_usage_errors_exit_2(tmp_path, capsys):
     assert code == 2 and "does not exist" in err
 
 
+@pytest.mark.parametrize("argv", [
+    ("generate", "--preset", "kams-a", "--se", "3"),  # --seed
+    ("generate", "--pre", "kams-a"),  # --preset
+    ("export", "x.h5", "--format", "mot", "--gt", "amodal"),  # --gt-mode
+])
+def test_an_abbreviated_flag_is_a_usage_error(tmp_path, capsys, argv):
+    # Prefix matching would tie scripts to today's flag set: --gt means --gt-mode until a
+    # second --gt... flag makes it ambiguous. Flags are spelt in full or refused, exit 2.
+    code, out, err = run(capsys, *argv, "-o", tmp_path / "x")
+    assert code == 2 and out == ""
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert not (tmp_path / "x").exists()
+
+
 @pytest.mark.parametrize("verb", ["inspect", "validate"])
 def test_bad_files_exit_1(tmp_path, capsys, verb):
     junk = tmp_path / "junk.h5"

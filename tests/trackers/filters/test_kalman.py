@@ -324,3 +324,16 @@ def test_ar2_coefficients_must_be_finite(name):
     kwargs = {"a1": 2.0, "a2": -1.0, "noise_std": 1.0, name: np.nan}
     with pytest.raises(ValueError, match=f"{name} must be finite, got nan"):
         MotionModel.ar2(**kwargs)
+
+
+@pytest.mark.parametrize("a1, a2", [(2.5, -0.5), (100.0, 0.0), (0.0, 1.5), (-2.1, -1.0)])
+def test_ar2_explosive_coefficients_are_refused(a1, a2):
+    # The one definition of "explosive" (check_ar2_coefficients) holds for the building
+    # block too: the covariance of such a model grows without bound (NaN boxes).
+    with pytest.raises(ValueError, match="a1, a2 must not be explosive"):
+        MotionModel.ar2(a1=a1, a2=a2, noise_std=1.0)
+
+
+@pytest.mark.parametrize("a1, a2", [(2.0, -1.0), (0.0, 1.0), (-2.0, -1.0), (1.9, -0.9)])
+def test_ar2_coefficients_on_the_stable_boundary_are_accepted(a1, a2):
+    assert MotionModel.ar2(a1=a1, a2=a2, noise_std=1.0).F[0, 0] == a1
