@@ -373,7 +373,7 @@ def manifest_entries(
     DataError
         If the header's ``count`` or ``shard_size`` is not an integer >= 1.
     """
-    from scenegen.config import _short
+    from scenegen.config.messages import _short
 
     count, size = manifest.get("count"), manifest.get("shard_size")
     if not (_is(count, int) and _is(size, int) and count >= 1 and size >= 1):

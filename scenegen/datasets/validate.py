@@ -128,7 +128,7 @@ def _against_family(
 ) -> list[str]:
     """The sequence ``seq`` stored for entry ``e`` against the family's draw for its index,
     and ``e`` against the entry the builder makes of them (:func:`_entry`): one line each."""
-    from scenegen.config import _short
+    from scenegen.config.messages import _short
 
     try:
         d = fam.draw(e["index"], seed)

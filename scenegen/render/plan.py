@@ -27,7 +27,8 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
-from scenegen.config import Background, EntitySpec, SceneConfig, _short
+from scenegen.config import Background, EntitySpec, SceneConfig
+from scenegen.config.messages import _short
 from scenegen.errors import ConfigError
 from scenegen.render import compose as kernels
 from scenegen.render import photometric, textures

@@ -90,19 +90,14 @@ FIXTURE_NAMES = (
     "scenegen_expect",
     "scenegen_expect_distribution",
 )
-# Modules whose source decides the pixels and ground truth of a generated sequence.
+# Modules whose source decides the pixels and ground truth of a generated sequence, as
+# patterns under the package folder: a module added to config/ or render/ is covered.
 _GENERATOR_MODULES = (
-    "config.py",
+    "config/*.py",
     "io/hdf5.py",
     "io/schema.py",
     "presets.py",
-    "render/compose.py",
-    "render/draw.py",
-    "render/camera.py",
-    "render/motion.py",
-    "render/photometric.py",
-    "render/plan.py",
-    "render/textures.py",
+    "render/*.py",
     "sequence.py",
 )
 _written_key = pytest.StashKey[list[tuple[str, str]]]()
@@ -163,10 +158,22 @@ def generator_fingerprint() -> str:
 
     h = hashlib.sha256(scenegen.__version__.encode())
     folder = Path(scenegen.__file__).parent
-    for name in _GENERATOR_MODULES:
-        h.update(name.encode())
-        h.update((folder / name).read_bytes())
+    for path in _generator_sources(folder):
+        h.update(path.relative_to(folder).as_posix().encode())
+        h.update(path.read_bytes())
     return h.hexdigest()[:16]
+
+
+def _generator_sources(folder: Path) -> list[Path]:
+    """The source files of ``folder`` (scenegen's package folder) that
+    :func:`generator_fingerprint` hashes, in a fixed order."""
+    found: list[Path] = []
+    for pattern in _GENERATOR_MODULES:
+        matches = sorted(folder.glob(pattern))
+        if not matches:  # a renamed module must not silently leave the fingerprint
+            raise FileNotFoundError(f"no generator source matches {pattern!r} in {folder}")
+        found.extend(matches)
+    return found
 
 
 def cache_key(config: Any, seed: int, frames: int | None = None) -> str:

@@ -20,8 +20,9 @@ from hypothesis import strategies as st
 
 from scenegen import presets
 from scenegen.cli import main
-from scenegen.config import MAX_ALIASES, MAX_NAME, SceneConfig, _short, from_dict, load_config
+from scenegen.config import MAX_ALIASES, MAX_NAME, SceneConfig, from_dict, load_config
 from scenegen.config import to_dict as plain
+from scenegen.config.messages import _short
 from scenegen.errors import ConfigError
 
 SMALL = {
@@ -317,42 +318,42 @@ def test_a_million_list_items_are_refused_up_front(tmp_path, suffix, capsys):
 @pytest.mark.parametrize("libyaml", [True, False])
 def test_the_value_limit_is_counted_while_composing(monkeypatch, libyaml):
     # With libyaml's parser or PyYAML's own, the composer counts every node it makes.
-    import scenegen.config as config
+    from scenegen.config import files
 
     if libyaml and not yaml.__with_libyaml__:
         pytest.skip("PyYAML without libyaml")
     monkeypatch.setattr(yaml, "__with_libyaml__", libyaml)
-    monkeypatch.setattr(config, "MAX_VALUES", 50)
+    monkeypatch.setattr(files, "MAX_VALUES", 50)
     with pytest.raises(ConfigError, match="^more than 50 values"):
-        config._load_yaml("a: [" + ",".join(["1"] * 60) + "]")
-    assert config._load_yaml("a: [" + ",".join(["1"] * 40) + "]") == {"a": [1] * 40}
+        files._load_yaml("a: [" + ",".join(["1"] * 60) + "]")
+    assert files._load_yaml("a: [" + ",".join(["1"] * 40) + "]") == {"a": [1] * 40}
 
 
 def test_libyaml_and_pyyaml_parse_a_config_alike():
     # The loader parses with libyaml when PyYAML has it: the same data, the same core
     # schema scalars, merge keys and duplicate-key refusal as PyYAML's own parser.
-    import scenegen.config as config
+    from scenegen.config import files
 
     if not yaml.__with_libyaml__:
         pytest.skip("PyYAML without libyaml")
-    assert config._core_parsing_loader() is not config._yaml_core()[0]
+    assert files._core_parsing_loader() is not files._yaml_core()[0]
     text = (
         "base: &b {x: 1, on: yes, n: 010, h: 0x1f, f: 1e3, d: 2024-01-01, z: ~, t: true}\n"
         "a:\n  <<: *b\n  x: 2\n  list: [1, 'two', -3.5, .inf, null, 0o17]\n"
     )
-    fast = config._load_yaml(text)
+    fast = files._load_yaml(text)
     with pytest.MonkeyPatch.context() as m:
         m.setattr(yaml, "__with_libyaml__", False)
-        assert config._core_parsing_loader() is config._yaml_core()[0]
-        slow = config._load_yaml(text)
+        assert files._core_parsing_loader() is files._yaml_core()[0]
+        slow = files._load_yaml(text)
         with pytest.raises(ConfigError, match=r"^duplicate key 'x' \(line 2\)"):
-            config._load_yaml("x: 1\nx: 2\n")
+            files._load_yaml("x: 1\nx: 2\n")
     assert fast == slow
     assert fast["a"] == {**fast["base"], "x": 2, "list": [1, "two", -3.5, float("inf"), None, 15]}
     base = fast["base"]
     assert base["on"] == "yes" and base["n"] == 10 and base["d"] == "2024-01-01"
     with pytest.raises(ConfigError, match=r"^duplicate key 'x' \(line 2\)"):
-        config._load_yaml("x: 1\nx: 2\n")
+        files._load_yaml("x: 1\nx: 2\n")
 
 
 def test_a_million_entities_from_python_are_refused_before_they_are_read():

@@ -1,6 +1,7 @@
 """The pytest plugin as a user meets it: test files run with ``pytester``."""
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -305,3 +306,17 @@ def test_cache_key_changes_with_every_input():
     other = from_dict({**SMALL, "width": 41})
     assert cache_key(other, 0) != base
     assert len(generator_fingerprint()) == 16
+
+
+def test_the_generator_fingerprint_covers_every_config_and_render_module():
+    # A module of the config or render package decides pixels and ground truth: one added
+    # or split off (config.py became a package) must change the fingerprint with it.
+    import scenegen
+    from scenegen.testing.pytest_plugin import _generator_sources
+
+    folder = Path(scenegen.__file__).parent
+    hashed = set(_generator_sources(folder))
+    for package in ("config", "render"):
+        modules = set((folder / package).glob("*.py"))
+        assert len(modules) > 3 and modules <= hashed
+    assert {folder / "presets.py", folder / "io" / "hdf5.py", folder / "sequence.py"} <= hashed
