@@ -278,8 +278,8 @@ class AnnealedPF(Tracker):
     ``survival`` (K, n_layers) the survival rate 1 / (N Σ w²) of the normalised weights w
     each layer resampled by (or, for the last layer, returned).
 
-    Example
-    -------
+    Examples
+    --------
     >>> import trackers
     >>> tracker = trackers.make("annealed", n_particles=100, n_layers=3, rng=0)
     """

@@ -92,8 +92,8 @@ class HybridPF(Tracker):
     -----
     ``Estimate.extras``: ``confidence`` (K,) = 1 − d at the estimate.
 
-    Example
-    -------
+    Examples
+    --------
     >>> import trackers
     >>> tracker = trackers.make("hybrid", n_particles=100, rng=0)
     """

@@ -166,8 +166,8 @@ class KalmanTracker(Tracker):
     rng : Generator, int or None
         Unused by this deterministic tracker; accepted like every tracker's.
 
-    Example
-    -------
+    Examples
+    --------
     >>> import trackers
     >>> tracker = trackers.make("kalman", search_radius=12)
     """

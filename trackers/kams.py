@@ -80,8 +80,8 @@ class KAMS(AnnealedPF):
     ``Estimate.extras`` as for ``AnnealedPF``: ``confidence`` (K,) and ``beta``
     (K, n_layers).
 
-    Example
-    -------
+    Examples
+    --------
     >>> import trackers
     >>> tracker = trackers.make("kams", n_particles=40, n_layers=3, rng=0)
     """

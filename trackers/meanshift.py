@@ -187,8 +187,8 @@ class MeanShiftTracker(Tracker):
     ``Estimate.extras``: ``confidence`` (K,) = 1 − Bhattacharyya distance at the estimate
     (SOK's C_t, KAMS eq. 8) and ``n_iter`` (K,) mean-shift iterations used.
 
-    Example
-    -------
+    Examples
+    --------
     >>> import trackers
     >>> tracker = trackers.make("meanshift", max_iter=20)
     """

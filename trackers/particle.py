@@ -32,8 +32,8 @@ how far (docs/experiments.md, "DPS Table 3"). The arrays are the hook's to keep.
 Initialisation: the reference histograms are taken from the
 frame-0 boxes and every particle starts on its initial box with zero velocity.
 
-Example
--------
+Examples
+--------
 >>> import numpy as np
 >>> rng = np.random.default_rng(0)
 >>> frame = rng.integers(0, 256, (60, 80, 3), dtype=np.uint8)

@@ -249,8 +249,8 @@ min_visible, support, blur
     order_prob : ndarray of shape (L,)
         P(ordering) after the last step (also ``Estimate.extras["order_prob"]``).
 
-    Example
-    -------
+    Examples
+    --------
     >>> import trackers
     >>> tracker = trackers.make("shm", p_stay=0.8)
     """
@@ -340,8 +340,8 @@ min_visible, support, blur, p_stay, lam, mse_rate, mse_floor, evidence
     order_prob : ndarray of shape (L,)
         P(ordering) after the last step (also ``Estimate.extras["order_prob"]``).
 
-    Example
-    -------
+    Examples
+    --------
     >>> import trackers
     >>> tracker = trackers.make("shm-fast", search_radius=12)
     """

@@ -74,8 +74,8 @@ class SOK(Tracker):
     ``Estimate.extras``: ``confidence`` (K,) of the kept estimate, ``spawned`` (K,) bool,
     whether the extra trackers ran this frame.
 
-    Example
-    -------
+    Examples
+    --------
     >>> import trackers
     >>> tracker = trackers.make("sok", threshold=0.9)
     """

@@ -21,8 +21,8 @@ One module per concept, each re-exported here:
 - ``files``: reading and writing YAML/JSON files (``load_config``, ``load_data``,
   ``dump_yaml``, ``json_object``) and the limits of a file (``MAX_VALUES``, ...).
 
-Example
--------
+Examples
+--------
 >>> cfg = from_dict({
 ...     "width": 64, "height": 48, "n_frames": 10,
 ...     "entities": [{"name": "t1", "role": "target", "position": [20, 20],

@@ -232,8 +232,8 @@ class LocalPool:
         Modules the fork server imports before it forks the workers (when this process
         starts its fork server first).
 
-    Example
-    -------
+    Examples
+    --------
     >>> pool = LocalPool(2)                                 # doctest: +SKIP
     >>> fut = pool.submit(abs, -3, "taking abs(-3)")        # doctest: +SKIP
     >>> fut.result(); pool.close()                          # doctest: +SKIP

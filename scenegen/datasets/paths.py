@@ -6,8 +6,8 @@ number, or (for ``entities`` and ``clutter``) the ``name`` of an item, so
 Paths are checked against the config's dataclass types, so an unknown field names the
 valid ones.
 
-Example
--------
+Examples
+--------
 >>> from scenegen import presets
 >>> from scenegen.config import to_dict
 >>> data = to_dict(presets.get("kams-a"))

@@ -1,7 +1,7 @@
 """Reading a dataset folder lazily: by index, by a query on the drawn parameters, as samples.
 
-Example
--------
+Examples
+--------
 >>> import scenegen                                                 # doctest: +SKIP
 >>> ds = scenegen.open_dataset("data/kams")                         # doctest: +SKIP
 >>> len(ds), ds.params                                              # doctest: +SKIP

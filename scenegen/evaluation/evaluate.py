@@ -17,8 +17,8 @@ so TrackEval on the exported files gives the numbers of ``evaluate`` (see
 :mod:`scenegen.io.mot`). CLEAR MOT, identity and HOTA are scored over every target of the
 sequence (what the MOT ground-truth export holds), single-target scores per target row.
 
-Example
--------
+Examples
+--------
 >>> seq = scenegen.generate("kams-a", seed=0)                     # doctest: +SKIP
 >>> report = evaluate(seq, boxes, seq.target_ids(), tracker="kams")  # doctest: +SKIP
 >>> print(format_table(report))                                   # doctest: +SKIP
@@ -367,8 +367,8 @@ def evaluate_target(
     ConfigError
         If an option is out of range, or ``target_id`` as :func:`pick_target` says.
 
-    Example
-    -------
+    Examples
+    --------
     >>> boxes = read_benchmark_result("otb.txt", seq.n_frames, "otb")  # doctest: +SKIP
     >>> print(format_table(evaluate_target(seq, boxes, 1)))            # doctest: +SKIP
     """

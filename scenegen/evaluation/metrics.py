@@ -12,8 +12,8 @@ Frame conventions
 * Per-run aggregates take a track-state array ``state`` of shape (R, T) (runs, frames) for
   one object and return percentages, as the DPS paper reports them.
 
-Example
--------
+Examples
+--------
 >>> import numpy as np
 >>> float(iou(np.array([0, 0, 10, 10.]), np.array([5, 0, 10, 10.])))
 0.3333333333333333
@@ -484,8 +484,8 @@ def mcnemar(n_sf: int, n_fs: int) -> McNemar:
     counts are equal), and z carries the sign of N_sf − N_fs so that z > 0 means A is more
     robust than B. With no discordant pairs both are 0.
 
-    Example
-    -------
+    Examples
+    --------
     >>> m = mcnemar(10, 2)
     >>> round(m.chi2, 4), round(m.z, 4)
     (4.0833, 2.0207)

@@ -14,8 +14,8 @@ The input is :class:`MotFrames`: per frame the ground-truth and tracker ids pres
 metrics. :func:`mot_frames` builds it from box arrays, :func:`remove_distractor_matches`
 applies MOTChallenge's preprocessing (tracker boxes matched to a distractor are dropped).
 
-Example
--------
+Examples
+--------
 >>> import numpy as np
 >>> gt = np.array([[[0, 0, 10, 10.]], [[1, 0, 10, 10.]]])      # (T=2, K=1, 4)
 >>> scores = score_all(mot_frames(gt, gt))

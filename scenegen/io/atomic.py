@@ -78,8 +78,8 @@ def temp_prefix(name: str, kind: str = "tmp") -> str:
     str
         ``.NAME.KIND-PID@HOST-``; a random part follows it in the actual name.
 
-    Example
-    -------
+    Examples
+    --------
     >>> temp_prefix("a.h5").startswith(".a.h5.tmp-")
     True
     """
@@ -99,8 +99,8 @@ def temp_file_owner(path: str | Path) -> tuple[str, int, str] | None:
         The target's name, and the process and host that write(s) it; None if ``path``
         is not named like a temporary file.
 
-    Example
-    -------
+    Examples
+    --------
     >>> temp_file_owner(".a.h5.tmp-123@box-x1y2z3")
     ('a.h5', 123, 'box')
     """

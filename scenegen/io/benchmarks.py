@@ -318,8 +318,8 @@ def read_benchmark_result(
     ConfigError
         For a ``kind`` not in :data:`RESULT_KINDS`.
 
-    Example
-    -------
+    Examples
+    --------
     >>> boxes = read_benchmark_result("out/crossing_target/groundtruth_rect.txt",
     ...                               seq.n_frames)  # doctest: +SKIP
     """

@@ -17,8 +17,8 @@ raises its subclass :class:`Unsealed`, so that callers can choose what old files
 Parsing is bounded: at most :data:`MAX_BYTES`, and nesting deeper than Python's
 recursion limit, duplicate keys or NaN are refused with one line.
 
-Example
--------
+Examples
+--------
 >>> import tempfile, pathlib
 >>> p = pathlib.Path(tempfile.mkdtemp()) / "run.json"
 >>> digest = write_sealed_json(p, {"a": [1, 2.5]})

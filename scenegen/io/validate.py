@@ -88,8 +88,8 @@ def check_file(
     list of str
         Empty when the file is valid.
 
-    Example
-    -------
+    Examples
+    --------
     >>> check_file("missing.h5")
     ['missing.h5: no such file']
     """

@@ -827,8 +827,8 @@ def generate(
     Sequence
         ``frames`` (T, H, W, 3) uint8, ``labels`` (T, H, W) uint16, ``gt`` and templates.
 
-    Example
-    -------
+    Examples
+    --------
     >>> seq = generate("kams-a", seed=1)
     >>> seq.frames.shape
     (140, 240, 320, 3)

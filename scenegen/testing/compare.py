@@ -66,8 +66,8 @@ def difference(
     ValueError
         If a tolerance is negative.
 
-    Example
-    -------
+    Examples
+    --------
     >>> difference([1.0, float("nan")], [1.0, float("nan")]) is None
     True
     >>> difference([1.0, 2.5], [1.0, 2.0], atol=0.1)

@@ -43,8 +43,8 @@ failing runs (and how many more). ``check_tracker(..., report=True)`` returns a
 :class:`ConformanceReport` instead of raising; :func:`parametrize_with_checks` makes one
 pytest test per tracker and check.
 
-Example
--------
+Examples
+--------
 >>> import numpy as np
 >>> class Still:                       # a tracker that never moves its boxes
 ...     def init(self, frame, boxes):
@@ -246,8 +246,8 @@ def parametrize_with_checks(factories: Iterable[Any]) -> Any:
         (``checks`` chooses the tests made for that factory; a bad option is a
         ``ValueError`` when the tests are collected).
 
-    Example
-    -------
+    Examples
+    --------
     ::
 
         from scenegen.testing import parametrize_with_checks

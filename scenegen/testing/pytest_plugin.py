@@ -52,8 +52,8 @@ scenegen
 scenegen_tolerance(atol=0.0, rtol=0.0)
     Default tolerances of ``scenegen_expect`` in the marked test.
 
-Example
--------
+Examples
+--------
 ::
 
     def test_kams_regression(scenegen_sequence, scenegen_expect):

@@ -31,8 +31,8 @@ config is attached with ``note()`` as YAML, with the command that regenerates th
     regenerate: scenegen generate --config /tmp/scenegen-examples/scene-1a2b3c4d5e6f.yaml
     --seed 7 -o scene.h5
 
-Example
--------
+Examples
+--------
 >>> import scenegen
 >>> from hypothesis import given
 >>> from scenegen.testing.strategies import scene_configs

@@ -40,8 +40,8 @@ def uniqueness(particles: NDArray[np.floating]) -> NDArray[np.float64]:
     particles : ndarray of shape (N, K, 3)
         Particle states (u, v, a).
 
-    Example
-    -------
+    Examples
+    --------
     >>> p = np.zeros((4, 2, 3)); p[:, 1, 0] = [0.0, 1.0, 1.0, 2.0]
     >>> uniqueness(p).tolist()
     [0.25, 0.75]
@@ -62,8 +62,8 @@ def effective_dynamics(particles: NDArray[np.floating], sigma: NDArray[np.floati
         σ of the tracking dynamics per parameter; a parameter with σ = 0 gives 1 (no
         spread to lose).
 
-    Example
-    -------
+    Examples
+    --------
     >>> p = np.zeros((2, 1, 3)); p[:, 0, 0] = [0.0, 4.0]
     >>> effective_dynamics(p, [2.0, 2.0, 1.0]).tolist()
     [[1.0, 0.0, 0.0]]

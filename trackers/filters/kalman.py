@@ -10,8 +10,8 @@ that the two agree to rounding error; ``update(None)`` is a missed measurement.
 velocity, or a second-order autoregression (AR2, docs/algorithms.md §1.1), and stacks them
 block-diagonally for a joint state of several objects (SHM paper §2.2, eq. 2).
 
-Example
--------
+Examples
+--------
 >>> import numpy as np
 >>> model = MotionModel.constant_velocity(accel_std=1.0)
 >>> kf = KalmanFilter(np.zeros((3, 4)), np.tile(np.eye(4), (3, 1, 1)),

@@ -14,8 +14,8 @@ a contiguous slice of the weight vector (``sizes`` lists the slice lengths) and 
 function here resamples all groups in one vectorised pass, each group within itself and
 to its own size. One group is the usual case.
 
-Example
--------
+Examples
+--------
 >>> import numpy as np
 >>> rng = np.random.default_rng(0)
 >>> resample(np.array([0.0, 1.0, 0.0]), rng=rng).tolist()
@@ -270,8 +270,8 @@ def weighted_resample(
 ) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
     """Weighted resampling of one set: ``weighted_resample_groups`` with one group.
 
-    Example
-    -------
+    Examples
+    --------
     >>> rng = np.random.default_rng(1)
     >>> idx, w = weighted_resample(np.full(4, 0.25), np.array([1.0, 1.0, 1.0, 3.0]), rng=rng)
     >>> idx.tolist(), np.round(w * 8, 6).tolist()

@@ -5,8 +5,8 @@ them into normalised linear weights here, subtracting the largest log-weight fir
 that exp never overflows and the largest weight is exp(0) = 1 before normalising. The
 same functions normalise the SHM trackers' ordering probabilities.
 
-Example
--------
+Examples
+--------
 >>> import numpy as np
 >>> normalised_weights(np.array([0.0, np.log(3.0)])).tolist()
 [0.25, 0.75]

@@ -343,8 +343,8 @@ def mean_shift(
         For inconsistent shapes, a bin index outside ``models``' bins, an unknown kernel,
         non-positive sizes or negative ``max_iter``, ``eps`` or ``min_distance``.
 
-    Example
-    -------
+    Examples
+    --------
     A two-colour disc of radius 10 centred at (20, 20) on a background of bin 0:
 
     >>> import numpy as np

@@ -93,8 +93,8 @@ def inverse_cdf_groups(
     ndarray of shape (counts.sum(),), int64
         Indices into ``weights``, group by group; draws of group c lie in group c.
 
-    Example
-    -------
+    Examples
+    --------
     >>> inverse_cdf_groups(np.array([1.0, 3.0, 1.0, 1.0]), np.array([2, 2]),
     ...                    np.array([2, 2]), np.array([0.5, 0.5]), SYSTEMATIC).tolist()
     [1, 1, 2, 3]

@@ -54,8 +54,8 @@ def check_ar2(sigma: object, a1: object, a2: object
         ``a2`` not a finite number; ``a1, a2`` explosive (a root of z² − A1 z − A2
         outside the unit circle; :func:`check_ar2_coefficients`).
 
-    Example
-    -------
+    Examples
+    --------
     >>> check_ar2((2, 2, 0.001), 2, -1)
     ((2.0, 2.0, 0.001), 2.0, -1.0)
     >>> check_ar2((2, 2, 0.001), 3.0, -1.0)
@@ -93,8 +93,8 @@ def check_ar2_coefficients(a1: object, a2: object) -> tuple[float, float]:
         One line naming the parameter and its value: ``a1`` or ``a2`` not a finite
         number; ``a1, a2`` explosive (a root of z² − A1 z − A2 outside the unit circle).
 
-    Example
-    -------
+    Examples
+    --------
     >>> check_ar2_coefficients(1.9, -0.9)
     (1.9, -0.9)
     >>> check_ar2_coefficients(2.5, -0.5)
@@ -136,8 +136,8 @@ def boxes_from_states(states: NDArray[np.floating], sizes: NDArray[np.floating]
 
     ``sizes`` broadcasts against ``states[..., :2]`` (e.g. (K, 2) for states (N, K, 3)).
 
-    Example
-    -------
+    Examples
+    --------
     >>> boxes_from_states(np.array([[10.0, 20.0, 0.0]]), np.array([[4.0, 6.0]])).tolist()
     [[8.0, 17.0, 4.0, 6.0]]
     """
@@ -163,8 +163,8 @@ class AR2:
     ValueError
         For parameters :func:`check_ar2` refuses, naming the parameter.
 
-    Example
-    -------
+    Examples
+    --------
     >>> dyn = AR2(sigma=(0.0, 0.0, 0.0))
     >>> dyn.propagate(np.array([[3.0, 1.0, 0.0]]), np.array([[1.0, 1.0, 0.0]]),
     ...               np.zeros(3), rng=np.random.default_rng(0)).tolist()

@@ -129,8 +129,8 @@ class LayeredMatcher:
     sizes : ndarray of shape (M, 2), int64
         Template (height, width): the box's part inside frame 0.
 
-    Example
-    -------
+    Examples
+    --------
     >>> import numpy as np
     >>> frame = np.random.default_rng(0).integers(0, 256, (60, 80, 3), dtype=np.uint8)
     >>> matcher = LayeredMatcher(frame, [[10, 10, 16, 16], [40, 20, 16, 16]], step=1)

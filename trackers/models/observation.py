@@ -155,8 +155,8 @@ class ColourModel:
     references : ndarray of shape (K, dim) or None
         Reference histograms, one per object, after ``set_references``.
 
-    Example
-    -------
+    Examples
+    --------
     >>> frame = np.zeros((40, 40, 3), dtype=np.uint8); frame[10:20, 10:20] = (255, 0, 0)
     >>> model = ColourModel("rgb", lam=20.0)
     >>> model.set_references(frame, np.array([[10.0, 10.0, 10.0, 10.0]]))
@@ -351,8 +351,8 @@ class PositionModel:
     the t-th ``step`` after ``init`` scores against ``measurements[t]``. Observing more
     than T − 1 frames raises ``ValueError``.
 
-    Example
-    -------
+    Examples
+    --------
     >>> z = np.array([[[10.0, 10.0]], [[12.0, 10.0]]])         # T = 2, K = 1
     >>> model = PositionModel(z, np.eye(2))
     >>> model.set_references(np.zeros((20, 20, 3), np.uint8), np.array([[8.0, 8, 4, 4]]))

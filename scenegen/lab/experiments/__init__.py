@@ -22,8 +22,8 @@ scene's tasks in batches (the sequence is generated once and kept for the next b
 ``scenegen experiment all`` starts its workers once and hands them every experiment's tasks
 at once, so they run the next experiment while this process summarises the previous one.
 
-Example
--------
+Examples
+--------
 >>> from scenegen.lab.experiments import run_experiment
 >>> res = run_experiment("shm-depth", "out/shm", runs=2, quick=True)   # doctest: +SKIP
 """

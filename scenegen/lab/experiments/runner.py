@@ -59,8 +59,8 @@ def derive_seed(*parts: Any) -> int:
 
     The parts are joined as text, hashed with SHA-256 and fed to ``np.random.SeedSequence``.
 
-    Example
-    -------
+    Examples
+    --------
     >>> derive_seed("dps-synthetic", "dps", "lam=20.0", 3) == derive_seed(
     ...     "dps-synthetic", "dps", "lam=20.0", 3)
     True
@@ -539,8 +539,8 @@ def batches(tasks: list[Task], size: int = BATCH) -> list[list[Task]]:
     ``size``: a worker running a chunk generates its sequence once (and keeps the last few
     in memory, so the next chunk of the same scene reuses it).
 
-    Example
-    -------
+    Examples
+    --------
     >>> from scenegen.lab.experiments.definitions import get
     >>> tasks = plan_tasks(get("shm-depth"), runs=1, scenes=2, seed=0, quick=True)
     >>> [[(t.preset, t.scene) for t in b][0] for b in batches(tasks)]
