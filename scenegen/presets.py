@@ -45,29 +45,70 @@ _ORIGINAL_ORDER = ("dps-synthetic", "dps-occlusion", "kams-a", "kams-b", "kams-c
 
 def names() -> list[str]:
     """The preset names: the original seven in the contract's order, then the newer ones
-    (``dps-occlusion-2``, ``dps-dancers``, ``shm-clutter``) in definition order."""
+    (``dps-occlusion-2``, ``dps-dancers``, ``shm-clutter``) in definition order.
+
+    Returns
+    -------
+    list of str
+        The names of the papers' scenarios.
+
+    Examples
+    --------
+    >>> from scenegen import presets
+    >>> presets.names()[:3]
+    ['dps-synthetic', 'dps-occlusion', 'kams-a']
+    """
     first = [n for n in _ORIGINAL_ORDER if n in _PRESETS]
     return first + [n for n in _PRESETS if n not in _ORIGINAL_ORDER]
 
 
 def realistic_names() -> list[str]:
     """The realistic presets (real images, textures, camera motion, blur, light): kept
-    apart from :func:`names` (the papers' scenarios, each with a committed fixture)."""
+    apart from :func:`names` (the papers' scenarios, each with a committed fixture).
+
+    Returns
+    -------
+    list of str
+        Their names, in definition order.
+    """
     return list(_REALISTIC)
 
 
 def all_names() -> list[str]:
-    """:func:`names` then :func:`realistic_names`: every name :func:`get` accepts."""
+    """:func:`names` then :func:`realistic_names`: every name :func:`get` accepts.
+
+    Returns
+    -------
+    list of str
+        Every preset name.
+    """
     return names() + realistic_names()
 
 
 def get(name: str) -> SceneConfig:
     """The config of preset ``name`` (any of :func:`all_names`).
 
+    Parameters
+    ----------
+    name : str
+        The preset's name.
+
+    Returns
+    -------
+    SceneConfig
+        A new config, built on each call.
+
     Raises
     ------
     ConfigError
         For an unknown name, listing the valid ones.
+
+    Examples
+    --------
+    >>> from scenegen import presets
+    >>> config = presets.get("kams-a")
+    >>> config.width, config.height, config.n_frames
+    (320, 240, 140)
     """
     if name in _REALISTIC:
         return _REALISTIC[name]()
@@ -77,7 +118,23 @@ def get(name: str) -> SceneConfig:
 
 
 def describe(name: str) -> str:
-    """The first paragraph of the preset's docstring (what it reproduces)."""
+    """The first paragraph of the preset's docstring (what it reproduces).
+
+    Parameters
+    ----------
+    name : str
+        The preset's name (any of :func:`all_names`).
+
+    Returns
+    -------
+    str
+        The paragraph on one line (whitespace runs collapsed to one space).
+
+    Raises
+    ------
+    ConfigError
+        For an unknown name, listing the valid ones.
+    """
     get(name)
     doc = ((_PRESETS.get(name) or _REALISTIC[name]).__doc__ or "").strip()
     return " ".join(doc.split("\n\n")[0].split())

@@ -59,7 +59,24 @@ ESTIMATES = ("mean", "mode")
 
 
 def survival_rate(log_w: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Survival rate α = (Σ w)² / (N Σ w²) of each row of log-weights (K, N), shape (K,)."""
+    """Survival rate α = (Σ w)² / (N Σ w²) of each row of log-weights (K, N), shape (K,).
+
+    Parameters
+    ----------
+    log_w : ndarray of float64, shape (K, N)
+        Log-weights (unnormalised) of each target's N particles; the row's maximum is
+        subtracted before exp.
+
+    Returns
+    -------
+    ndarray of float64, shape (K,)
+        α in [1/N, 1]: 1 for equal weights, 1/N for a single non-zero weight.
+
+    Examples
+    --------
+    >>> survival_rate(np.array([[0.0, 0.0], [0.0, -np.inf]])).tolist()
+    [1.0, 0.5]
+    """
     w = np.exp(log_w - log_w.max(axis=1, keepdims=True))
     return w.sum(axis=1) ** 2 / (log_w.shape[1] * (w * w).sum(axis=1))
 
@@ -88,6 +105,8 @@ def survival_beta(log_lik: NDArray[np.float64], alpha: float) -> NDArray[np.floa
     Returns
     -------
     ndarray of shape (K,)
+        β per target, in [1e-8, 1]: 1e-8 (the smallest candidate) when even that β
+        leaves a survival rate below ``alpha``.
     """
     log_w = log_lik - log_lik.max(axis=1, keepdims=True)
     coarse = np.broadcast_to(_COARSE, (log_w.shape[0], 65))
@@ -117,6 +136,31 @@ def weighted_estimate(particles: NDArray[np.float64], weights: NDArray[np.float6
     With ``radius`` (K,), only the particles within that distance of the target's heaviest
     particle count (the weighted mean of its mode), so that a set split between the target
     and a distractor is not averaged into the empty space between them.
+
+    Parameters
+    ----------
+    particles : ndarray of float64, shape (K, N, 2)
+        Particle centres (x, y) of each target, in px.
+    weights : ndarray of float64, shape (K, N)
+        Normalised weights (each row sums to 1).
+    radius : ndarray of float64, shape (K,), optional
+        Radius in px of each target's mode around its heaviest particle; None (the
+        default): all particles.
+
+    Returns
+    -------
+    ndarray of float64, shape (K, 2)
+        The weighted mean centre of each target (with ``radius``, the weights of the
+        particles within it renormalised).
+
+    Examples
+    --------
+    >>> x = np.array([[[0.0, 0.0], [2.0, 0.0], [40.0, 0.0]]])
+    >>> w = np.array([[0.4, 0.3, 0.3]])
+    >>> weighted_estimate(x, w).round(6).tolist()
+    [[12.6, 0.0]]
+    >>> weighted_estimate(x, w, np.array([5.0])).round(6).tolist()
+    [[0.857143, 0.0]]
     """
     if radius is not None:
         best = particles[np.arange(particles.shape[0]), np.argmax(weights, axis=1)]
@@ -133,6 +177,28 @@ def resample_targets(particles: NDArray[np.float64], weights: NDArray[np.float64
 
     Each target is a group of the shared resampler (``resample_groups``), resampled
     within itself; returns the new particles (K, N, D).
+
+    Parameters
+    ----------
+    particles : ndarray of float64, shape (K, N, D)
+        Each target's particles (C-contiguous or reshapeable to (K N, D)).
+    weights : ndarray of float64, shape (K, N)
+        Non-negative weights, a positive sum per row (normalised here).
+    rng : numpy.random.Generator
+        Source of randomness.
+    method : {"multinomial", "systematic", "stratified", "residual"}
+        Resampling scheme (``trackers.filters.resampling``).
+
+    Returns
+    -------
+    ndarray of float64, shape (K, N, D)
+        The resampled particles, a new array; row k draws only from target k.
+
+    Raises
+    ------
+    ValueError
+        As ``resample_groups``: an unknown method, negative or non-finite weights, a row
+        of zero total weight.
     """
     k, n = weights.shape
     idx = resample_groups(weights.ravel(), np.full(k, n), method=method, rng=rng)
@@ -142,6 +208,12 @@ def resample_targets(particles: NDArray[np.float64], weights: NDArray[np.float64
 def check_particles(params: TrackerParams) -> None:
     """Check and store ``n_particles`` (:func:`trackers.params.check_particle_count`),
     ``lam`` (finite, > 0) and ``resampler`` (one of ``RESAMPLERS``) of ``params``.
+
+    Parameters
+    ----------
+    params : TrackerParams
+        A dataclass with fields ``n_particles``, ``lam`` and ``resampler`` (from its
+        ``__post_init__``); ``n_particles`` is stored as ``int``, ``lam`` as ``float``.
 
     Raises
     ------
@@ -158,6 +230,39 @@ class AnnealedParams(ColourParams):
     """Parameters of the annealed particle filter (documented on ``AnnealedPF``).
 
     ``sigma`` is stored as a float, or as a tuple of ``n_layers`` floats.
+
+    Parameters
+    ----------
+    kernel : {"cone", "epanechnikov"}, default "cone"
+        Histogram kernel (``ColourParams``).
+    bins : int, default 10
+        Bins per RGB channel, in [1, 32].
+    n_particles : int, default 100
+        Particles per target N, in [1, ``trackers.params.MAX_PARTICLES``].
+    n_layers : int, default 3
+        Annealing layers per frame, in [1, ``MAX_LAYERS``].
+    lam : float, default 1000.0
+        λ of the weighting function exp(−λ d²), finite and > 0.
+    sigma : float or sequence of float, default 12.0
+        Noise standard deviation in px: the first layer's (a number), or one per layer
+        (``n_layers`` numbers); finite and >= 0.
+    sigma_decay : float, default 0.5
+        Ratio between successive layers' noise when ``sigma`` is a number, in (0, 1].
+    schedule : {"adaptive", "geometric"}, default "adaptive"
+        How β is chosen for the layers before the last.
+    alpha : float, default 0.5
+        Survival rate of the adaptive schedule, in (0, 1).
+    beta_ratio : float, default 0.5
+        Ratio of the geometric schedule, in (0, 1].
+    estimate : {"mean", "mode"}, default "mean"
+        Weighted mean of all the last layer's particles, or of its main mode.
+    resampler : {"systematic", "multinomial", "stratified", "residual"}, default "systematic"
+        Resampling method (``trackers.filters.resampling``).
+
+    Raises
+    ------
+    ValueError
+        For a bad value, naming the parameter.
     """
 
     n_particles: int = 100

@@ -124,7 +124,23 @@ beyond 9.2e18 the template trackers cast coordinates to int64 with undefined res
 
 
 def as_generator(rng: RngLike) -> np.random.Generator:
-    """Turn an ``rng`` argument into a Generator (a Generator is used as is)."""
+    """Turn an ``rng`` argument into a Generator (a Generator is used as is).
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator, int or None
+        A Generator (returned as is), a non-negative seed, or None (fresh OS entropy).
+
+    Returns
+    -------
+    numpy.random.Generator
+        ``rng`` itself, or ``numpy.random.default_rng(rng)``.
+
+    Raises
+    ------
+    ValueError
+        For anything else (a negative int, a bool, a float, a string, a SeedSequence).
+    """
     if isinstance(rng, np.random.Generator):
         return rng
     if rng is None or (isinstance(rng, (int, np.integer)) and not isinstance(rng, bool)
@@ -155,6 +171,19 @@ class Estimate:
 def check_frame(frame: Any, expected_shape: tuple[int, ...] | None = None) -> NDArray[np.uint8]:
     """Validate one RGB frame and return it as a C-contiguous uint8 array (H, W, 3).
 
+    Parameters
+    ----------
+    frame : array_like of uint8, shape (H, W, 3)
+        The frame, H, W >= 1. Other dtypes are refused, not converted.
+    expected_shape : tuple of int or None, optional
+        The shape the frame must have (that of the sequence's first frame); None (the
+        default): any (H, W, 3).
+
+    Returns
+    -------
+    ndarray of uint8, shape (H, W, 3)
+        ``frame`` as a C-contiguous array (no copy when it already is one).
+
     Raises
     ------
     ValueError
@@ -181,6 +210,18 @@ def check_frame(frame: Any, expected_shape: tuple[int, ...] | None = None) -> ND
 def box_array(boxes: Any, name: str = "boxes") -> NDArray[np.float64]:
     """``boxes`` as a new float64 array (K, 4), K >= 1; one box (4,) is one row.
 
+    Parameters
+    ----------
+    boxes : array_like of float, shape (K, 4) or (4,)
+        Boxes [x, y, w, h] in px.
+    name : str, default "boxes"
+        What the error messages call ``boxes``.
+
+    Returns
+    -------
+    ndarray of float64, shape (K, 4)
+        A new array (never a view of ``boxes``); no check of the values.
+
     Raises
     ------
     ValueError
@@ -204,6 +245,18 @@ def check_boxes(boxes: Any, frame_shape: tuple[int, ...]) -> NDArray[np.float64]
 
     A box must have positive width and height, overlap the frame and have no coordinate
     or size beyond :data:`MAX_BOX_VALUE` pixels.
+
+    Parameters
+    ----------
+    boxes : array_like of float, shape (K, 4) or (4,)
+        Boxes [x, y, w, h] in px, K >= 1.
+    frame_shape : tuple of int
+        Shape of the frame, (H, W, ...), in px.
+
+    Returns
+    -------
+    ndarray of float64, shape (K, 4)
+        The boxes as a new array (see :func:`box_array`).
 
     Raises
     ------
@@ -231,6 +284,11 @@ class BaseTracker(ABC):
     Subclasses set ``name`` and implement ``_init`` and ``_step``; this class validates
     frames and boxes so that every tracker rejects bad input the same way.
 
+    A subclass with parameters sets ``Params`` to its frozen parameter dataclass
+    (``trackers.params``) and builds its parts from ``self.params`` in ``_configure``;
+    the class's signature (``help``, ``inspect.signature``) lists the fields with their
+    defaults. Fields can be read as attributes of the tracker (``tracker.n_particles``).
+
     Parameters
     ----------
     params : TrackerParams, optional (positional only)
@@ -238,20 +296,18 @@ class BaseTracker(ABC):
         its fields (``dataclasses.replace``).
     rng : numpy.random.Generator, int or None, optional
         Source of randomness, kept as ``self.rng``.
-    **kwargs
+    **kwargs : Any
         The fields of ``Params`` (see the tracker's parameter dataclass).
-
-    A subclass with parameters sets ``Params`` to its frozen parameter dataclass
-    (``trackers.params``) and builds its parts from ``self.params`` in ``_configure``;
-    the class's signature (``help``, ``inspect.signature``) lists the fields with their
-    defaults. Fields can be read as attributes of the tracker (``tracker.n_particles``).
 
     Raises
     ------
     TypeError
-        For a keyword that is not a field of ``Params``, naming it.
+        For a keyword that is not a field of ``Params``, naming it; for ``params`` that
+        is not an instance of ``Params``; for any parameter but ``rng`` when ``Params``
+        is None.
     ValueError
-        From ``Params`` for a bad value, naming the parameter.
+        From ``Params`` for a bad value, naming the parameter; for a bad ``rng``
+        (:func:`as_generator`).
     """
 
     name: ClassVar[str] = ""

@@ -26,7 +26,32 @@ __all__ = ["HybridPF", "HybridParams"]
 @dataclass(frozen=True)
 class HybridParams(MeanShiftParams):
     """Parameters of the hybrid filter: ``MeanShiftParams`` (10 iterations by default) and
-    the particle set's (documented on ``HybridPF``)."""
+    the particle set's (documented on ``HybridPF``).
+
+    Parameters
+    ----------
+    kernel : {"cone", "epanechnikov"}, default "cone"
+        Histogram kernel (``ColourParams``).
+    bins : int, default 10
+        Bins per RGB channel, in [1, 32].
+    max_iter : int, default 10
+        Mean-shift iterations per particle and frame, in [0, ``MAX_ITER``].
+    eps : float, default 0.5
+        Mean-shift stopping shift in px, >= 0.
+    n_particles : int, default 100
+        Particles per target N, in [1, ``trackers.params.MAX_PARTICLES``].
+    lam : float, default 1000.0
+        λ of the likelihood exp(−λ d²), finite and > 0.
+    sigma : float, default 8.0
+        Position noise after the constant-velocity prediction, in px, finite and >= 0.
+    resampler : {"systematic", "multinomial", "stratified", "residual"}, default "systematic"
+        Resampling method (``trackers.filters.resampling``).
+
+    Raises
+    ------
+    ValueError
+        For a bad value, naming the parameter.
+    """
 
     max_iter: int = 10
     n_particles: int = 100

@@ -85,7 +85,39 @@ def boxes_at(centres: NDArray[np.float64], sizes: NDArray[np.float64]) -> NDArra
 @dataclass(frozen=True)
 class KalmanParams(TrackerParams):
     """Motion, measurement noise and matching: the parameters of the Kalman tracker and of
-    the SHM trackers (``trackers.shm``), documented on ``KalmanTracker``."""
+    the SHM trackers (``trackers.shm``), documented on ``KalmanTracker``.
+
+    Parameters
+    ----------
+    motion : {"cv", "ar2"}, default "cv"
+        Motion model: constant velocity or AR2.
+    process_std : float, default 1.5
+        Process noise std, px/frame², in [0, ``MAX_STD``].
+    a1, a2 : float, default 2.0 and -1.0
+        AR2 coefficients, finite and not explosive (checked whatever the motion).
+    velocity_std : float, default 5.0
+        Initial velocity std, px/frame, in (0, ``MAX_STD``].
+    r_gain : float, default 0.01
+        Measurement variance per unit of mean squared difference, px²/intensity², in
+        [0, ``MAX_R``].
+    r_floor : float, default 0.5
+        Smallest measurement variance, px², in [``MIN_R_FLOOR``, ``MAX_R``].
+    search_radius : int, default 12
+        Search window half-size, px, in [1, 200].
+    step : int, default 2
+        Coarse-to-fine search stride, in [1, 8].
+    min_visible : float, default 0.25
+        Fraction of the template that must be compared for a match to count, in (0, 1].
+    support : {"box", "ellipse"}, default "ellipse"
+        Template support (``trackers.models.layered``).
+    blur : float, default 2.0
+        Gaussian pre-smoothing std, px, in [0, 20].
+
+    Raises
+    ------
+    ValueError
+        For a bad value, naming the parameter.
+    """
 
     motion: str = "cv"
     process_std: float = 1.5
@@ -134,37 +166,42 @@ class KalmanTracker(Tracker):
 
     Parameters
     ----------
-    motion : {"cv", "ar2"}
+    motion : {"cv", "ar2"}, default "cv"
         Motion model (see the module docstring).
-    process_std : float
+    process_std : float, default 1.5
         Process noise std: acceleration (cv) or AR2 noise, px/frame², in [0, 1e6].
-    a1, a2 : float
+    a1, a2 : float, default 2.0 and -1.0
         AR2 coefficients (used by ``motion="ar2"`` only, checked whatever the motion),
         not explosive: |a2| <= 1 and |a1| <= 1 − a2
         (``trackers.models.dynamics.check_ar2_coefficients``, as for the particle trackers).
-    velocity_std : float
+    velocity_std : float, default 5.0
         Initial velocity std, px/frame (objects start at rest), in (0, 1e6].
-    r_gain : float
+    r_gain : float, default 0.01
         Measurement variance per unit of mean squared difference, px²/intensity², in
         [0, 1e12].
-    r_floor : float
+    r_floor : float, default 0.5
         Smallest measurement variance, px², in [1e-6, 1e12].
-    search_radius : int
-        Search window half-size around the predicted position, px.
-    step : int
-        Coarse-to-fine search stride; 1 is exhaustive. The coarse grid of the default 2
-        is safe because of the blur (σ = 2 px smooths textures below the grid's Nyquist
-        limit; measured on ``shm-crossing``: the same errors as exhaustive search, about
-        2.5x faster); with ``blur=0`` on fine textures use 1.
-    min_visible : float
-        Fraction of the template that must be compared for a match to count.
-    support : {"box", "ellipse"}
+    search_radius : int, default 12
+        Search window half-size around the predicted position, px, in [1, 200].
+    step : int, default 2
+        Coarse-to-fine search stride, in [1, 8]; 1 is exhaustive. The coarse grid of the
+        default 2 is safe because of the blur (σ = 2 px smooths textures below the grid's
+        Nyquist limit; measured on ``shm-crossing``: the same errors as exhaustive search,
+        about 2.5x faster); with ``blur=0`` on fine textures use 1.
+    min_visible : float, default 0.25
+        Fraction of the template that must be compared for a match to count, in (0, 1].
+    support : {"box", "ellipse"}, default "ellipse"
         Template support (``trackers.models.layered``); the ellipse inscribed in the box fits
         round objects and keeps the background corners out of the match.
-    blur : float
-        Gaussian pre-smoothing of frames and templates, std in px (0 = none).
-    rng : Generator, int or None
+    blur : float, default 2.0
+        Gaussian pre-smoothing of frames and templates, std in px, in [0, 20] (0 = none).
+    rng : Generator, int or None, optional
         Unused by this deterministic tracker; accepted like every tracker's.
+
+    Notes
+    -----
+    ``Estimate.extras``: ``mse`` (K,), the mean squared difference per channel of each
+    object's match (NaN if missed).
 
     Examples
     --------

@@ -19,6 +19,43 @@ class KamsParams(AnnealedParams):
     """Parameters of KAMS: ``AnnealedParams`` with KAMS defaults, and the mean-shift loop.
 
     Documented on ``KAMS``.
+
+    Parameters
+    ----------
+    kernel : {"cone", "epanechnikov"}, default "cone"
+        Histogram kernel (``ColourParams``).
+    bins : int, default 10
+        Bins per RGB channel, in [1, 32].
+    n_particles : int, default 40
+        Particles per target N, in [1, ``trackers.params.MAX_PARTICLES``].
+    n_layers : int, default 3
+        Annealing layers per frame, in [1, ``trackers.annealed.MAX_LAYERS``].
+    lam : float, default 1000.0
+        λ of the weighting function exp(−λ d²), finite and > 0.
+    sigma : float or sequence of float, default 30.0
+        Noise standard deviation in px: the first layer's (a number), or one per layer
+        (``n_layers`` numbers); finite and >= 0.
+    sigma_decay : float, default 0.5
+        Ratio between successive layers' noise when ``sigma`` is a number, in (0, 1].
+    schedule : {"adaptive", "geometric"}, default "adaptive"
+        How β is chosen for the layers before the last.
+    alpha : float, default 0.8
+        Survival rate of the adaptive schedule, in (0, 1).
+    beta_ratio : float, default 0.5
+        Ratio of the geometric schedule, in (0, 1].
+    estimate : {"mean", "mode"}, default "mean"
+        Weighted mean of all the last layer's particles, or of its main mode.
+    resampler : {"systematic", "multinomial", "stratified", "residual"}, default "systematic"
+        Resampling method (``trackers.filters.resampling``).
+    max_iter : int, default 20
+        Mean-shift iterations per particle and layer, in [0, ``MAX_ITER``].
+    eps : float, default 0.5
+        Mean-shift stopping shift in px, >= 0.
+
+    Raises
+    ------
+    ValueError
+        For a bad value, naming the parameter.
     """
 
     n_particles: int = 40
@@ -70,15 +107,31 @@ class KAMS(AnnealedPF):
         kams-d, with jumps beyond 50 px in most sequences). Measured on kams-d, seeds
         0–19, runs tracked to the end with 40 particles and max_iter 20: 16/20 at 30, 11/20
         at 40, 13/20 at 30 with 4 layers, 3/20 at 12 (the annealed filter's default).
-    n_layers, lam, sigma_decay, schedule, beta_ratio, estimate, resampler
+    n_layers : int, default 3
         As for ``AnnealedPF``.
-    kernel, bins, rng
+    lam : float, default 1000.0
+        As for ``AnnealedPF``.
+    sigma_decay : float, default 0.5
+        As for ``AnnealedPF``.
+    schedule : {"adaptive", "geometric"}, default "adaptive"
+        As for ``AnnealedPF``.
+    beta_ratio : float, default 0.5
+        As for ``AnnealedPF``.
+    estimate : {"mean", "mode"}, default "mean"
+        As for ``AnnealedPF``.
+    resampler : str, default "systematic"
+        As for ``AnnealedPF``.
+    kernel : {"cone", "epanechnikov"}, default "cone"
+        As for ``AnnealedPF``.
+    bins : int, default 10
+        As for ``AnnealedPF``.
+    rng : Generator, int or None, optional
         As for ``AnnealedPF``.
 
     Notes
     -----
-    ``Estimate.extras`` as for ``AnnealedPF``: ``confidence`` (K,) and ``beta``
-    (K, n_layers).
+    ``Estimate.extras`` as for ``AnnealedPF``: ``confidence`` (K,), ``beta``
+    (K, n_layers) and ``survival`` (K, n_layers).
 
     Examples
     --------

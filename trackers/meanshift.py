@@ -47,7 +47,29 @@ __all__ = [
 def colour_model(frame: NDArray[np.uint8], boxes: NDArray[np.float64],
                  params: ColourParams, *, lam: float = 20.0) -> ColourModel:
     """The family's colour model: ``ColourModel("rgb")`` of one part with the templates of
-    ``boxes`` (K, 4) in ``frame`` (H, W, 3)."""
+    ``boxes`` (K, 4) in ``frame`` (H, W, 3).
+
+    Parameters
+    ----------
+    frame : ndarray of uint8, shape (H, W, 3)
+        The frame the templates are taken from (RGB).
+    boxes : ndarray of float64, shape (K, 4)
+        One box [x, y, w, h] per target, in px.
+    params : ColourParams
+        ``kernel`` and ``bins`` of the model.
+    lam : float, default 20.0
+        λ of the model's likelihood exp(−λ d²), > 0.
+
+    Returns
+    -------
+    ColourModel
+        The model, its references (K, bins³) set.
+
+    Raises
+    ------
+    ValueError
+        For a ``lam`` that is not a finite number > 0.
+    """
     model = ColourModel("rgb", bins=params.bins, n_parts=1, kernel=params.kernel, lam=lam)
     model.set_references(frame, boxes)
     return model
@@ -55,14 +77,47 @@ def colour_model(frame: NDArray[np.uint8], boxes: NDArray[np.float64],
 
 def window_boxes(centres: NDArray[np.float64], sizes: NDArray[np.float64]
                  ) -> NDArray[np.float64]:
-    """Boxes (K, N, 4) of per-object sets of centres (K, N, 2), sizes (K, 2) per object."""
+    """Boxes (K, N, 4) of per-object sets of centres (K, N, 2), sizes (K, 2) per object.
+
+    Parameters
+    ----------
+    centres : ndarray of float64, shape (K, N, 2)
+        Window centres (x, y) in px, N per object.
+    sizes : ndarray of float64, shape (K, 2)
+        Window (w, h) of each object, in px.
+
+    Returns
+    -------
+    ndarray of float64, shape (K, N, 4)
+        Boxes [x - w/2, y - h/2, w, h], in px.
+
+    Examples
+    --------
+    >>> window_boxes(np.array([[[10.0, 20.0]]]), np.array([[4.0, 6.0]])).tolist()
+    [[[8.0, 17.0, 4.0, 6.0]]]
+    """
     size = np.broadcast_to(sizes[:, None, :], centres.shape)
     return np.concatenate([centres - 0.5 * size, size], axis=-1)
 
 
 def set_log_likelihoods(obs: FrameObservation, centres: NDArray[np.float64],
                         sizes: NDArray[np.float64]) -> NDArray[np.float64]:
-    """log w = −λ d² (K, N) of windows at per-object centres (K, N, 2), in one call."""
+    """log w = −λ d² (K, N) of windows at per-object centres (K, N, 2), in one call.
+
+    Parameters
+    ----------
+    obs : FrameObservation
+        The frame seen through the family's colour model (``ColourModel.observe``).
+    centres : ndarray of float64, shape (K, N, 2)
+        Window centres (x, y) in px, N per object, object k's windows in row k.
+    sizes : ndarray of float64, shape (K, 2)
+        Window (w, h) of each object, in px.
+
+    Returns
+    -------
+    ndarray of float64, shape (K, N)
+        −λ d², d the Bhattacharyya distance of each window to its object's template.
+    """
     k, n = centres.shape[:2]
     return obs.log_likelihoods(window_boxes(centres, sizes).reshape(k * n, 4),
                                np.repeat(np.arange(k), n)).reshape(k, n)
@@ -70,7 +125,22 @@ def set_log_likelihoods(obs: FrameObservation, centres: NDArray[np.float64],
 
 def set_distances(obs: FrameObservation, centres: NDArray[np.float64],
                   sizes: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Bhattacharyya distances (K, N) of windows at per-object centres (K, N, 2)."""
+    """Bhattacharyya distances (K, N) of windows at per-object centres (K, N, 2).
+
+    Parameters
+    ----------
+    obs : FrameObservation
+        The frame seen through the family's colour model (``ColourModel.observe``).
+    centres : ndarray of float64, shape (K, N, 2)
+        Window centres (x, y) in px, N per object, object k's windows in row k.
+    sizes : ndarray of float64, shape (K, 2)
+        Window (w, h) of each object, in px.
+
+    Returns
+    -------
+    ndarray of float64, shape (K, N)
+        Distance d in [0, 1] of each window to its object's template.
+    """
     k, n = centres.shape[:2]
     return obs.distances(window_boxes(centres, sizes).reshape(k * n, 4),
                          np.repeat(np.arange(k), n)).reshape(k, n)
@@ -84,6 +154,33 @@ def set_mean_shift(obs: FrameObservation, centres: NDArray[np.float64],
     ``which`` (K',) lists the objects the rows of ``centres`` belong to (default: all K,
     in order); ``sizes`` (K, 2) are every object's window sizes. Returns the converged
     centres (K', N, 2), their Bhattacharyya distances (K', N) and the shifts used (K', N).
+
+    Parameters
+    ----------
+    obs : FrameObservation
+        The frame seen through the family's colour model (one part, a kernel of
+        ``MEAN_SHIFT_KERNELS``).
+    centres : ndarray of float64, shape (K', N, 2)
+        Start centres (x, y) in px, N per row.
+    sizes : ndarray of float64, shape (K, 2)
+        Window (w, h) of every object, in px.
+    max_iter : int
+        Largest number of shifts per window.
+    eps : float
+        Stop when a shift moves the window by less than ``eps`` px.
+    which : ndarray of int, shape (K',), optional
+        Object index of each row of ``centres``; None (the default): ``arange(K)``.
+
+    Returns
+    -------
+    MeanShiftResult
+        ``centres`` (K', N, 2), ``distances`` (K', N) and ``n_iter`` (K', N).
+
+    Raises
+    ------
+    ValueError
+        From ``FrameObservation.mean_shift``, for a model of several parts or a kernel
+        without a mean-shift shadow.
     """
     k, n = centres.shape[:2]
     rows = np.arange(k) if which is None else np.asarray(which)
@@ -94,7 +191,20 @@ def set_mean_shift(obs: FrameObservation, centres: NDArray[np.float64],
 
 
 def check_kernel_bins(kernel: str, bins: int) -> None:
-    """Raise ``ValueError`` for an unknown kernel name or a bin count outside [1, 32]."""
+    """Raise ``ValueError`` for an unknown kernel name or a bin count outside [1, 32].
+
+    Parameters
+    ----------
+    kernel : str
+        A name of ``MEAN_SHIFT_KERNELS`` (``"epanechnikov"``, ``"cone"``).
+    bins : int
+        Bins per RGB channel, an integer (or integral float) in [1, 32]; not a bool.
+
+    Raises
+    ------
+    ValueError
+        Naming the parameter and its value.
+    """
     if not isinstance(kernel, str) or kernel not in MEAN_SHIFT_KERNELS:
         raise ValueError(f"unknown kernel {kernel!r}; valid kernels: "
                          f"{', '.join(MEAN_SHIFT_KERNELS)}")
@@ -104,7 +214,20 @@ def check_kernel_bins(kernel: str, bins: int) -> None:
 
 def check_mean_shift(max_iter: int, eps: float) -> None:
     """Raise ``ValueError`` for a ``max_iter`` that is not an integer in [0, MAX_ITER] or an
-    ``eps`` that is not a finite number >= 0."""
+    ``eps`` that is not a finite number >= 0.
+
+    Parameters
+    ----------
+    max_iter : int
+        Mean-shift iterations, an integer (or integral float) in [0, ``MAX_ITER``].
+    eps : float
+        Stopping shift in px, a finite number >= 0 (not a bool).
+
+    Raises
+    ------
+    ValueError
+        Naming the parameter and its value.
+    """
     if not _whole(max_iter, 0, MAX_ITER):
         raise ValueError(f"max_iter must be an integer in [0, {MAX_ITER}], got {max_iter!r}")
     ok = not isinstance(eps, bool) and isinstance(eps, (int, float, np.integer, np.floating))
@@ -124,7 +247,15 @@ def _whole(value: object, low: int, high: int) -> bool:
 
 
 def keep_inside(centres: NDArray[np.float64], frame_shape: tuple[int, ...]) -> None:
-    """Clip centres (..., 2) into the frame in place, so windows never leave it entirely."""
+    """Clip centres (..., 2) into the frame in place, so windows never leave it entirely.
+
+    Parameters
+    ----------
+    centres : ndarray of float64, shape (..., 2)
+        Centres (x, y) in px; x is clipped to [0, W] and y to [0, H], in place.
+    frame_shape : tuple of int
+        Shape of the frame, (H, W, ...).
+    """
     np.clip(centres[..., 0], 0.0, frame_shape[1], out=centres[..., 0])
     np.clip(centres[..., 1], 0.0, frame_shape[0], out=centres[..., 1])
 
@@ -155,10 +286,19 @@ class MeanShiftParams(ColourParams):
 
     Parameters
     ----------
+    kernel : {"cone", "epanechnikov"}, default "cone"
+        Histogram kernel (``ColourParams``).
+    bins : int, default 10
+        Bins per RGB channel, in [1, 32] (``ColourParams``).
     max_iter : int, optional
         Maximum mean-shift iterations per start point and frame (Comaniciu et al. use 20).
     eps : float, optional
         Stop when a shift moves the window by less than ``eps`` pixels (>= 0).
+
+    Raises
+    ------
+    ValueError
+        For a bad value, naming the parameter.
     """
 
     max_iter: int = 20
@@ -179,8 +319,25 @@ class MeanShiftTracker(Tracker):
     all targets run in one compiled call. Deterministic: ``rng`` is accepted for the common
     protocol and not used.
 
-    Parameters: ``MeanShiftParams`` (kernel, bins, max_iter, eps) as keywords, and
-    ``rng`` (unused: the tracker is deterministic).
+    The parameters are the fields of ``MeanShiftParams``, and ``rng``.
+
+    Parameters
+    ----------
+    kernel : {"cone", "epanechnikov"}, default "cone"
+        Histogram kernel.
+    bins : int, default 10
+        Bins per RGB channel, in [1, 32].
+    max_iter : int, default 20
+        Maximum mean-shift iterations per target and frame, in [0, ``MAX_ITER``].
+    eps : float, default 0.5
+        Stop when a shift moves the window by less than ``eps`` px (>= 0).
+    rng : Generator, int or None, optional
+        Unused (the tracker is deterministic).
+
+    Attributes
+    ----------
+    centres : ndarray of shape (K, 2)
+        The targets' window centres (x, y) after the last step, in px.
 
     Notes
     -----

@@ -77,6 +77,18 @@ def check_integer(params: TrackerParams, name: str, *, low: int | None = None,
 
     With ``optional``, None is accepted as is.
 
+    Parameters
+    ----------
+    params : TrackerParams
+        The dataclass being validated (from its ``__post_init__``); the field is replaced
+        by its ``int`` value in place.
+    name : str
+        Name of the field.
+    low, high : int or None, optional
+        Inclusive bounds; None (the default) leaves that side unbounded.
+    optional : bool, default False
+        Accept None.
+
     Raises
     ------
     ValueError
@@ -103,6 +115,11 @@ def check_integer(params: TrackerParams, name: str, *, low: int | None = None,
 def check_particle_count(params: TrackerParams) -> None:
     """Check ``n_particles``: an integer in [1, :data:`MAX_PARTICLES`], stored as ``int``.
 
+    Parameters
+    ----------
+    params : TrackerParams
+        A dataclass with an ``n_particles`` field (from its ``__post_init__``).
+
     Raises
     ------
     ValueError
@@ -117,6 +134,20 @@ def check_number(params: TrackerParams, name: str, *, low: float | None = None,
     """Check that field ``name`` is a finite number in its interval and store it as ``float``.
 
     ``low``/``high`` bound the interval, closed unless ``low_open``/``high_open``.
+    The value is converted with ``float()`` (so a numeric string such as ``"30"`` is
+    accepted); booleans, unconvertible values and NaN/inf are rejected.
+
+    Parameters
+    ----------
+    params : TrackerParams
+        The dataclass being validated (from its ``__post_init__``); the field is replaced
+        by its ``float`` value in place.
+    name : str
+        Name of the field.
+    low, high : float or None, optional
+        Bounds of the interval; None (the default) leaves that side unbounded.
+    low_open, high_open : bool, default False
+        Exclude ``low`` (``high``) itself from the interval.
 
     Raises
     ------
@@ -152,6 +183,17 @@ def check_number(params: TrackerParams, name: str, *, low: float | None = None,
 def check_choice(params: TrackerParams, name: str, valid: Iterable[str], *,
                  what: str | None = None) -> None:
     """Check that field ``name`` is one of ``valid``.
+
+    Parameters
+    ----------
+    params : TrackerParams
+        The dataclass being validated (from its ``__post_init__``); left unchanged.
+    name : str
+        Name of the field.
+    valid : iterable of str
+        The accepted values.
+    what : str or None, optional
+        What the value is called in the error message; None (the default): ``name``.
 
     Raises
     ------

@@ -125,7 +125,25 @@ RESAMPLE_SCOPES: tuple[str, ...] = ("joint", "placed")
 
 
 def circular_shift(n_objects: int, k: int) -> NDArray[np.int64]:
-    """The k-th circular shift (k, k+1, …, M−1, 0, …, k−1) of the objects 0…M−1."""
+    """The k-th circular shift (k, k+1, …, M−1, 0, …, k−1) of the objects 0…M−1.
+
+    Parameters
+    ----------
+    n_objects : int
+        M, the number of objects (>= 1).
+    k : int
+        The shift; taken modulo M.
+
+    Returns
+    -------
+    ndarray of int64, shape (M,)
+        The ordering, (k + i) mod M for i = 0 … M−1.
+
+    Examples
+    --------
+    >>> circular_shift(4, 1).tolist()
+    [1, 2, 3, 0]
+    """
     return (np.arange(n_objects) + k) % n_objects
 
 
@@ -200,6 +218,29 @@ class PartitionedParams(ParticleParams):
 
     Parameters
     ----------
+    n_particles : int, default 300
+        N, particles of the whole set, in [1, ``trackers.params.MAX_PARTICLES``].
+    lam : float, default 20.0
+        λ of the likelihood exp(−λ d²), finite and > 0.
+    model : {"hsv", "rgb"}, default "hsv"
+        Colour-histogram observation model (``trackers.models.observation``).
+    bins : int, default 10
+        Histogram bins per colour channel, in [1, 256].
+    n_parts : int or None, default None
+        Spatial components (horizontal bands) of a region; None: the model's default.
+    kernel : {"uniform", "epanechnikov", "cone", "box"} or None, default None
+        Kernel weighting the pixels of a region; None: the model's default.
+    box_levels : int, default 3
+        Levels of the "box" kernel (nested rectangles), in [1, 16].
+    sigma : tuple of 3 float, default (2.0, 2.0, 0.001)
+        (σ_u, σ_v, σ_a) of the AR2 tracking dynamics: px, px and log scale per frame.
+    a1, a2 : float, default 2.0 and -1.0
+        AR2 coefficients, not explosive (``trackers.models.dynamics.check_ar2``).
+    resampler : {"systematic", "multinomial", "stratified", "residual"}, default "systematic"
+        Resampling scheme of every (weighted) resampling step.
+    observation : ObservationModel or None, default None
+        Replaces the colour-histogram model built from ``lam``, ``model``, ``bins``,
+        ``n_parts``, ``kernel`` and ``box_levels`` (then unused).
     weighting : {"stage", "placed", "g-only"}, optional
         **(open)** The weighting function g_j of stage j's weighted resampling, which
         draws ancestors ∝ π g_j with π the weights carried from stage j − 1 (∝ 1 / g_{j−1})
@@ -223,6 +264,11 @@ class PartitionedParams(ParticleParams):
         their own. Valid because the objects are independent a priori and in the
         likelihood, and every step starts from an equally weighted set; then the object
         sampled last is resampled once per step and the first M times.
+
+    Raises
+    ------
+    ValueError
+        For a bad value, naming the parameter.
     """
 
     weighting: str = "stage"
@@ -240,10 +286,44 @@ class PSParams(PartitionedParams):
 
     Parameters
     ----------
+    n_particles : int, default 300
+        N, particles of the whole set, in [1, ``trackers.params.MAX_PARTICLES``].
+    lam : float, default 20.0
+        λ of the likelihood exp(−λ d²), finite and > 0.
+    model : {"hsv", "rgb"}, default "hsv"
+        Colour-histogram observation model (``trackers.models.observation``).
+    bins : int, default 10
+        Histogram bins per colour channel, in [1, 256].
+    n_parts : int or None, default None
+        Spatial components (horizontal bands) of a region; None: the model's default.
+    kernel : {"uniform", "epanechnikov", "cone", "box"} or None, default None
+        Kernel weighting the pixels of a region; None: the model's default.
+    box_levels : int, default 3
+        Levels of the "box" kernel (nested rectangles), in [1, 16].
+    sigma : tuple of 3 float, default (2.0, 2.0, 0.001)
+        (σ_u, σ_v, σ_a) of the AR2 tracking dynamics: px, px and log scale per frame.
+    a1, a2 : float, default 2.0 and -1.0
+        AR2 coefficients, not explosive (``trackers.models.dynamics.check_ar2``).
+    resampler : {"systematic", "multinomial", "stratified", "residual"}, default "systematic"
+        Resampling scheme of every (weighted) resampling step.
+    observation : ObservationModel or None, default None
+        Replaces the colour-histogram model built from ``lam``, ``model``, ``bins``,
+        ``n_parts``, ``kernel`` and ``box_levels`` (then unused).
+    weighting : {"stage", "placed", "g-only"}, default "stage"
+        The weighting function of the weighted resampling stages (``PartitionedParams``).
+    resample_scope : {"joint", "placed"}, default "joint"
+        What a stage's weighted resampling copies from the drawn ancestor
+        (``PartitionedParams``).
     ordering : int or tuple of int, optional
         The order in which objects are sampled: an int k is the k-th circular shift
         (k, k+1, …, K−1, 0, …, k−1) of the targets (0 ≤ k < K; the paper's orderings),
-        a sequence is an explicit permutation of 0…K−1 (stored as a tuple).
+        a sequence is an explicit permutation of 0…K−1 (stored as a tuple). Checked
+        against K at ``init``.
+
+    Raises
+    ------
+    ValueError
+        For a bad value, naming the parameter.
     """
 
     ordering: int | tuple[int, ...] = 0
@@ -278,6 +358,34 @@ class DPSParams(PartitionedParams):
 
     Parameters
     ----------
+    n_particles : int, default 300
+        N, particles of the whole set, in [1, ``trackers.params.MAX_PARTICLES``].
+    lam : float, default 20.0
+        λ of the likelihood exp(−λ d²), finite and > 0.
+    model : {"hsv", "rgb"}, default "hsv"
+        Colour-histogram observation model (``trackers.models.observation``).
+    bins : int, default 10
+        Histogram bins per colour channel, in [1, 256].
+    n_parts : int or None, default None
+        Spatial components (horizontal bands) of a region; None: the model's default.
+    kernel : {"uniform", "epanechnikov", "cone", "box"} or None, default None
+        Kernel weighting the pixels of a region; None: the model's default.
+    box_levels : int, default 3
+        Levels of the "box" kernel (nested rectangles), in [1, 16].
+    sigma : tuple of 3 float, default (2.0, 2.0, 0.001)
+        (σ_u, σ_v, σ_a) of the AR2 tracking dynamics: px, px and log scale per frame.
+    a1, a2 : float, default 2.0 and -1.0
+        AR2 coefficients, not explosive (``trackers.models.dynamics.check_ar2``).
+    resampler : {"systematic", "multinomial", "stratified", "residual"}, default "systematic"
+        Resampling scheme of every (weighted) resampling step.
+    observation : ObservationModel or None, default None
+        Replaces the colour-histogram model built from ``lam``, ``model``, ``bins``,
+        ``n_parts``, ``kernel`` and ``box_levels`` (then unused).
+    weighting : {"stage", "placed", "g-only"}, default "stage"
+        The weighting function of the weighted resampling stages (``PartitionedParams``).
+    resample_scope : {"joint", "placed"}, default "joint"
+        What a stage's weighted resampling copies from the drawn ancestor
+        (``PartitionedParams``).
     n_groups : int or None, optional
         C, the number of mixture components, in [1, n_particles]; None: one per target
         (the paper's C = M).
@@ -287,6 +395,11 @@ class DPSParams(PartitionedParams):
         The components' mixture weights at reassembly: "evidence" (π_c,t ∝ π_c,t−1 times
         the component's evidence, Vermaak et al.) or "prior" (π_c,t = π_c,t−1, each
         component keeps its share; ``DistributedPartitionedSampling``).
+
+    Raises
+    ------
+    ValueError
+        For a bad value, naming the parameter.
     """
 
     n_groups: int | None = None
@@ -370,6 +483,41 @@ class Condensation(_ParticleTracker):
 
     After a step ``weights`` has shape (N, K): column k weights target k's filter.
     Parameters: ``ParticleParams`` as keywords, and ``rng``.
+
+    Parameters
+    ----------
+    n_particles : int, default 300
+        N, particles per target, in [1, ``trackers.params.MAX_PARTICLES``].
+    lam : float, default 20.0
+        λ of the likelihood exp(−λ d²), finite and > 0.
+    model : {"hsv", "rgb"}, default "hsv"
+        Colour-histogram observation model (``trackers.models.observation``).
+    bins : int, default 10
+        Histogram bins per colour channel, in [1, 256].
+    n_parts : int or None, default None
+        Spatial components (horizontal bands) of a region; None: the model's default.
+    kernel : {"uniform", "epanechnikov", "cone", "box"} or None, default None
+        Kernel weighting the pixels of a region; None: the model's default.
+    box_levels : int, default 3
+        Levels of the "box" kernel (nested rectangles), in [1, 16].
+    sigma : tuple of 3 float, default (2.0, 2.0, 0.001)
+        (σ_u, σ_v, σ_a) of the AR2 tracking dynamics: px, px and log scale per frame.
+    a1, a2 : float, default 2.0 and -1.0
+        AR2 coefficients, not explosive (``trackers.models.dynamics.check_ar2``).
+    resampler : {"systematic", "multinomial", "stratified", "residual"}, default "systematic"
+        Resampling scheme of every (weighted) resampling step.
+    observation : ObservationModel or None, default None
+        Replaces the colour-histogram model built from ``lam``, ``model``, ``bins``,
+        ``n_parts``, ``kernel`` and ``box_levels`` (then unused).
+    rng : Generator, int or None, optional
+        Source of all randomness; the same seed gives the same track.
+
+    Attributes
+    ----------
+    particles : ndarray of shape (N, K, 3)
+        Particle states (u, v, a) after the last step.
+    weights : ndarray of shape (N, K)
+        Normalised weights; each column sums to 1.
     """
 
     name = "condensation"
@@ -407,6 +555,41 @@ class JointPF(_ParticleTracker):
     Resample the joint set, propagate every object, weight by Π_i p(Z | X_i). The
     likelihoods of all N × K candidate boxes come from one kernel call.
     Parameters: ``ParticleParams`` as keywords, and ``rng``.
+
+    Parameters
+    ----------
+    n_particles : int, default 300
+        N, particles of the whole set, in [1, ``trackers.params.MAX_PARTICLES``].
+    lam : float, default 20.0
+        λ of the likelihood exp(−λ d²), finite and > 0.
+    model : {"hsv", "rgb"}, default "hsv"
+        Colour-histogram observation model (``trackers.models.observation``).
+    bins : int, default 10
+        Histogram bins per colour channel, in [1, 256].
+    n_parts : int or None, default None
+        Spatial components (horizontal bands) of a region; None: the model's default.
+    kernel : {"uniform", "epanechnikov", "cone", "box"} or None, default None
+        Kernel weighting the pixels of a region; None: the model's default.
+    box_levels : int, default 3
+        Levels of the "box" kernel (nested rectangles), in [1, 16].
+    sigma : tuple of 3 float, default (2.0, 2.0, 0.001)
+        (σ_u, σ_v, σ_a) of the AR2 tracking dynamics: px, px and log scale per frame.
+    a1, a2 : float, default 2.0 and -1.0
+        AR2 coefficients, not explosive (``trackers.models.dynamics.check_ar2``).
+    resampler : {"systematic", "multinomial", "stratified", "residual"}, default "systematic"
+        Resampling scheme of every (weighted) resampling step.
+    observation : ObservationModel or None, default None
+        Replaces the colour-histogram model built from ``lam``, ``model``, ``bins``,
+        ``n_parts``, ``kernel`` and ``box_levels`` (then unused).
+    rng : Generator, int or None, optional
+        Source of all randomness; the same seed gives the same track.
+
+    Attributes
+    ----------
+    particles : ndarray of shape (N, K, 3)
+        Particle states (u, v, a) of the joint set after the last step.
+    weights : ndarray of shape (N,)
+        Normalised weights of the joint set; they sum to 1.
     """
 
     name = "joint-pf"
@@ -575,6 +758,55 @@ class PartitionedSampling(_Partitioned):
 
     Parameters: ``PSParams`` (``ordering`` and the ``ParticleParams``) as keywords, and
     ``rng``.
+
+    Parameters
+    ----------
+    n_particles : int, default 300
+        N, particles of the whole set, in [1, ``trackers.params.MAX_PARTICLES``].
+    lam : float, default 20.0
+        λ of the likelihood exp(−λ d²), finite and > 0.
+    model : {"hsv", "rgb"}, default "hsv"
+        Colour-histogram observation model (``trackers.models.observation``).
+    bins : int, default 10
+        Histogram bins per colour channel, in [1, 256].
+    n_parts : int or None, default None
+        Spatial components (horizontal bands) of a region; None: the model's default.
+    kernel : {"uniform", "epanechnikov", "cone", "box"} or None, default None
+        Kernel weighting the pixels of a region; None: the model's default.
+    box_levels : int, default 3
+        Levels of the "box" kernel (nested rectangles), in [1, 16].
+    sigma : tuple of 3 float, default (2.0, 2.0, 0.001)
+        (σ_u, σ_v, σ_a) of the AR2 tracking dynamics: px, px and log scale per frame.
+    a1, a2 : float, default 2.0 and -1.0
+        AR2 coefficients, not explosive (``trackers.models.dynamics.check_ar2``).
+    resampler : {"systematic", "multinomial", "stratified", "residual"}, default "systematic"
+        Resampling scheme of every (weighted) resampling step.
+    observation : ObservationModel or None, default None
+        Replaces the colour-histogram model built from ``lam``, ``model``, ``bins``,
+        ``n_parts``, ``kernel`` and ``box_levels`` (then unused).
+    weighting : {"stage", "placed", "g-only"}, default "stage"
+        The weighting function of the weighted resampling stages (``PartitionedParams``).
+    resample_scope : {"joint", "placed"}, default "joint"
+        What a stage's weighted resampling copies from the drawn ancestor
+        (``PartitionedParams``).
+    ordering : int or tuple of int, default 0
+        The order in which objects are sampled: the k-th circular shift, or an explicit
+        permutation of the K targets (``PSParams``).
+    rng : Generator, int or None, optional
+        Source of all randomness; the same seed gives the same track.
+
+    Attributes
+    ----------
+    particles : ndarray of shape (N, K, 3)
+        Particle states (u, v, a) of the joint set after the last step.
+    weights : ndarray of shape (N,)
+        Normalised weights of the joint set; they sum to 1.
+
+    Raises
+    ------
+    ValueError
+        For a bad parameter value; at ``init``, for an ``ordering`` that is not a
+        circular shift in [0, K) or a permutation of the K targets.
     """
 
     name = "ps"
@@ -629,6 +861,58 @@ class DistributedPartitionedSampling(_Partitioned):
     "prior", π_c,t = π_c,t−1: each component keeps its share whatever its evidence (the
     other reading of the paper's "multiplied by the prior factor π_C,t to ensure a fair
     representation"; docs/algorithms.md §2.6).
+
+    Parameters
+    ----------
+    n_particles : int, default 300
+        N, particles of the whole set, in [1, ``trackers.params.MAX_PARTICLES``].
+    lam : float, default 20.0
+        λ of the likelihood exp(−λ d²), finite and > 0.
+    model : {"hsv", "rgb"}, default "hsv"
+        Colour-histogram observation model (``trackers.models.observation``).
+    bins : int, default 10
+        Histogram bins per colour channel, in [1, 256].
+    n_parts : int or None, default None
+        Spatial components (horizontal bands) of a region; None: the model's default.
+    kernel : {"uniform", "epanechnikov", "cone", "box"} or None, default None
+        Kernel weighting the pixels of a region; None: the model's default.
+    box_levels : int, default 3
+        Levels of the "box" kernel (nested rectangles), in [1, 16].
+    sigma : tuple of 3 float, default (2.0, 2.0, 0.001)
+        (σ_u, σ_v, σ_a) of the AR2 tracking dynamics: px, px and log scale per frame.
+    a1, a2 : float, default 2.0 and -1.0
+        AR2 coefficients, not explosive (``trackers.models.dynamics.check_ar2``).
+    resampler : {"systematic", "multinomial", "stratified", "residual"}, default "systematic"
+        Resampling scheme of every (weighted) resampling step.
+    observation : ObservationModel or None, default None
+        Replaces the colour-histogram model built from ``lam``, ``model``, ``bins``,
+        ``n_parts``, ``kernel`` and ``box_levels`` (then unused).
+    weighting : {"stage", "placed", "g-only"}, default "stage"
+        The weighting function of the weighted resampling stages (``PartitionedParams``).
+    resample_scope : {"joint", "placed"}, default "joint"
+        What a stage's weighted resampling copies from the drawn ancestor
+        (``PartitionedParams``).
+    n_groups : int or None, default None
+        C, the number of mixture components, in [1, n_particles]; None: one per target.
+    assignment : {"random", "interleaved", "persistent"}, default "random"
+        How particles are assigned to components (above).
+    mixture : {"evidence", "prior"}, default "evidence"
+        The components' mixture weights at reassembly (above).
+    rng : Generator, int or None, optional
+        Source of all randomness; the same seed gives the same track.
+
+    Attributes
+    ----------
+    particles : ndarray of shape (N, K, 3)
+        Particle states (u, v, a) of the joint set after the last step.
+    weights : ndarray of shape (N,)
+        Normalised weights of the joint set (all components); they sum to 1.
+
+    Raises
+    ------
+    ValueError
+        For a bad parameter value; at ``init``, when ``n_groups`` is None and the
+        number of targets exceeds ``n_particles``.
     """
 
     name = "dps"

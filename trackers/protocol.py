@@ -32,7 +32,21 @@ __all__ = ["EstimateLike", "Tracker"]
 
 @runtime_checkable
 class EstimateLike(Protocol):
-    """What ``step`` returns: anything with ``boxes``, array-like of shape (K, 4)."""
+    """What ``step`` returns: anything with ``boxes``, array-like of shape (K, 4).
+
+    A protocol: checked with ``isinstance``, never instantiated.
+
+    Parameters
+    ----------
+    *args, **kwargs : Any
+        None accepted: ``typing.Protocol`` refuses to instantiate a protocol (TypeError).
+
+    Attributes
+    ----------
+    boxes : array_like of float, shape (K, 4)
+        Estimated box [x, y, w, h] per target, in px; NaN rows where the tracker has lost
+        a target.
+    """
 
     boxes: Any
 
@@ -44,6 +58,11 @@ class Tracker(Protocol):
     ``isinstance(obj, trackers.Tracker)`` is True for any object with both methods (a
     tracker *class* too: ``trackers.track`` and ``scenegen track`` refuse a class, naming
     it).
+
+    Parameters
+    ----------
+    *args, **kwargs : Any
+        None accepted: ``typing.Protocol`` refuses to instantiate a protocol (TypeError).
     """
 
     def init(self, frame: Any, boxes: Any) -> None:

@@ -28,12 +28,34 @@ _REGISTRY: dict[str, str] = {
 
 
 def names() -> list[str]:
-    """All tracker names, in the contract's order."""
+    """All tracker names, in the contract's order.
+
+    Returns
+    -------
+    list of str
+        The registered names (``"condensation"``, ``"joint-pf"``, ..., ``"shm-fast"``).
+
+    Examples
+    --------
+    >>> from trackers.registry import names
+    >>> names()[:4]
+    ['condensation', 'joint-pf', 'ps', 'dps']
+    """
     return list(_REGISTRY)
 
 
 def get_class(name: str) -> type[Tracker]:
     """The tracker class registered under ``name``.
+
+    Parameters
+    ----------
+    name : str
+        A name of :func:`names`.
+
+    Returns
+    -------
+    type
+        The class (its module is imported on first use).
 
     Raises
     ------
@@ -51,6 +73,27 @@ def defaults(name: str) -> dict[str, Any]:
 
     Read from the fields of the tracker's parameter dataclass (``cls.Params``); a
     registered class without one is read from its constructor's signature.
+
+    Parameters
+    ----------
+    name : str
+        A name of :func:`names`.
+
+    Returns
+    -------
+    dict of str to Any
+        Parameter name -> default, in declaration order, ``"rng": None`` last.
+
+    Raises
+    ------
+    ValueError
+        For an unknown name, listing the valid ones.
+
+    Examples
+    --------
+    >>> from trackers.registry import defaults
+    >>> defaults("meanshift")
+    {'kernel': 'cone', 'bins': 10, 'max_iter': 20, 'eps': 0.5, 'rng': None}
     """
     cls = get_class(name)
     if cls.Params is not None:
@@ -61,17 +104,47 @@ def defaults(name: str) -> dict[str, Any]:
 
 
 def parameters(name: str) -> list[str]:
-    """Keyword parameters accepted by tracker ``name`` (``rng`` included, last)."""
+    """Keyword parameters accepted by tracker ``name`` (``rng`` included, last).
+
+    Parameters
+    ----------
+    name : str
+        A name of :func:`names`.
+
+    Returns
+    -------
+    list of str
+        The keys of :func:`defaults`, in the same order.
+
+    Raises
+    ------
+    ValueError
+        For an unknown name, listing the valid ones.
+    """
     return list(defaults(name))
 
 
 def make(name: str, **params: Any) -> Tracker:
     """Construct tracker ``name`` with keyword ``params``.
 
+    Parameters
+    ----------
+    name : str
+        A name of :func:`names`.
+    **params : Any
+        Keyword parameters of that tracker (:func:`parameters`), ``rng`` included;
+        the others take their defaults.
+
+    Returns
+    -------
+    Tracker
+        A new, uninitialised tracker (call ``init`` before ``step``).
+
     Raises
     ------
     ValueError
-        For an unknown tracker or parameter name, listing the valid ones.
+        For an unknown tracker or parameter name, listing the valid ones; from the
+        tracker's parameter dataclass for a bad value, naming the parameter.
     """
     cls = get_class(name)
     valid = parameters(name)

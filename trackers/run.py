@@ -30,7 +30,8 @@ class TrackResult:
         Estimated boxes; frame 0 holds the initial boxes.
     extras : dict of str to ndarray
         Per-frame diagnostics stacked over frames, shape (T, ...); frame 0 repeats frame 1's
-        shape with NaN (floats) where the tracker reports nothing before its first step.
+        shape with NaN (floats) where the tracker reports nothing before its first step
+        (0 for other dtypes).
         Empty for a tracker whose estimates have no ``extras``.
     """
 
@@ -45,11 +46,29 @@ def _label(tracker: Any) -> str:
 def estimate_boxes(tracker: Any, estimate: Any, n_targets: int, frame: int) -> NDArray[np.float64]:
     """The ``boxes`` of what ``tracker.step`` returned, checked: float64 (K, 4).
 
+    A row must be finite with w, h >= 0, or all NaN (a lost target).
+
+    Parameters
+    ----------
+    tracker : Any
+        The tracker that made ``estimate`` (its class name goes into the messages).
+    estimate : Any
+        What ``tracker.step`` returned: an object with ``boxes``.
+    n_targets : int
+        K, the number of initial boxes.
+    frame : int
+        Index of the frame stepped (for the messages).
+
+    Returns
+    -------
+    ndarray of float64, shape (K, 4)
+        ``estimate.boxes`` [x, y, w, h] in px (no copy when already float64).
+
     Raises
     ------
     ValueError
         Naming the tracker, the frame and what is wrong (no ``boxes``, wrong shape,
-        infinite values).
+        infinite values, a partly NaN row, a negative size).
     """
     if not hasattr(estimate, "boxes"):
         raise ValueError(
@@ -123,6 +142,24 @@ def track(
     array (anything indexable with a length); frames are read one at a time.
     ``progress``, if given, is called with the number of frames done.
 
+    Parameters
+    ----------
+    tracker : Tracker
+        An instance following the protocol (:class:`trackers.protocol.Tracker`).
+    frames : sequence of ndarray of uint8 or ndarray of uint8, shape (T, H, W, 3)
+        The frames, T >= 1; ``frames[0]`` initialises the tracker.
+    init_boxes : array_like of float, shape (K, 4)
+        The boxes [x, y, w, h] of the K targets on frame 0, in px (one box (4,) is one
+        target).
+    progress : callable or None, optional
+        Called as ``progress(t)`` after step t, t = 1, ..., T - 1; None (the default):
+        not called.
+
+    Returns
+    -------
+    TrackResult
+        ``boxes`` (T, K, 4), ``init_boxes`` at frame 0, and the stacked ``extras``.
+
     Raises
     ------
     ValueError
@@ -131,6 +168,21 @@ def track(
     TypeError
         If ``tracker`` lacks ``init`` or ``step``, or is a class rather than an instance,
         or ``frames`` has no length (a generator: pass ``list(frames)``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from trackers.base import Estimate
+    >>> from trackers.run import track
+    >>> class Still:  # the smallest tracker: never moves its boxes
+    ...     def init(self, frame, boxes):
+    ...         self.boxes = boxes
+    ...     def step(self, frame):
+    ...         return Estimate(self.boxes)
+    >>> frames = np.zeros((3, 20, 30, 3), np.uint8)
+    >>> result = track(Still(), frames, [2.0, 3.0, 8.0, 6.0])
+    >>> result.boxes.shape
+    (3, 1, 4)
     """
     if isinstance(tracker, type):  # a class has init and step too, unbound
         raise TypeError(

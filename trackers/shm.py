@@ -91,7 +91,26 @@ __all__ = [
 
 
 def transition_matrix(n_orderings: int, p_stay: float) -> NDArray[np.float64]:
-    """Markov transition Π (L, L) of the ordering: stay ``p_stay``, else uniform (eq. 1)."""
+    """Markov transition Π (L, L) of the ordering: stay ``p_stay``, else uniform (eq. 1).
+
+    Parameters
+    ----------
+    n_orderings : int
+        Number of orderings L >= 1.
+    p_stay : float
+        Probability of keeping the ordering, in [0, 1] (not checked; ignored when L = 1).
+
+    Returns
+    -------
+    ndarray of float64, shape (L, L)
+        Π[i, j] = P(s_t = j | s_{t−1} = i): ``p_stay`` on the diagonal,
+        (1 − p_stay) / (L − 1) elsewhere; each row sums to 1.
+
+    Examples
+    --------
+    >>> transition_matrix(3, 0.8).round(6).tolist()
+    [[0.8, 0.1, 0.1], [0.1, 0.8, 0.1], [0.1, 0.1, 0.8]]
+    """
     if n_orderings == 1:
         return np.ones((1, 1))
     pi = np.full((n_orderings, n_orderings), (1.0 - p_stay) / (n_orderings - 1))
@@ -157,7 +176,50 @@ class _OrderingEvidence:
 @dataclass(frozen=True)
 class FastShmParams(KalmanParams):
     """Parameters of "shm-fast": ``KalmanParams`` and the ordering evidence's (documented on
-    ``SHMTracker``)."""
+    ``SHMTracker``).
+
+    Parameters
+    ----------
+    motion : {"cv", "ar2"}, default "cv"
+        Motion model (``KalmanParams``, as the next eleven entries).
+    process_std : float, default 1.5
+        Process noise std, px/frame², in [0, 1e6].
+    a1, a2 : float, default 2.0 and -1.0
+        AR2 coefficients, finite and not explosive.
+    velocity_std : float, default 5.0
+        Initial velocity std, px/frame, in (0, 1e6].
+    r_gain : float, default 0.01
+        Measurement variance per unit of mean squared difference, px²/intensity², in
+        [0, 1e12].
+    r_floor : float, default 0.5
+        Smallest measurement variance, px², in [1e-6, 1e12].
+    search_radius : int, default 12
+        Search window half-size, px, in [1, 200].
+    step : int, default 2
+        Coarse-to-fine search stride, in [1, 8].
+    min_visible : float, default 0.25
+        Fraction of the template that must be compared for a match to count, in (0, 1].
+    support : {"box", "ellipse"}, default "ellipse"
+        Template support (``trackers.models.layered``).
+    blur : float, default 2.0
+        Gaussian pre-smoothing std, px, in [0, 20].
+    p_stay : float, default 0.8
+        Probability that the depth ordering stays the same from one frame to the next,
+        in (0, 1].
+    lam : float, default 1.0
+        Sharpness of the squared-difference evidence, in [0, ``MAX_LAM``].
+    mse_rate : float, default 0.1
+        Rate of the moving average ``ē``, in (0, 1].
+    mse_floor : float, default 25.0
+        Smallest ``ē``, intensity², finite and >= ``MIN_MSE_FLOOR``.
+    evidence : {"union", "objects"}, default "union"
+        Which squared-difference mean is scored (module docstring).
+
+    Raises
+    ------
+    ValueError
+        For a bad value, naming the parameter.
+    """
 
     p_stay: float = 0.8
     lam: float = 1.0
@@ -176,7 +238,53 @@ class FastShmParams(KalmanParams):
 
 @dataclass(frozen=True)
 class ShmParams(FastShmParams):
-    """Parameters of "shm": ``FastShmParams`` and ``use_mse`` (documented on ``SHMTracker``)."""
+    """Parameters of "shm": ``FastShmParams`` and ``use_mse`` (documented on ``SHMTracker``).
+
+    Parameters
+    ----------
+    motion : {"cv", "ar2"}, default "cv"
+        Motion model (``KalmanParams``, as the next eleven entries).
+    process_std : float, default 1.5
+        Process noise std, px/frame², in [0, 1e6].
+    a1, a2 : float, default 2.0 and -1.0
+        AR2 coefficients, finite and not explosive.
+    velocity_std : float, default 5.0
+        Initial velocity std, px/frame, in (0, 1e6].
+    r_gain : float, default 0.01
+        Measurement variance per unit of mean squared difference, px²/intensity², in
+        [0, 1e12].
+    r_floor : float, default 0.5
+        Smallest measurement variance, px², in [1e-6, 1e12].
+    search_radius : int, default 12
+        Search window half-size, px, in [1, 200].
+    step : int, default 2
+        Coarse-to-fine search stride, in [1, 8].
+    min_visible : float, default 0.25
+        Fraction of the template that must be compared for a match to count, in (0, 1].
+    support : {"box", "ellipse"}, default "ellipse"
+        Template support (``trackers.models.layered``).
+    blur : float, default 2.0
+        Gaussian pre-smoothing std, px, in [0, 20].
+    p_stay : float, default 0.8
+        Probability that the depth ordering stays the same from one frame to the next,
+        in (0, 1].
+    lam : float, default 1.0
+        Sharpness of the squared-difference evidence, in [0, ``MAX_LAM``].
+    mse_rate : float, default 0.1
+        Rate of the moving average ``ē``, in (0, 1].
+    mse_floor : float, default 25.0
+        Smallest ``ē``, intensity², finite and >= ``MIN_MSE_FLOOR``.
+    evidence : {"union", "objects"}, default "union"
+        Which squared-difference mean is scored (module docstring).
+    use_mse : bool, default True
+        Include the squared-difference evidence in the hypothesis weights (True, False,
+        or a numpy bool, 0 or 1; stored as ``bool``).
+
+    Raises
+    ------
+    ValueError
+        For a bad value, naming the parameter.
+    """
 
     use_mse: bool = True
 
@@ -213,33 +321,53 @@ class _SHMBase(Tracker):
 class SHMTracker(_SHMBase):
     """SHM filter (§3.2): Gaussian sum over depth orderings with GPB2 collapsing.
 
-    The parameters are the fields of ``ShmParams``, and ``rng``.
+    The parameters are the fields of ``ShmParams``, and ``rng``. ``init`` refuses more than
+    ``trackers.models.layered.MAX_OBJECTS`` (4) targets with a ``ValueError``.
 
     Parameters
     ----------
-    motion, process_std, a1, a2, velocity_std, r_gain, r_floor, search_radius, step, \
-min_visible, support, blur
-        As for ``trackers.kalman.KalmanTracker``.
-    p_stay : float
+    motion : {"cv", "ar2"}, default "cv"
+        As for ``trackers.kalman.KalmanTracker`` (and the next eleven entries).
+    process_std : float, default 1.5
+        Process noise std, px/frame², in [0, 1e6].
+    a1, a2 : float, default 2.0 and -1.0
+        AR2 coefficients, finite and not explosive.
+    velocity_std : float, default 5.0
+        Initial velocity std, px/frame, in (0, 1e6].
+    r_gain : float, default 0.01
+        Measurement variance per unit of mean squared difference, px²/intensity².
+    r_floor : float, default 0.5
+        Smallest measurement variance, px².
+    search_radius : int, default 12
+        Search window half-size, px, in [1, 200].
+    step : int, default 2
+        Coarse-to-fine search stride, in [1, 8].
+    min_visible : float, default 0.25
+        Fraction of the template that must be compared for a match to count, in (0, 1].
+    support : {"box", "ellipse"}, default "ellipse"
+        Template support.
+    blur : float, default 2.0
+        Gaussian pre-smoothing std, px, in [0, 20].
+    p_stay : float, default 0.8
         Probability that the depth ordering stays the same from one frame to the next
         (**open**). The order cannot be observed while the objects are apart and may
         change then, so the belief should relax towards uniform within a few frames
         (by a factor ``(L p_stay − 1) / (L − 1)`` per frame). Measured on
         ``shm-crossing`` seeds 0–7: depth-order accuracy 100% for 0.5 to 0.9; mean
         ``max |P − 1/L|`` on frames where the targets are apart 0.04 at 0.8, 0.11 at 0.9.
-    lam : float
+    lam : float, default 1.0
         Sharpness of the squared-difference evidence ``exp(−lam e / ē)``, in [0, 1e6].
-    mse_rate : float
+    mse_rate : float, default 0.1
         Rate of the moving average ``ē`` of the best squared-difference mean, in (0, 1].
-    mse_floor : float
+    mse_floor : float, default 25.0
         Smallest ``ē``, intensity², >= 1e-6 (so exact synthetic matches do not give
         ē = 0).
-    evidence : {"union", "objects"}
+    evidence : {"union", "objects"}, default "union"
         Which squared-difference mean is scored (module docstring).
-    use_mse : bool
+    use_mse : bool, default True
         Include the squared-difference evidence in the hypothesis weights (§3.3's
         generalised measurement); False is the plain §3.2 filter on positions only.
-    rng : Generator, int or None
+    rng : Generator, int or None, optional
         Unused (the filter is deterministic); accepted like every tracker's.
 
     Attributes
@@ -323,14 +451,45 @@ min_visible, support, blur
 class FastSHMTracker(_SHMBase):
     """Fast SHM filter (§3.3): ordering posterior from the matches, one Kalman filter.
 
-    The parameters are the fields of ``FastShmParams``, and ``rng``.
+    The parameters are the fields of ``FastShmParams``, and ``rng``. ``init`` refuses more than
+    ``trackers.models.layered.MAX_OBJECTS`` (4) targets with a ``ValueError``.
 
     Parameters
     ----------
-    motion, process_std, a1, a2, velocity_std, r_gain, r_floor, search_radius, step, \
-min_visible, support, blur, p_stay, lam, mse_rate, mse_floor, evidence
-        As for ``SHMTracker``.
-    rng : Generator, int or None
+    motion : {"cv", "ar2"}, default "cv"
+        As for ``SHMTracker`` (and every entry below but ``rng``).
+    process_std : float, default 1.5
+        Process noise std, px/frame², in [0, 1e6].
+    a1, a2 : float, default 2.0 and -1.0
+        AR2 coefficients, finite and not explosive.
+    velocity_std : float, default 5.0
+        Initial velocity std, px/frame, in (0, 1e6].
+    r_gain : float, default 0.01
+        Measurement variance per unit of mean squared difference, px²/intensity².
+    r_floor : float, default 0.5
+        Smallest measurement variance, px².
+    search_radius : int, default 12
+        Search window half-size, px, in [1, 200].
+    step : int, default 2
+        Coarse-to-fine search stride, in [1, 8].
+    min_visible : float, default 0.25
+        Fraction of the template that must be compared for a match to count, in (0, 1].
+    support : {"box", "ellipse"}, default "ellipse"
+        Template support.
+    blur : float, default 2.0
+        Gaussian pre-smoothing std, px, in [0, 20].
+    p_stay : float, default 0.8
+        Probability that the depth ordering stays the same from one frame to the next,
+        in (0, 1].
+    lam : float, default 1.0
+        Sharpness of the squared-difference evidence ``exp(−lam e / ē)``, in [0, 1e6].
+    mse_rate : float, default 0.1
+        Rate of the moving average ``ē``, in (0, 1].
+    mse_floor : float, default 25.0
+        Smallest ``ē``, intensity², >= 1e-6.
+    evidence : {"union", "objects"}, default "union"
+        Which squared-difference mean is scored (module docstring).
+    rng : Generator, int or None, optional
         Unused (the filter is deterministic); accepted like every tracker's.
 
     Attributes

@@ -29,7 +29,28 @@ _OCTAL = np.array([(-1, -1), (0, -1), (1, -1), (-1, 0), (1, 0), (-1, 1), (0, 1),
 
 @dataclass(frozen=True)
 class SokParams(MeanShiftParams):
-    """Parameters of SOK: ``MeanShiftParams``, ``threshold`` and ``spacing`` (see ``SOK``)."""
+    """Parameters of SOK: ``MeanShiftParams``, ``threshold`` and ``spacing`` (see ``SOK``).
+
+    Parameters
+    ----------
+    kernel : {"cone", "epanechnikov"}, default "cone"
+        Histogram kernel (``ColourParams``).
+    bins : int, default 10
+        Bins per RGB channel, in [1, 32].
+    max_iter : int, default 20
+        Mean-shift iterations per tracker and frame, in [0, ``MAX_ITER``].
+    eps : float, default 0.5
+        Mean-shift stopping shift in px, >= 0.
+    threshold : float, default 0.9
+        Confidence below which the grid search runs, in [0, 1].
+    spacing : float, default 0.5
+        Grid spacing in units of the target's box width and height, finite and > 0.
+
+    Raises
+    ------
+    ValueError
+        For a bad value, naming the parameter.
+    """
 
     threshold: float = 0.9
     spacing: float = 0.5
@@ -47,8 +68,8 @@ class SOK(Tracker):
     C_t = 1 − d (KAMS eq. 8). If C_t < ``threshold``, eight more mean-shift trackers with
     the same model start on the other cells of a 3x3 grid centred on that estimate (cell
     spacing ``spacing`` times the target's box size; KAMS Fig. 2), all in one call; the
-    most confident of the nine results is kept (of confidences equal to 1e-9, the one
-    nearest the primary estimate). Deterministic: ``rng`` is accepted for the
+    most confident of the nine results is kept (of confidences equal to within 1e-9, the
+    one nearest the primary estimate). Deterministic: ``rng`` is accepted for the
     common protocol. The parameters are the fields of ``SokParams``, and ``rng``.
 
     Parameters
@@ -64,8 +85,14 @@ class SOK(Tracker):
         default to 0.5 (about four times), because jumps on the kams presets stay within
         about one radius and the outer cells mostly meet clutter (sok on kams-a, seeds
         0–9: 8/10 runs tracked to the end at 0.5, 5/10 at 1).
-    max_iter, eps, kernel, bins
+    max_iter : int, default 20
         As for ``MeanShiftTracker`` (``MeanShiftParams``): per tracker and frame.
+    eps : float, default 0.5
+        As for ``MeanShiftTracker``: the stopping shift, in px.
+    kernel : {"cone", "epanechnikov"}, default "cone"
+        As for ``MeanShiftTracker``.
+    bins : int, default 10
+        As for ``MeanShiftTracker``.
     rng : Generator, int or None, optional
         Unused (the tracker is deterministic).
 

@@ -43,6 +43,42 @@ class Appearance:
     recorded absolute: :func:`load_config`), else to the current directory. A field that
     the pattern does not use (``crop`` on a ``solid`` pattern, ``colors`` on an ``image``)
     is refused unless it holds its default: :data:`PATTERN_FIELDS`.
+
+    Attributes
+    ----------
+    shape : {"rect", "ellipse", "triangle", "diamond"}
+        The silhouette that masks the pattern. Default ``"rect"``.
+    size : tuple of (int, int)
+        Width and height (px), each in 1..:data:`MAX_SIDE`. Default ``(20, 20)``.
+    pattern : {"solid", "rings", "sectors", "stripes", "bands", "checker", "texture", \
+"image", "perlin"}
+        What fills the silhouette. Default ``"solid"``.
+    colors : tuple of (int, int, int)
+        At least one RGB colour, each channel in 0..255. Default ``((255, 0, 0),)``.
+    stripe_width : int
+        Width of a stripe or side of a checker square (px), >= 1. Default 4.
+    texture_sigma : float
+        Std of the ``texture`` pattern's Gaussian texture (grey levels), >= 0. Default 20.
+    source : str or None
+        The ``image`` pattern's image: a name of :data:`SKIMAGE_NAMES` or a file path.
+        Required by the ``image`` pattern. Default None.
+    crop : tuple of (int, int, int, int) or None
+        ``[x, y, w, h]`` (px) cut from ``source`` before fitting, with x, y >= 0 and
+        w, h >= 1; None keeps the whole image. Default None.
+    fit : {"stretch", "tile", "crop"}
+        How the image is brought to ``size``. Default ``"stretch"``.
+    tint : tuple of (int, int, int) or None
+        Per-channel factor (0..255, 255 = unchanged) on ``image`` pixels. Default None.
+    noise_scale : float
+        Feature size of the ``perlin`` pattern (px), in 1..:data:`MAX_SIDE`. Default 8.
+
+    Raises
+    ------
+    ConfigError
+        A value out of its range, an ``image`` pattern without ``source``, a malformed
+        ``source`` (empty, unknown ``skimage:`` name; a file is read only when planning),
+        or a pattern-specific field set on a pattern that does not use it; the message
+        names the field.
     """
 
     shape: Shape = "rect"
@@ -96,6 +132,22 @@ class Variation:
 
     The angle is ``rotation * sin(2 pi t / period + phase)`` degrees and the brightness
     factor ``1 + shading * sin(2 pi t / period + phase)``.
+
+    Attributes
+    ----------
+    rotation : float
+        Amplitude of the rotation (degrees). Default 0.
+    shading : float
+        Amplitude of the brightness factor, in [0, 1). Default 0.
+    period : float
+        Period of both oscillations (frames), > 0. Default 40.
+    phase : float
+        Phase of both oscillations (radians). Default 0.
+
+    Raises
+    ------
+    ConfigError
+        ``period <= 0`` or ``shading`` outside [0, 1); the message names the field.
     """
 
     rotation: float = 0.0

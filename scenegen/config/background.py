@@ -28,7 +28,34 @@ class Background:
     unchanged; a relative file path as for :class:`Appearance`). With a :class:`Camera`
     the background is larger than the frame by the camera's ``extent`` on every side. A
     field that the kind does not use (``low`` on ``uniform``, ``color`` on ``noise``) is
-    refused unless it holds its default: :data:`BACKGROUND_FIELDS`."""
+    refused unless it holds its default: :data:`BACKGROUND_FIELDS`.
+
+    Attributes
+    ----------
+    kind : {"uniform", "noise", "texture", "perlin", "image"}
+        What the background is made of. Default ``"uniform"``.
+    color : tuple of (int, int, int)
+        RGB colour (0..255): the ``uniform`` colour, the tint of ``texture`` and
+        ``perlin``, the per-channel factor times 255 of ``image``. Default white.
+    low, high : int
+        Grey-level range of ``noise``, ``texture`` and ``perlin``, with
+        ``0 <= low <= high <= 255``. Defaults 0 and 255.
+    scale : float
+        Gaussian std of ``texture``, feature size of ``perlin`` (px), in
+        (0, :data:`MAX_BLUR`]. Default 4.
+    source : str or None
+        The ``image`` kind's image (:data:`SKIMAGE_NAMES` or a file path); required by
+        it. Default None.
+    fit : {"stretch", "tile", "crop"}
+        How the image is brought to the background's size. Default ``"crop"``.
+
+    Raises
+    ------
+    ConfigError
+        A value out of its range, an ``image`` kind without ``source``, a malformed
+        ``source``, or a kind-specific field set on a kind that does not use it; the
+        message names the field.
+    """
 
     kind: Literal["uniform", "noise", "texture", "perlin", "image"] = "uniform"
     color: Color = (255, 255, 255)

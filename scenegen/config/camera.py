@@ -40,6 +40,30 @@ class Camera:
     is then resampled per frame (bilinear, mirrored beyond its edge) and every entity,
     static ones included, is drawn per frame at ``scale * zoom`` (nearest neighbour, as
     for any scale change), so labels stay exact.
+
+    Attributes
+    ----------
+    extent : tuple of (int, int)
+        (ex, ey): how far the background reaches beyond the frame on each side (px), each
+        in 0..:data:`MAX_SIDE`. Default ``(32, 32)``.
+    x, y : AR2 or None
+        The offset's motion per axis (px), ``reflect`` or ``clamp``; None: no motion on
+        that axis. Default None.
+    velocity : tuple of (float, float)
+        Initial (x, y) velocity of the offset (px/frame); non-zero only on an axis with
+        its AR2. Default ``(0, 0)``.
+    keyframes : tuple of (int, float, float)
+        Scripted offsets ``(frame, dx, dy)`` (frames increasing from >= 0; px within the
+        extent); not with ``x`` or ``y``. Default ``()``.
+    zoom : AR2 or None
+        Motion of the log zoom, ``reflect`` or ``clamp``; None: no zoom. Default None.
+
+    Raises
+    ------
+    ConfigError
+        ``extent`` out of range, a ``free`` boundary, ``keyframes`` with ``x`` or ``y``,
+        a velocity without its axis' AR2, keyframe frames not increasing or an offset
+        beyond the extent; the message names the field.
     """
 
     extent: tuple[int, int] = (32, 32)

@@ -23,13 +23,21 @@ Role = Literal["target", "distractor", "occluder", "clutter"]
 class EntitySpec:
     """One entity of the scene.
 
+    ``color_jitter`` and ``mimic_offset`` are used only by a mimic (and ``mimic_offset``
+    only without a ``position``; ``color_jitter`` only when the model's pattern has
+    colours, not on an ``image``): elsewhere they are refused unless they hold their
+    defaults, as they would be silently ignored. A mimic's own ``appearance`` is ignored
+    (it draws its model's), yet tolerated: a regression fixture records one.
+
     Attributes
     ----------
     name : str
         Unique name; it also keys the entity's own random stream, so adding or removing
         another entity never changes this one's trajectory.
     role : {'target', 'distractor', 'occluder', 'clutter'}
+        What the entity is to a tracker.
     appearance : Appearance
+        How it looks. Default :class:`Appearance` ().
     position : (x, y) or None
         Initial centre in pixels. ``None`` only for a distractor with ``mimic``: it then
         starts at the mimicked target's drawn centre at its ``appear`` frame, plus
@@ -38,25 +46,29 @@ class EntitySpec:
         ``None``: static.
     position_noise : float
         Std (pixels) of Gaussian noise added to the drawn centre every frame (KAMS
-        "measurement noise"); the motion state itself is not perturbed.
+        "measurement noise"); the motion state itself is not perturbed. >= 0.
     appear, disappear : int, int or None
-        The entity exists for frames ``appear <= t < disappear``.
+        The entity exists for frames ``appear <= t < disappear`` (``appear >= 0``;
+        ``disappear`` None: to the end).
     depth : tuple of (frame, depth)
         Depth keyframes: from ``frame`` on the entity has ``depth`` (smaller is nearer).
-        Two entities may never share a depth at the same frame.
+        Two entities may never share a depth at the same frame. The first keyframe is at
+        frame 0, frames increase, depths are >= 0. Default ``((0, 0),)``.
     mimic : str or None
         Name of a target whose appearance this entity copies (distractors).
     mimic_offset : (dx, dy)
         Where a mimic without a ``position`` starts, relative to its model's centre.
     color_jitter : float
-        Std of a per-channel colour offset applied to a mimicked appearance.
+        Std of a per-channel colour offset applied to a mimicked appearance. >= 0.
     variation : Variation or None
+        Pose changes over time; None: none.
 
-    ``color_jitter`` and ``mimic_offset`` are used only by a mimic (and ``mimic_offset``
-    only without a ``position``; ``color_jitter`` only when the model's pattern has
-    colours, not on an ``image``): elsewhere they are refused unless they hold their
-    defaults, as they would be silently ignored. A mimic's own ``appearance`` is ignored
-    (it draws its model's), yet tolerated: a regression fixture records one.
+    Raises
+    ------
+    ConfigError
+        A bad name, a negative ``position_noise``, ``appear`` or ``color_jitter``,
+        ``disappear <= appear``, bad depth keyframes, no ``position`` without ``mimic``,
+        or a mimic-only field set where it is not used; the message names the field.
     """
 
     name: str
@@ -132,6 +144,35 @@ class ClutterSpec:
     ignored (tolerated, not refused: the regression fixture ``single-frame`` records one).
     An ``image`` item takes its pixels from the image: ``palette`` and ``n_colors`` are
     refused on it unless they hold their defaults (:data:`CLUTTER_FIELDS`).
+
+    Attributes
+    ----------
+    count : int
+        Number of items, >= 0.
+    appearance : Appearance
+        The items' shape, pattern and largest size. Default :class:`Appearance` ().
+    palette : tuple of (int, int, int)
+        RGB colours the items' colours are drawn from (at least one). Default red, green,
+        blue and yellow.
+    n_colors : int
+        Colours drawn per item, in 1..:data:`MAX_COLORS`. Default 1.
+    min_size : int
+        Smallest item side (px), in 0..min(appearance.size); 0: every item at
+        ``appearance.size``. Default 0.
+    placement : {"uniform", "grid"}
+        How the centres are placed over ``region``. Default ``"uniform"``.
+    region : tuple of (float, float, float, float) or None
+        ``(x, y, w, h)`` (px, scene coordinates) the centres are placed in, w, h > 0;
+        None: the whole frame. Default None.
+    name : str
+        Name of the group: item ``j`` is named ``{name}-{j}`` and the group's random
+        stream is keyed by it. Default ``"clutter"``.
+
+    Raises
+    ------
+    ConfigError
+        A value out of its range or a bad name, or ``palette`` / ``n_colors`` set on an
+        ``image`` appearance; the message names the field.
     """
 
     count: int

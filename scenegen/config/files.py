@@ -95,7 +95,18 @@ def _yaml_core() -> tuple[type, type]:
 
 def dump_yaml(data: Any) -> str:
     """``data`` (plain data, as :func:`to_dict` gives) as YAML text that :func:`load_data`
-    reads back equal: a string such as ``'1e9'``, ``'no'`` or ``'010'`` is quoted."""
+    reads back equal: a string such as ``'1e9'``, ``'no'`` or ``'010'`` is quoted.
+
+    Parameters
+    ----------
+    data : Any
+        Plain data: dicts, lists, strings, numbers, booleans and None.
+
+    Returns
+    -------
+    str
+        The YAML text, keys in their given order.
+    """
     import yaml
 
     return yaml.dump(data, Dumper=_yaml_core()[1], sort_keys=False)
@@ -241,6 +252,16 @@ def json_object(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
     """A JSON object, refusing a key given twice (``json.loads`` would keep the last): the
     ``object_pairs_hook`` of every JSON file scenegen reads.
 
+    Parameters
+    ----------
+    pairs : list of tuple of (str, Any)
+        The object's key-value pairs, in file order.
+
+    Returns
+    -------
+    dict of str to Any
+        The object.
+
     Raises
     ------
     ConfigError
@@ -278,8 +299,14 @@ def load_data(path: str | Path, what: str = "config") -> Any:
     Parameters
     ----------
     path : str or Path
-    what : str
+    what : str, default "config"
         What the file holds, for messages ("config", "family").
+
+    Returns
+    -------
+    Any
+        The file's data as parsed: dicts, lists, strings, numbers, booleans and None
+        (never None itself: an empty YAML document is refused).
 
     Raises
     ------
@@ -336,6 +363,11 @@ def load_config(path: str | Path, *, folder: str | Path | None = None) -> SceneC
     folder : str or Path, optional
         Join relative sources to this folder instead of the file's absolute folder (a
         family keeps them relative to its own file: :func:`from_dict`).
+
+    Returns
+    -------
+    SceneConfig
+        The validated config.
 
     Raises
     ------

@@ -46,6 +46,28 @@ class AR2:
     of an explosive AR2 grows geometrically: a path beyond :data:`MAX_PATH` in magnitude is
     refused when the scene is planned, with a ConfigError naming the field and the frame
     (``entities[0].motion.x: the AR2 path reaches 1.2e+18 at frame 7, ...``).
+
+    Attributes
+    ----------
+    boundary : {"reflect", "clamp", "free"}
+        What happens at the limits (required).
+    a1, a2 : float
+        The autoregression coefficients. Defaults 2 and -1 (constant velocity).
+    sigma : float
+        Std of the noise ``eps_t`` (px; log units for a scale, zoom or gain; grey levels
+        for an offset), >= 0. Default 0.
+    mean : float or None
+        The level the path reverts to; None: the initial value. Default None.
+    margin : float
+        Distance kept from the frame border (px) beyond half the entity's size; for a
+        log scale, zoom, gain or offset the bound of ``|value|`` (0: none). >= 0; must be
+        0 with ``free``. Default 0.
+
+    Raises
+    ------
+    ConfigError
+        ``sigma < 0``, ``margin < 0``, or a non-zero ``margin`` with ``free``; the
+        message names the field.
     """
 
     boundary: Boundary
@@ -69,6 +91,16 @@ class Motion:
 
     ``velocity`` sets the initial velocity: the value before the first frame is
     ``position - velocity``.
+
+    Attributes
+    ----------
+    x, y : AR2
+        Motion of the centre's x and y (px).
+    scale : AR2 or None
+        Motion of the log scale (from 0: the appearance's size); None: constant scale.
+        Default None.
+    velocity : tuple of (float, float)
+        Initial (x, y) velocity of the centre (px/frame). Default ``(0, 0)``.
     """
 
     x: AR2

@@ -164,6 +164,11 @@ def from_dict(data: Any, *, folder: str | Path | None = None) -> SceneConfig:
         to it (:func:`relative_to`). ``None`` leaves them as given: relative to the current
         directory when the scene is planned.
 
+    Returns
+    -------
+    SceneConfig
+        The validated config.
+
     Raises
     ------
     ConfigError
@@ -180,6 +185,17 @@ def from_stored(data: Any) -> SceneConfig:
     config since it would be silently ignored) is tolerated here: files written before
     such a refusal existed stay readable and valid, and render as they did. Every other
     check applies.
+
+    Parameters
+    ----------
+    data : dict
+        The config as plain data (the parsed ``config`` attribute). Relative image file
+        sources are left as given.
+
+    Returns
+    -------
+    SceneConfig
+        The validated config.
 
     Raises
     ------
@@ -206,5 +222,17 @@ def _plain(value: Any) -> Any:
 
 
 def to_dict(config: SceneConfig) -> dict[str, Any]:
-    """The fully resolved config as plain data; ``from_dict(to_dict(c)) == c``."""
+    """The fully resolved config as plain data; ``from_dict(to_dict(c)) == c``.
+
+    Parameters
+    ----------
+    config : SceneConfig
+        The config.
+
+    Returns
+    -------
+    dict of str to Any
+        Every field, defaults included (but a field added after the first release, left
+        out while it holds its default), nested configs as dicts and tuples as lists.
+    """
     return _plain(config)

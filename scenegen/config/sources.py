@@ -30,6 +30,13 @@ N_FACES = 200
 def check_source(source: str) -> None:
     """Validate the syntax of an image source (a file is read only when planning).
 
+    Parameters
+    ----------
+    source : str
+        ``skimage:NAME`` (a name of :data:`SKIMAGE_NAMES`), ``skimage:lfw_subset[i]``
+        (``0 <= i < 200``) or a file path (any non-empty string not starting with
+        ``skimage:``).
+
     Raises
     ------
     ConfigError
@@ -53,7 +60,20 @@ def check_source(source: str) -> None:
 def relative_to(path: str | Path, folder: str | Path | None) -> Path:
     """``path`` read from a file in ``folder``: joined to it when relative (``None``: as
     given). The one rule for every path a config or family file names (image sources,
-    a family's ``base`` config)."""
+    a family's ``base`` config).
+
+    Parameters
+    ----------
+    path : str or Path
+        The path as read.
+    folder : str or Path or None
+        The folder of the file it was read from.
+
+    Returns
+    -------
+    Path
+        ``folder / path`` when ``path`` is relative and ``folder`` given, else ``path``.
+    """
     p = Path(path)
     return p if folder is None or p.is_absolute() else Path(folder) / p
 

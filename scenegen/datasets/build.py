@@ -66,7 +66,18 @@ _FLUSH_SECONDS = 2.0  # the manifest is rewritten at most this often while shard
 
 
 def shard_name(j: int) -> str:
-    """File name of shard ``j``: ``shard-NNNNN.h5``."""
+    """File name of shard ``j``: ``shard-NNNNN.h5``.
+
+    Parameters
+    ----------
+    j : int
+        The shard's index (>= 0).
+
+    Returns
+    -------
+    str
+        ``j`` zero-padded to five digits (more when it needs them): ``shard-00002.h5``.
+    """
     return f"shard-{j:05d}.h5"
 
 
@@ -186,6 +197,12 @@ def make_shard(task: ShardTask) -> dict[str, Any]:
 
     Runs in a worker process (or on a Dask worker, which must see the dataset folder).
 
+    Parameters
+    ----------
+    task : ShardTask
+        The shard: its index, folder, draws, compression and the digests expected of an
+        existing file.
+
     Returns
     -------
     dict
@@ -193,6 +210,13 @@ def make_shard(task: ShardTask) -> dict[str, Any]:
         entries, one per sequence, with digests), and the worker's ``pid``,
         ``cpu_seconds`` (CPU time of this shard) and ``peak_rss_mb`` (peak resident memory
         so far, MiB).
+
+    Raises
+    ------
+    ConfigError
+        A sequence that cannot be planned (a missing image, a runaway AR2 path), naming
+        its index and parameters; or the shard that cannot be written (a full disk, a
+        read-only folder).
     """
     from scenegen.io import write
     from scenegen.io.mot import writable
@@ -231,7 +255,32 @@ def plan_shards(
     compression: str,
     previous: dict[int, dict[str, Any]] | None = None,
 ) -> list[ShardTask]:
-    """Group draws into shard tasks (``previous``: manifest entries by index)."""
+    """Group draws into shard tasks (``previous``: manifest entries by index).
+
+    Parameters
+    ----------
+    draws : list of Draw
+        The sequences, in index order.
+    root : Path
+        The dataset folder.
+    shard_size : int
+        Sequences per shard (>= 1): shard ``j`` holds ``draws[j*S : j*S + S]``.
+    compression : str
+        The HDF5 compression of the shard files.
+    previous : dict of int to dict, optional
+        Manifest entries of an earlier run by index: an entry's digests are expected of
+        the existing file when its file and seed are those of the new draw.
+
+    Returns
+    -------
+    list of ShardTask
+        One task per shard, in shard order.
+
+    Raises
+    ------
+    ConfigError
+        ``shard_size < 1``.
+    """
     if shard_size < 1:
         raise ConfigError(f"--shard-size must be >= 1, got {shard_size}")
     prev = previous or {}
@@ -281,7 +330,15 @@ _IDENTITY = ("schema", "family_digest", "seed", "shard_size", "compression")
 
 
 def write_manifest(root: Path, manifest: dict[str, Any]) -> None:
-    """Write ``manifest.json`` atomically (sorted keys, entries in index order).
+    """Write ``manifest.json`` atomically (sorted keys, entries in the order given).
+
+    Parameters
+    ----------
+    root : Path
+        The dataset folder.
+    manifest : dict
+        The header and its ``sequences`` entries (kept in index order by
+        :func:`build_dataset`); JSON-serialisable, without NaN or infinity.
 
     Raises
     ------
@@ -302,8 +359,13 @@ def read_manifest(root: Path, *, check_entries: bool = True) -> dict[str, Any]:
     Parameters
     ----------
     root : Path
-    check_entries : bool
+    check_entries : bool, default True
         Also check its count, shard size and every entry (:func:`manifest_entries`).
+
+    Returns
+    -------
+    dict
+        The parsed manifest: its header fields and the ``sequences`` list.
 
     Raises
     ------
@@ -413,6 +475,18 @@ def manifest_entries(
 def manifest_axes(manifest: dict[str, Any], path: Path) -> tuple[Axis, ...]:
     """The grid axes the header of a manifest lists (``axes``).
 
+    Parameters
+    ----------
+    manifest : dict
+        As read from ``manifest.json``.
+    path : Path
+        The manifest file, for messages.
+
+    Returns
+    -------
+    tuple of Axis
+        The axes, each with a value (a tuple) per path.
+
     Raises
     ------
     DataError
@@ -437,6 +511,18 @@ def manifest_family(manifest: dict[str, Any], path: Path) -> Family:
     written before the header held ``resolved`` is tried with its ``family_spec`` (which
     gives the digest only when the order of its sections' keys is the sorted one: the
     manifest is written with sorted keys).
+
+    Parameters
+    ----------
+    manifest : dict
+        As read from ``manifest.json``.
+    path : Path
+        The manifest file, for messages.
+
+    Returns
+    -------
+    Family
+        The family, its digest equal to the header's ``family_digest``.
 
     Raises
     ------
@@ -490,6 +576,16 @@ def holds_benchmark_outputs(folder: Path) -> bool:
 
     Defined here, below the lab, so that no dataset is written into one;
     :func:`scenegen.lab.benchmark_outputs.is_benchmark_folder` uses it.
+
+    Parameters
+    ----------
+    folder : Path
+        The folder (it need not exist).
+
+    Returns
+    -------
+    bool
+        Whether it holds a benchmark's outputs.
     """
     root = Path(folder)
     if (root / "scores.csv").is_file() or (root / "leaderboard.md").is_file():
@@ -515,7 +611,18 @@ def _results_json(folder: Path) -> Any:
 def holds_report(folder: Path) -> bool:
     """True for the report folder of ``scenegen experiment all`` or ``scenegen demo`` (even
     damaged): a ``results.json`` holding ``{"experiments": ...}``, or ``experiments/``
-    beside an ``index.html``."""
+    beside an ``index.html``.
+
+    Parameters
+    ----------
+    folder : Path
+        The folder (it need not exist).
+
+    Returns
+    -------
+    bool
+        Whether it holds such a report.
+    """
     root = Path(folder)
     held = _results_json(root)
     if isinstance(held, dict) and "experiments" in held:
@@ -530,6 +637,16 @@ def holds_experiment_outputs(folder: Path) -> bool:
 
     Defined here, below the lab, so that no dataset is written into one;
     ``scenegen benchmark -o`` refuses such a folder too.
+
+    Parameters
+    ----------
+    folder : Path
+        The folder (it need not exist).
+
+    Returns
+    -------
+    bool
+        Whether it holds an experiment's outputs or a report.
     """
     root = Path(folder)
     held = _results_json(root)
@@ -543,6 +660,11 @@ def holds_experiment_outputs(folder: Path) -> bool:
 
 def make_output_folder(folder: Path) -> None:
     """Create the output folder ``folder`` (``-o``) and its parents, if missing.
+
+    Parameters
+    ----------
+    folder : Path
+        The folder.
 
     Raises
     ------

@@ -84,12 +84,31 @@ BUILTIN: dict[str, dict[str, Any]] = {
 
 
 def builtin_names() -> list[str]:
-    """Names of the built-in families."""
+    """Names of the built-in families.
+
+    Returns
+    -------
+    list of str
+        The names of :data:`BUILTIN`, in definition order.
+    """
     return list(BUILTIN)
 
 
 def resolve_family(family: str | Path | Family | dict[str, Any]) -> Family:
     """A :class:`Family` from a file, a built-in family name, a preset name or a mapping.
+
+    Parameters
+    ----------
+    family : str, Path, Family or dict
+        A family itself (returned as is); a mapping (:func:`family_from_dict`); a path
+        ending in ``.yaml``, ``.yml`` or ``.json``, or naming an existing file
+        (:func:`load_family`); else a name of :data:`BUILTIN` or a preset (that preset
+        with fresh seeds, no parameter varied).
+
+    Returns
+    -------
+    Family
+        The family.
 
     Raises
     ------

@@ -49,7 +49,19 @@ WORKER_TIMEOUT = 60.0
 
 def worker_timeout() -> float:
     """:data:`WORKER_TIMEOUT`, or ``SCENEGEN_DASK_WORKER_TIMEOUT`` when set to a positive
-    number (ConfigError naming it otherwise)."""
+    number (ConfigError naming it otherwise).
+
+    Returns
+    -------
+    float
+        Seconds to wait for a Dask worker.
+
+    Raises
+    ------
+    ConfigError
+        ``SCENEGEN_DASK_WORKER_TIMEOUT`` is set to something other than a positive
+        finite number.
+    """
     text = os.environ.get("SCENEGEN_DASK_WORKER_TIMEOUT")
     if text is None:
         return WORKER_TIMEOUT
@@ -63,7 +75,20 @@ def worker_timeout() -> float:
 
 
 def check_executor(jobs: int | None, scheduler: str | None) -> None:
-    """Raise :class:`ConfigError` for jobs < 1 or both jobs and a scheduler."""
+    """Raise :class:`ConfigError` for jobs < 1 or both jobs and a scheduler.
+
+    Parameters
+    ----------
+    jobs : int or None
+        Local worker processes (None: not given).
+    scheduler : str or None
+        A Dask scheduler address (None: not given).
+
+    Raises
+    ------
+    ConfigError
+        ``--jobs must be >= 1``, or ``give either --jobs or --scheduler, not both``.
+    """
     if jobs is not None and jobs < 1:
         raise ConfigError(f"--jobs must be >= 1, got {jobs}")
     if jobs is not None and scheduler is not None:
@@ -83,6 +108,11 @@ async def _identity(address: str) -> dict[str, Any]:
 
 def probe(address: str) -> None:
     """Check within :data:`SCHEDULER_TIMEOUT` seconds that a Dask scheduler answers.
+
+    Parameters
+    ----------
+    address : str
+        The scheduler's address (``tcp://host:8786``).
 
     Raises
     ------
@@ -108,6 +138,16 @@ def probe(address: str) -> None:
 
 def connect(address: str) -> Any:
     """A ``distributed.Client`` of the scheduler at ``address`` (probed first).
+
+    Parameters
+    ----------
+    address : str
+        The scheduler's address (``tcp://host:8786``).
+
+    Returns
+    -------
+    distributed.Client
+        A client, not set as the default one; the caller closes it.
 
     Raises
     ------

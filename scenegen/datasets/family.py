@@ -536,6 +536,11 @@ def family_from_dict(data: Any, *, source: str = "family", folder: Path | None =
         in a base config file, whose are relative to that file) are read from; ``None``:
         the current directory.
 
+    Returns
+    -------
+    Family
+        The validated family (every grid point's config checked).
+
     Raises
     ------
     ConfigError
@@ -656,6 +661,17 @@ def load_family(path: str | Path) -> Family:
     It is read as a scenario config is (:func:`scenegen.config.load_data`: UTF-8, at most
     :data:`~scenegen.config.MAX_CONFIG_BYTES`, YAML aliases bounded, duplicate keys
     refused).
+
+    Parameters
+    ----------
+    path : str or Path
+        The family file; relative ``base`` files and image sources in it are relative to
+        its folder.
+
+    Returns
+    -------
+    Family
+        The validated family.
 
     Raises
     ------

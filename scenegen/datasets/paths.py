@@ -39,6 +39,16 @@ def parse_path(path: str) -> list[str | int]:
 
     Indices by name are returned as ``"[name]"`` strings.
 
+    Parameters
+    ----------
+    path : str
+        A field path, such as ``entities[walker].motion.x.sigma``.
+
+    Returns
+    -------
+    list of (str or int)
+        The tokens: ``["entities", "[walker]", "motion", "x", "sigma"]``.
+
     Raises
     ------
     ConfigError
@@ -138,6 +148,19 @@ def _walk(data: Any, path: str) -> tuple[Any, str | int, Any, str]:
 def leaf_type(data: dict[str, Any], path: str) -> Any:
     """The declared type of the field at ``path`` (Optional unwrapped).
 
+    Parameters
+    ----------
+    data : dict
+        Plain config data (as :func:`scenegen.config.to_dict` gives).
+    path : str
+        A field path into it.
+
+    Returns
+    -------
+    type
+        The field's type hint (``int``, ``tuple[int, int]``, a config dataclass, ...),
+        ``X | None`` given as ``X``.
+
     Raises
     ------
     ConfigError
@@ -151,6 +174,18 @@ def canonical_path(data: dict[str, Any], path: str) -> str:
     ``clutter[clutter].count`` -> ``clutter[0].count`` (two paths set the same field when
     these are equal).
 
+    Parameters
+    ----------
+    data : dict
+        Plain config data (as :func:`scenegen.config.to_dict` gives).
+    path : str
+        A field path into it.
+
+    Returns
+    -------
+    str
+        The path with every ``[name]`` index replaced by its item's position.
+
     Raises
     ------
     ConfigError
@@ -160,12 +195,45 @@ def canonical_path(data: dict[str, Any], path: str) -> str:
 
 
 def get_path(data: dict[str, Any], path: str) -> Any:
-    """The value at ``path`` in plain config data."""
+    """The value at ``path`` in plain config data.
+
+    Parameters
+    ----------
+    data : dict
+        Plain config data (as :func:`scenegen.config.to_dict` gives).
+    path : str
+        A field path into it.
+
+    Returns
+    -------
+    Any
+        The value (None for a field missing from a mapping).
+
+    Raises
+    ------
+    ConfigError
+        As :func:`leaf_type`.
+    """
     cont, key, _, _ = _walk(data, path)
     return cont[key] if isinstance(cont, list) else cont.get(key)
 
 
 def set_path(data: dict[str, Any], path: str, value: Any) -> None:
-    """Set the value at ``path`` in plain config data, in place."""
+    """Set the value at ``path`` in plain config data, in place.
+
+    Parameters
+    ----------
+    data : dict
+        Plain config data (as :func:`scenegen.config.to_dict` gives); changed in place.
+    path : str
+        A field path into it; every field above the last must be present and not null.
+    value : Any
+        The new value (not validated here: :func:`scenegen.config.from_dict` does).
+
+    Raises
+    ------
+    ConfigError
+        As :func:`leaf_type`.
+    """
     cont, key, _, _ = _walk(data, path)
     cont[key] = value

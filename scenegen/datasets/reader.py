@@ -201,19 +201,25 @@ class Samples:
     files themselves. It works with ``torch.utils.data.DataLoader`` as is (numpy arrays
     are collated into tensors), and without torch as a plain iterable.
 
+    A sample (``samples[j]``, and each item of the iteration) is a tuple
+    ``(frames, boxes)``:
+
+    - ``frames``: ndarray of shape (L, H, W, 3), uint8 (L the sequence's length without
+      ``clip``);
+    - ``boxes``: ndarray of shape (L, M, 4), float32. The boxes [x, y, w, h] (px) of the
+      sequence's M targets; NaN where absent.
+
     Parameters
     ----------
     dataset : Dataset
+        The dataset (:func:`open_dataset`).
     clip : int, optional
+        Window length L (frames), >= 1; None: whole sequences. A sequence shorter than
+        L gives no window.
     stride : int, optional
-    gt : {'box', 'visible_box'}
+        Frames between window starts, >= 1 (default: ``clip``); unused without ``clip``.
+    gt : {'box', 'visible_box'}, default 'box'
         Amodal or visible boxes.
-
-    Yields / returns
-    ----------------
-    frames : ndarray of shape (L, H, W, 3), uint8
-    boxes : ndarray of shape (L, M, 4), float32
-        The boxes [x, y, w, h] of the sequence's M targets; NaN where absent.
 
     Raises
     ------

@@ -39,11 +39,17 @@ def validate_dataset(
     Parameters
     ----------
     root : str or Path
-    deep : bool
+    deep : bool, default False
         Also generate every sequence again from its stored config and seed and compare
         with the manifest's digests (as long as making the dataset).
     progress : callable, optional
         Called with the number of shard files checked so far.
+
+    Returns
+    -------
+    list of str
+        One line per problem, each naming the file (and entry or sequence) at fault; a
+        manifest that cannot be read at all gives that one line.
     """
     from scenegen.io import read, sequence_names
     from scenegen.io.validate import check_file

@@ -123,6 +123,11 @@ def failure_threshold(gt: ArrayLike, *, fraction: float = 1.0) -> NDArray[np.flo
     -------
     ndarray of shape (M,)
         Threshold in pixels (NaN for a target never present).
+
+    Raises
+    ------
+    ValueError
+        If ``fraction`` is not > 0.
     """
     if not fraction > 0:
         raise ValueError(f"fraction must be > 0, got {fraction}")
@@ -146,7 +151,26 @@ def check_options(
     gt_mode: str, visibility_threshold: float, otb_average: str, iou_threshold: float = 0.5
 ) -> None:
     """Raise ConfigError naming an unknown ``gt_mode`` / ``otb_average`` or a bad threshold
-    (:func:`scenegen.io.mot.check_gt_mode`: one definition with the exports)."""
+    (:func:`scenegen.io.mot.check_gt_mode`: one definition with the exports).
+
+    Parameters
+    ----------
+    gt_mode : str
+        Ground-truth convention, one of :data:`GT_MODES`.
+    visibility_threshold : float
+        Visible fraction above which a target counts, in [0, 1); 0 in ``"amodal"`` mode.
+    otb_average : str
+        Overall OTB average, one of :data:`OTB_AVERAGES`.
+    iou_threshold : float
+        IoU of a match, in (0, 1].
+
+    Raises
+    ------
+    ConfigError
+        If ``iou_threshold`` is not in (0, 1], ``gt_mode`` or ``otb_average`` is unknown,
+        ``visibility_threshold`` is not in [0, 1), or it is not 0 with ``gt_mode``
+        ``"amodal"``.
+    """
     if not 0.0 < iou_threshold <= 1.0:
         raise ConfigError(f"iou_threshold must be in (0, 1], got {iou_threshold}")
     check_gt_mode(gt_mode, visibility_threshold)
@@ -211,10 +235,12 @@ def evaluate(
     Raises
     ------
     DataError
-        If the result's frame count differs from the sequence's, its target count differs
+        If ``boxes`` is not of shape (T, M, 4) for the M ids of ``target_ids``, the
+        result's frame count differs from the sequence's, its target count differs
         from the number of targets present at frame 0 (those ``scenegen track`` follows),
-        a target id is not one of those targets or not an integer, or a box row is neither
-        a box (finite, w, h >= 0) nor all NaN.
+        a target id is not one of those targets, is repeated or is not an integer, a box
+        row is neither a box (finite, w, h >= 0) nor all NaN, or ``order_prob`` and
+        ``orderings`` do not fit the frames and targets.
     ConfigError
         If an option is out of range.
     """
@@ -351,7 +377,15 @@ def evaluate_target(
     target_id : int, optional
         The entity id of the target followed (:func:`pick_target`: a target present at
         frame 0; default the only one).
-    tracker, recover_frames, persist, iou_threshold, gt_mode, visibility_threshold, otb_average
+    tracker : str
+        Tracker name, for the report.
+    recover_frames, persist : int
+        As in :func:`evaluate`.
+    iou_threshold, visibility_threshold : float
+        As in :func:`evaluate`.
+    gt_mode : {"amodal", "visible"}
+        As in :func:`evaluate`.
+    otb_average : {"sequence", "frames"}
         As in :func:`evaluate`.
 
     Returns
@@ -362,8 +396,9 @@ def evaluate_target(
     Raises
     ------
     DataError
-        If the frame count differs from the sequence's, or a box row is neither a box
-        (finite, w, h >= 0) nor all NaN.
+        If ``boxes`` is not of shape (T, 4), the frame count differs from the sequence's,
+        a box row is neither a box (finite, w, h >= 0) nor all NaN, or no target is
+        present at frame 0.
     ConfigError
         If an option is out of range, or ``target_id`` as :func:`pick_target` says.
 
@@ -479,7 +514,15 @@ def evaluate_tracks(
     track_ids : array_like of int, shape (H,)
         Track ids. A target is paired with the track of its own entity id (scenegen's
         exports use those), else with the track the identity matching assigns it.
-    tracker, recover_frames, persist, iou_threshold, gt_mode, visibility_threshold, otb_average
+    tracker : str
+        Tracker name, for the report.
+    recover_frames, persist : int
+        As in :func:`evaluate`.
+    iou_threshold, visibility_threshold : float
+        As in :func:`evaluate`.
+    gt_mode : {"amodal", "visible"}
+        As in :func:`evaluate`.
+    otb_average : {"sequence", "frames"}
         As in :func:`evaluate`.
     rank : array_like of int, shape (T, H), optional
         Order of each frame's boxes in the tracker file
@@ -494,9 +537,12 @@ def evaluate_tracks(
     Raises
     ------
     DataError
-        If the frame count differs from the sequence's, ``track_ids`` repeat an id or
-        hold one that is not an integer, or a box row is neither a box (finite, w, h >= 0)
-        nor all NaN (as the tracker-file reader refuses).
+        If ``boxes`` is not of shape (T, H, 4) for the H ids of ``track_ids``, the frame
+        count differs from the sequence's, ``rank`` is not of shape (T, H), ``track_ids``
+        repeat an id or hold one that is not an integer, or a box row is neither a box
+        (finite, w, h >= 0) nor all NaN (as the tracker-file reader refuses).
+    ConfigError
+        If an option is out of range.
     """
     check_options(gt_mode, visibility_threshold, otb_average, iou_threshold)
     est = np.asarray(boxes, dtype=np.float64)
@@ -637,5 +683,16 @@ def _report(
 
 
 def to_json(report: SequenceReport) -> str:
-    """One JSON document for a report (sorted keys, no NaN); ``report.to_json()``."""
+    """One JSON document for a report (sorted keys, no NaN); ``report.to_json()``.
+
+    Parameters
+    ----------
+    report : SequenceReport
+        The report to serialise.
+
+    Returns
+    -------
+    str
+        The JSON text; undefined numbers are ``null``.
+    """
     return report.to_json()

@@ -68,7 +68,23 @@ def _boxes(b: ArrayLike) -> FloatArray:
 
 
 def box_area(boxes: ArrayLike) -> FloatArray:
-    """Area w·h of boxes of shape (..., 4); NaN for a missing box."""
+    """Area w·h of boxes of shape (..., 4); NaN for a missing box.
+
+    Parameters
+    ----------
+    boxes : array_like of float, shape (..., 4)
+        Boxes ``[x, y, w, h]``, pixels.
+
+    Returns
+    -------
+    ndarray of float, shape (...)
+        Area in pixels².
+
+    Raises
+    ------
+    ValueError
+        If the last axis of ``boxes`` is not of length 4.
+    """
     b = _boxes(boxes)
     return b[..., 2] * b[..., 3]
 
@@ -76,10 +92,20 @@ def box_area(boxes: ArrayLike) -> FloatArray:
 def intersection_area(a: ArrayLike, b: ArrayLike) -> FloatArray:
     """Area of the intersection of boxes ``a`` and ``b`` (broadcast, shape (..., 4) each).
 
+    Parameters
+    ----------
+    a, b : array_like of float, shape (..., 4)
+        Boxes ``[x, y, w, h]``, pixels; NaN for a missing box.
+
     Returns
     -------
     ndarray of shape (...)
         Intersection area in pixels² (0 for disjoint boxes, NaN if either box is missing).
+
+    Raises
+    ------
+    ValueError
+        If the last axis of ``a`` or ``b`` is not of length 4.
     """
     a, b = _boxes(a), _boxes(b)
     x0 = np.maximum(a[..., 0], b[..., 0])
@@ -92,10 +118,26 @@ def intersection_area(a: ArrayLike, b: ArrayLike) -> FloatArray:
 def iou(a: ArrayLike, b: ArrayLike) -> FloatArray:
     """Intersection over union of boxes ``a`` and ``b`` (broadcast, shape (..., 4) each).
 
+    Parameters
+    ----------
+    a, b : array_like of float, shape (..., 4)
+        Boxes ``[x, y, w, h]``, pixels; NaN for a missing box.
+
     Returns
     -------
     ndarray of shape (...)
         IoU in [0, 1]; NaN if either box is missing; 0 if both boxes have zero area.
+
+    Raises
+    ------
+    ValueError
+        If the last axis of ``a`` or ``b`` is not of length 4.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> iou(np.array([[0, 0, 10, 10.], [0, 0, 4, 4.]]), np.array([0, 0, 10, 5.]))
+    array([0.5 , 0.32])
     """
     inter = intersection_area(a, b)
     union = box_area(a) + box_area(b) - inter
@@ -105,7 +147,23 @@ def iou(a: ArrayLike, b: ArrayLike) -> FloatArray:
 
 
 def centres(boxes: ArrayLike) -> FloatArray:
-    """Centres (x, y) of boxes of shape (..., 4), shape (..., 2)."""
+    """Centres (x, y) of boxes of shape (..., 4), shape (..., 2).
+
+    Parameters
+    ----------
+    boxes : array_like of float, shape (..., 4)
+        Boxes ``[x, y, w, h]``, pixels.
+
+    Returns
+    -------
+    ndarray of float, shape (..., 2)
+        Centres ``(x + w/2, y + h/2)``, pixels; NaN for a missing box.
+
+    Raises
+    ------
+    ValueError
+        If the last axis of ``boxes`` is not of length 4.
+    """
     b = _boxes(boxes)
     return np.stack([b[..., 0] + b[..., 2] / 2, b[..., 1] + b[..., 3] / 2], axis=-1)
 
@@ -114,6 +172,21 @@ def centre_error(est: ArrayLike, gt: ArrayLike) -> FloatArray:
     """Euclidean distance in pixels between box centres, shape (...) from (..., 4) each.
 
     NaN where either box is missing.
+
+    Parameters
+    ----------
+    est, gt : array_like of float, shape (..., 4)
+        Estimated and ground-truth boxes ``[x, y, w, h]``, pixels (broadcast).
+
+    Returns
+    -------
+    ndarray of float, shape (...)
+        Centre error, pixels.
+
+    Raises
+    ------
+    ValueError
+        If the last axis of ``est`` or ``gt`` is not of length 4.
     """
     d = centres(est) - centres(gt)
     return np.sqrt(np.sum(d * d, axis=-1))
@@ -178,6 +251,11 @@ def success_rate(state: ArrayLike) -> float:
     -------
     float
         Success rate in percent; NaN for R = 0.
+
+    Raises
+    ------
+    ValueError
+        If ``state`` is not of shape (R, T) with T ≥ 1.
     """
     s = _state(state)
     if s.shape[0] == 0:
@@ -205,6 +283,11 @@ def recovery_rate(state: ArrayLike, *, last_k: int = 5) -> float:
     -------
     float
         Recovery rate in percent; NaN for R = 0.
+
+    Raises
+    ------
+    ValueError
+        If ``state`` is not of shape (R, T) with T ≥ 1, or ``last_k`` < 1.
     """
     s = _state(state)
     if last_k < 1:
@@ -250,9 +333,20 @@ def uniqueness_percent(uniqueness: ArrayLike) -> FloatArray:
     of particles) per frame, as PF trackers report it; NaN frames (frame 0, before the first
     step) are ignored. Leading axes (e.g. runs) are averaged too.
 
+    Parameters
+    ----------
+    uniqueness : array_like of float, shape (..., T, K)
+        U/N per frame and object, in [0, 1]; NaN where undefined.
+
     Returns
     -------
     ndarray of shape (K,)
+        Mean uniqueness in percent; NaN for an object with no finite value.
+
+    Raises
+    ------
+    ValueError
+        If ``uniqueness`` has fewer than 2 axes.
     """
     u = np.asarray(uniqueness, dtype=np.float64)
     if u.ndim < 2:
@@ -281,6 +375,12 @@ def effective_dynamics_percent(
     Returns
     -------
     ndarray of shape (K,) or (K, C)
+        Mean in percent; NaN where no frame is finite.
+
+    Raises
+    ------
+    ValueError
+        If ``effective_dynamics`` has fewer than 2 axes (3 with ``components=True``).
     """
     e = np.asarray(effective_dynamics, dtype=np.float64)
     tail = 2 if components else 1
@@ -419,6 +519,11 @@ def failure_frame(error: ArrayLike, threshold: float, *, persist: int = 10) -> i
     -------
     int
         The failure frame, or -1.
+
+    Raises
+    ------
+    ValueError
+        If ``error`` is not 1-D or ``persist`` < 1.
     """
     e = np.asarray(error, dtype=np.float64)
     if e.ndim != 1:
@@ -438,6 +543,25 @@ def tracked_fraction(error: ArrayLike, threshold: float, *, persist: int = 10) -
     """Proportion of the sequence tracked before failure: failure frame / T, or 1.
 
     Used as the KAMS robustness score in :func:`mcnemar_counts`.
+
+    Parameters
+    ----------
+    error : array_like of float, shape (T,)
+        Centre error per frame, pixels (NaN, a missing estimate, counts as above).
+    threshold : float
+        Error above which the target is lost, pixels.
+    persist : int
+        Frames the error must stay above the threshold (≥ 1); see :func:`failure_frame`.
+
+    Returns
+    -------
+    float
+        Tracked proportion in [0, 1]; 1 if the run never fails.
+
+    Raises
+    ------
+    ValueError
+        If ``error`` is not 1-D or ``persist`` < 1.
     """
     e = np.asarray(error, dtype=np.float64)
     f = failure_frame(e, threshold, persist=persist)
@@ -460,6 +584,11 @@ def mcnemar_counts(score_a: ArrayLike, score_b: ArrayLike) -> tuple[int, int]:
     -------
     n_sf, n_fs : int
         Cases where A succeeded and B failed, and the reverse.
+
+    Raises
+    ------
+    ValueError
+        If the scores are not two 1-D arrays of the same length.
     """
     a = np.asarray(score_a, dtype=np.float64)
     b = np.asarray(score_b, dtype=np.float64)
@@ -470,7 +599,15 @@ def mcnemar_counts(score_a: ArrayLike, score_b: ArrayLike) -> tuple[int, int]:
 
 @dataclass(frozen=True)
 class McNemar:
-    """McNemar's statistic: ``chi2`` (eq. 9) and the signed ``z`` score (eq. 10)."""
+    """McNemar's statistic: ``chi2`` (eq. 9) and the signed ``z`` score (eq. 10).
+
+    Attributes
+    ----------
+    chi2 : float
+        Continuity-corrected χ² (≥ 0).
+    z : float
+        Signed z score; z > 0 means tracker A is more robust than B.
+    """
 
     chi2: float
     z: float
@@ -483,6 +620,22 @@ def mcnemar(n_sf: int, n_fs: int) -> McNemar:
     The continuity-corrected difference is clipped at 0 (no evidence either way when the
     counts are equal), and z carries the sign of N_sf − N_fs so that z > 0 means A is more
     robust than B. With no discordant pairs both are 0.
+
+    Parameters
+    ----------
+    n_sf, n_fs : int
+        Cases where A succeeded and B failed, and the reverse (≥ 0), e.g. from
+        :func:`mcnemar_counts`.
+
+    Returns
+    -------
+    McNemar
+        ``chi2`` and ``z``.
+
+    Raises
+    ------
+    ValueError
+        If a count is negative.
 
     Examples
     --------
@@ -559,6 +712,12 @@ def clear_mot(gt: ArrayLike, est: ArrayLike, *, iou_threshold: float = 0.5) -> C
     -------
     ClearMot
         MOTA is NaN when there is no ground-truth object at all, MOTP when nothing matches.
+
+    Raises
+    ------
+    ValueError
+        If ``gt`` and ``est`` are not of shapes (T, K, 4) and (T, M, 4) with the same T,
+        or ``iou_threshold`` is not in (0, 1].
     """
     g, e = _check_tracks(gt, est)
     mot.check_threshold(iou_threshold)
@@ -587,13 +746,23 @@ def idf1(gt: ArrayLike, est: ArrayLike, *, iou_threshold: float = 0.5) -> float:
     Parameters
     ----------
     gt : array_like of shape (T, K, 4)
+        Ground-truth boxes, NaN where the object is absent.
     est : array_like of shape (T, M, 4)
+        Hypothesis boxes (track j is column j), NaN where there is none.
     iou_threshold : float
+        Smallest IoU of a match, in (0, 1].
 
     Returns
     -------
     float
-        IDF1 in [0, 1]; NaN when there are no detections on either side.
+        IDF1 in [0, 1]; NaN when there are no detections on either side (0 when only one
+        side has none).
+
+    Raises
+    ------
+    ValueError
+        If ``gt`` and ``est`` are not of shapes (T, K, 4) and (T, M, 4) with the same T,
+        or ``iou_threshold`` is not in (0, 1].
     """
     mot.check_threshold(iou_threshold)
     g, e = _check_tracks(gt, est)
@@ -617,6 +786,11 @@ def ordering_index(depth: ArrayLike, orderings: ArrayLike) -> NDArray[np.intp]:
     ndarray of int, shape (T,)
         Row of ``orderings`` equal to the targets sorted nearest first (ties keep target
         order), or -1 where no row matches.
+
+    Raises
+    ------
+    ValueError
+        If ``depth`` and ``orderings`` are not 2-D with the same number of targets M.
     """
     d = np.asarray(depth)
     o = np.asarray(orderings)
@@ -628,7 +802,25 @@ def ordering_index(depth: ArrayLike, orderings: ArrayLike) -> NDArray[np.intp]:
 
 
 def overlap_fraction(a: ArrayLike, b: ArrayLike) -> FloatArray:
-    """Intersection area over the smaller box's area (broadcast, (..., 4) each); 0 if none."""
+    """Intersection area over the smaller box's area (broadcast, (..., 4) each); 0 if none.
+
+    "None" covers a missing box on either side and a smaller box of zero area.
+
+    Parameters
+    ----------
+    a, b : array_like of float, shape (..., 4)
+        Boxes ``[x, y, w, h]``, pixels; NaN for a missing box.
+
+    Returns
+    -------
+    ndarray of float, shape (...)
+        Overlap fraction in [0, 1].
+
+    Raises
+    ------
+    ValueError
+        If the last axis of ``a`` or ``b`` is not of length 4.
+    """
     inter = np.nan_to_num(intersection_area(a, b), nan=0.0)
     small = np.nan_to_num(np.minimum(box_area(a), box_area(b)), nan=0.0)
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -652,6 +844,12 @@ def overlapping_pairs(boxes: ArrayLike, *, min_overlap: float = 0.1) -> NDArray[
     -------
     ndarray of bool, shape (T, M, M)
         Symmetric, False on the diagonal.
+
+    Raises
+    ------
+    ValueError
+        If ``min_overlap`` is not in (0, 1], or the last axis of ``boxes`` is not of
+        length 4.
     """
     if not 0.0 < min_overlap <= 1.0:
         raise ValueError(f"min_overlap must be in (0, 1], got {min_overlap}")
@@ -694,6 +892,11 @@ def depth_order_accuracy(
     -------
     float
         Accuracy in percent; NaN if no pair ever overlaps.
+
+    Raises
+    ------
+    ValueError
+        If the shapes disagree (T, L and M as above) or ``min_overlap`` is not in (0, 1].
     """
     p = np.asarray(order_prob, dtype=np.float64)
     o = np.asarray(orderings)

@@ -58,6 +58,18 @@ def box_iou(a: ArrayLike, b: ArrayLike) -> NDArray[np.float64]:
     """IoU of boxes ``[x, y, w, h]``, (N, 4) against (M, 4) -> (N, M), as TrackEval.
 
     Boxes of zero area and pairs of zero union have IoU 0.
+
+    Parameters
+    ----------
+    a : array_like of float, shape (N, 4)
+        Boxes ``[x, y, w, h]``, pixels (any shape is read as rows of 4).
+    b : array_like of float, shape (M, 4)
+        Boxes ``[x, y, w, h]``, pixels.
+
+    Returns
+    -------
+    ndarray of float, shape (N, M)
+        IoU of every box of ``a`` with every box of ``b``, in [0, 1].
     """
     b1 = np.array(a, dtype=np.float64).reshape(-1, 4)
     b2 = np.array(b, dtype=np.float64).reshape(-1, 4)
@@ -146,6 +158,11 @@ def mot_frames(
         Within a frame, objects keep their column order and tracks the order of
         ``est_rank`` (TrackEval keeps the row order of its files, which breaks ties in
         its matchings; scenegen's exports list boxes in column order).
+
+    Raises
+    ------
+    ValueError
+        If ``gt`` and ``est`` are not of shapes (T, K, 4) and (T, H, 4) with the same T.
     """
     g, e = _frames_of_boxes(gt, est)
     gp = np.all(np.isfinite(g), axis=-1)
@@ -221,6 +238,11 @@ def remove_distractor_matches(
     -------
     ndarray of bool, shape (T, H)
         True for the tracker boxes to keep (and for absent ones).
+
+    Raises
+    ------
+    ValueError
+        If ``gt`` and ``est`` are not of shapes (T, K, 4) and (T, H, 4) with the same T.
     """
     g, e = _frames_of_boxes(gt, est)
     dis = np.broadcast_to(np.asarray(distractor, dtype=bool), g.shape[:2])
@@ -289,6 +311,16 @@ def check_threshold(threshold: float) -> None:
 
     A threshold of 0 would count every pair of boxes, overlapping or not, as a match (IoU
     is never negative), which no metric intends; above 1 nothing ever matches.
+
+    Parameters
+    ----------
+    threshold : float
+        Match IoU threshold to check.
+
+    Raises
+    ------
+    ValueError
+        If ``threshold`` is not in (0, 1].
     """
     if not 0.0 < float(threshold) <= 1.0:
         raise ValueError(f"iou_threshold must be in (0, 1], got {threshold}")
@@ -301,6 +333,24 @@ def clear(data: MotFrames, *, threshold: float = 0.5) -> ClearScores:
     track of the previous frame, then the summed IoU, among pairs with IoU ≥ ``threshold``.
     An object matched to a different track than at its last match (any number of frames
     earlier) is an identity switch.
+
+    Parameters
+    ----------
+    data : MotFrames
+        Detections and similarities of the sequence (e.g. from :func:`mot_frames`).
+    threshold : float
+        Smallest IoU of a match, in (0, 1].
+
+    Returns
+    -------
+    ClearScores
+        With no tracker detection, every object is missed (all FN, all ML); with no
+        ground-truth detection, every tracker detection is a false positive.
+
+    Raises
+    ------
+    ValueError
+        If ``threshold`` is not in (0, 1].
     """
     check_threshold(threshold)
     if data.n_tracker_dets == 0:
@@ -394,6 +444,23 @@ def identity(data: MotFrames, *, threshold: float = 0.5) -> IdentityScores:
     frames the matched pairs share, so minimising IDFN + IDFP is maximising IDTP: the
     rectangular problem on the shared-frame counts (objects x tracks) has the same optimum,
     in integers, and the same IDTP, IDFN and IDFP.
+
+    Parameters
+    ----------
+    data : MotFrames
+        Detections and similarities of the sequence (e.g. from :func:`mot_frames`).
+    threshold : float
+        Smallest IoU of a match, in (0, 1].
+
+    Returns
+    -------
+    IdentityScores
+        All rates 0 when either side has no detection.
+
+    Raises
+    ------
+    ValueError
+        If ``threshold`` is not in (0, 1].
     """
     check_threshold(threshold)
     if data.n_tracker_dets == 0:
@@ -465,6 +532,16 @@ def hota(data: MotFrames) -> HotaScores:
     A global alignment score between each object and track (their IoU-weighted co-occurrence
     Jaccard index) weights the per-frame IoU; the Hungarian algorithm maximises that
     product, and each threshold α in :data:`HOTA_ALPHAS` keeps the matches with IoU ≥ α.
+
+    Parameters
+    ----------
+    data : MotFrames
+        Detections and similarities of the sequence (e.g. from :func:`mot_frames`).
+
+    Returns
+    -------
+    HotaScores
+        When either side has no detection, every score is 0 but LocA, 1 (as TrackEval).
     """
     n_a = len(HOTA_ALPHAS)
     zeros = np.zeros(n_a)
@@ -519,7 +596,17 @@ def hota(data: MotFrames) -> HotaScores:
 
 @dataclass(frozen=True)
 class MotScores:
-    """CLEAR MOT, identity and HOTA scores of one sequence."""
+    """CLEAR MOT, identity and HOTA scores of one sequence.
+
+    Attributes
+    ----------
+    clear : ClearScores
+        CLEAR MOT scores (:func:`clear`).
+    identity : IdentityScores
+        IDF1, IDP, IDR (:func:`identity`).
+    hota : HotaScores
+        HOTA and its components (:func:`hota`).
+    """
 
     clear: ClearScores
     identity: IdentityScores
@@ -527,7 +614,25 @@ class MotScores:
 
 
 def score_all(data: MotFrames, *, threshold: float = 0.5) -> MotScores:
-    """:func:`clear`, :func:`identity` (both at ``threshold``) and :func:`hota` of ``data``."""
+    """:func:`clear`, :func:`identity` (both at ``threshold``) and :func:`hota` of ``data``.
+
+    Parameters
+    ----------
+    data : MotFrames
+        Detections and similarities of the sequence (e.g. from :func:`mot_frames`).
+    threshold : float
+        Smallest IoU of a match for CLEAR MOT and the identity scores, in (0, 1]; HOTA
+        uses its own thresholds :data:`HOTA_ALPHAS`.
+
+    Returns
+    -------
+    MotScores
+
+    Raises
+    ------
+    ValueError
+        If ``threshold`` is not in (0, 1].
+    """
     return MotScores(
         clear=clear(data, threshold=threshold),
         identity=identity(data, threshold=threshold),

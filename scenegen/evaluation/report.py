@@ -30,6 +30,25 @@ class MotSummary:
 
     Fractions in [0, 1] (MOTA can be negative); counts are ints. Computed as TrackEval
     does (:mod:`scenegen.evaluation.mot`).
+
+    Attributes
+    ----------
+    mota, motp, moda : float
+        CLEAR MOT accuracy, precision (mean IoU of the matches) and detection accuracy.
+    tp, fp, fn, idsw, frag : int
+        Matches, false positives, misses, identity switches, fragmentations.
+    mt, pt, ml : int
+        Objects mostly tracked, partly tracked, mostly lost.
+    idf1, idp, idr : float
+        Identity F1, precision and recall.
+    hota, deta, assa, loca : float
+        HOTA and its detection, association and localisation accuracy (means over the
+        thresholds).
+
+    See Also
+    --------
+    scenegen.evaluation.mot.ClearScores, scenegen.evaluation.mot.IdentityScores,
+    scenegen.evaluation.mot.HotaScores
     """
 
     mota: float
@@ -229,7 +248,19 @@ def _mot_cells(m: MotSummary) -> list[str]:
 
 
 def format_table(report: SequenceReport) -> str:
-    """Render a report as two plain-text tables (single-target and multi-object scores)."""
+    """Render a report as two plain-text tables (single-target and multi-object scores).
+
+    Parameters
+    ----------
+    report : SequenceReport
+        The report to render.
+
+    Returns
+    -------
+    str
+        A header line, the two tables (each with an ``all`` row for the overall scores) and
+        a one-line overall summary, joined by newlines; undefined numbers show as ``-``.
+    """
     thr = f" > {report.visibility_threshold:g}" if report.gt_mode == "visible" else ""
     lines = [
         f"sequence {report.sequence!r}, tracker {report.tracker!r}, {report.n_frames} frames, "

@@ -255,6 +255,11 @@ def atomic_path(path: str | Path, suffix: str = "") -> Iterator[Path]:
     suffix : str
         Ending of the temporary name (lets writers that pick a format by extension work).
 
+    Yields
+    ------
+    Path
+        The temporary file (created empty) to write the content to.
+
     Raises
     ------
     ConfigError
@@ -399,7 +404,8 @@ def write_npy(path: str | Path, array: ArrayLike, *, parents: bool = False) -> N
     ----------
     path : str or Path
         Written as given (no ``.npy`` appended).
-    array : array-like
+    array : array_like, any shape and dtype
+        Saved as ``np.asarray(array)``.
     parents : bool
         Create missing parent folders first.
 

@@ -79,7 +79,26 @@ _COVER_EDGES = np.array([0.15, 0.30, 0.45, 0.60, 0.75, 0.90], dtype=np.float32)
 
 
 def cover_level(visibility: float, present: bool) -> int:
-    """GOT-10k's cover level 0–8 of a visible fraction (0 when absent or fully occluded)."""
+    """GOT-10k's cover level 0–8 of a visible fraction (0 when absent or fully occluded).
+
+    Parameters
+    ----------
+    visibility : float
+        Visible fraction of the target, in [0, 1] (compared in float32).
+    present : bool
+        Whether the target is in the scene.
+
+    Returns
+    -------
+    int
+        0 absent or fully occluded, 1 (0, 15 %), 2 [15, 30 %), … 7 [90, 100 %), 8 fully
+        visible.
+
+    Examples
+    --------
+    >>> cover_level(0.5, True), cover_level(1.0, True), cover_level(0.5, False)
+    (4, 8, 0)
+    """
     v = np.float32(visibility)
     if not present or v <= 0.0:
         return 0
@@ -267,7 +286,19 @@ def _box_line(line: str) -> tuple[float, float, float, float] | None:
 def first_box_values(path: str | Path) -> int | None:
     """How many values the first line of a text file holds, split as
     :func:`read_benchmark_result` splits a line (4 for an OTB or GOT-10k result); None
-    if the file cannot be read as text. Reads at most the first 4 kB."""
+    if the file cannot be read as text. Reads at most the first 4 kB.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file.
+
+    Returns
+    -------
+    int or None
+        Values on the first line; None also for a FIFO or a device (not opened), an
+        empty file or a blank first line.
+    """
     if describe_special_file(path) is not None:  # a FIFO would wait for a writer
         return None
     try:

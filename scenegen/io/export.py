@@ -109,7 +109,28 @@ def _replace_dir(tmp: Path, out: Path) -> None:
 
 
 def encode_frame(frame: np.ndarray, image_format: str, where: Path) -> bytes:
-    """Encode an RGB frame (H, W, 3) uint8 as PNG or JPEG (quality 95) bytes."""
+    """Encode an RGB frame (H, W, 3) uint8 as PNG or JPEG (quality 95) bytes.
+
+    Parameters
+    ----------
+    frame : ndarray of uint8, shape (H, W, 3)
+        RGB frame.
+    image_format : {"png", "jpg"}
+        Encoding (:data:`IMAGE_FORMATS`).
+    where : Path
+        The output the frame is for, named in error messages.
+
+    Returns
+    -------
+    bytes
+        The encoded image file.
+
+    Raises
+    ------
+    ConfigError
+        For an image format not in :data:`IMAGE_FORMATS`, or a frame that cannot be encoded
+        (naming ``where``).
+    """
     if image_format not in IMAGE_FORMATS:
         raise ConfigError(
             f"image format must be one of {', '.join(IMAGE_FORMATS)}; got {image_format!r}"
@@ -124,6 +145,17 @@ def encode_frame(frame: np.ndarray, image_format: str, where: Path) -> bytes:
 
 def write_folder(out_dir: str | Path, fill: Callable[[Path], None]) -> None:
     """Create folder ``out_dir`` atomically: ``fill(tmp)`` writes into a temporary folder.
+
+    The temporary folder then replaces ``out_dir`` (and any folder there) in one step; if
+    ``fill`` raises, it is removed and the exception propagates.
+
+    Parameters
+    ----------
+    out_dir : str or Path
+        The folder to create or replace; its parent must exist.
+    fill : callable
+        ``fill(tmp)`` writes the folder's content into the temporary folder ``tmp``
+        (a :class:`~pathlib.Path` beside ``out_dir``).
 
     Raises
     ------

@@ -82,7 +82,14 @@ class Unreadable(DataError):
 
 def timeout() -> float:
     """The deadline in seconds: ``SCENEGEN_READ_TIMEOUT`` if set (and positive), else
-    :data:`TIMEOUT`."""
+    :data:`TIMEOUT`.
+
+    Returns
+    -------
+    float
+        The deadline, seconds; :data:`TIMEOUT` also when the variable is not a finite
+        number.
+    """
     text = os.environ.get("SCENEGEN_READ_TIMEOUT", "")
     try:
         value = float(text)
@@ -330,7 +337,25 @@ def _main_hidden() -> Any:
 
 
 def describe_exit(code: int | None) -> str:
-    """How a child process ended, from its ``exitcode``: ``"SIGKILL"``, ``"exit status 3"``."""
+    """How a child process ended, from its ``exitcode``: ``"SIGKILL"``, ``"exit status 3"``.
+
+    Parameters
+    ----------
+    code : int or None
+        The child's ``exitcode``: negative for the signal that killed it, None if it has
+        not ended.
+
+    Returns
+    -------
+    str
+        The signal's name (``"signal N"`` for an unknown one), ``"exit status N"``, or
+        ``"no exit status"``.
+
+    Examples
+    --------
+    >>> describe_exit(-9), describe_exit(3), describe_exit(None)
+    ('SIGKILL', 'exit status 3', 'no exit status')
+    """
     if code is None:
         return "no exit status"
     if code < 0:
@@ -354,7 +379,7 @@ def call(
     fn : callable
         A module-level (picklable) function; its arguments and result must pickle. It may
         call :func:`beat` to restart the deadline while it progresses.
-    *args
+    *args : object
         Its arguments.
     label : str
         What is read (usually the path): the prefix of the error lines.
@@ -437,7 +462,12 @@ def call(
 
 
 def in_child() -> bool:
-    """True inside a guarded child (where reads need no further guard)."""
+    """True inside a guarded child (where reads need no further guard).
+
+    Returns
+    -------
+    bool
+    """
     return _conn is not None
 
 
@@ -536,7 +566,16 @@ def _remember(key: tuple[str, int, int, int]) -> None:
 
 
 def trust(path: str | Path) -> None:
-    """Record that ``path`` (as it is now) was written by this process and is sound."""
+    """Record that ``path`` (as it is now) was written by this process and is sound.
+
+    :func:`preflight` then skips the file until it changes (path, inode, size or
+    modification time). A path that cannot be examined is ignored.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file written.
+    """
     with contextlib.suppress(OSError):
         _remember(_version_key(Path(path)))
 

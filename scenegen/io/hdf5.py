@@ -376,6 +376,11 @@ def write_scenario(
         Upper bound on the frames rendered at once.
     progress : callable, optional
         Called with the number of frames written so far.
+
+    Raises
+    ------
+    ConfigError
+        A bad compression or a missing folder.
     """
     cfg = scenario.config
     meta = {
@@ -426,8 +431,9 @@ def describe_open_error(path: str | Path, err: OSError) -> str:
     Returns
     -------
     str
-        ``"PATH: ..."``: truncated (with the byte counts), being written by another
-        process, not HDF5 at all, or otherwise damaged.
+        ``"PATH: ..."``: an unfinished temporary file of an atomic write, truncated (with
+        the byte counts), being written by another process, not HDF5 at all, not
+        readable (permission denied), or otherwise damaged.
     """
     p = Path(path)
     text = str(err)

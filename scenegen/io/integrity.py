@@ -56,7 +56,18 @@ _SKIP = {DIGEST, ATTRS_DIGEST}
 
 
 def text_dtype(n_bytes: int) -> Any:
-    """Fixed-length UTF-8 string dtype of ``n_bytes`` (at least 1)."""
+    """Fixed-length UTF-8 string dtype of ``n_bytes`` (at least 1).
+
+    Parameters
+    ----------
+    n_bytes : int
+        Length of the string in UTF-8 bytes; less than 1 gives 1.
+
+    Returns
+    -------
+    numpy.dtype
+        ``S<n>`` with h5py's UTF-8 string metadata.
+    """
     return h5py.string_dtype("utf-8", max(1, int(n_bytes)))
 
 
@@ -64,7 +75,17 @@ def put_text(obj: Any, key: str, value: str) -> None:
     """Store ``value`` as a fixed-length UTF-8 string attribute ``key`` of ``obj`` (an
     existing one is replaced). The attribute is the one ``obj.attrs.create(key,
     np.bytes_(raw), dtype=text_dtype(len(raw)))`` makes, through h5py's low-level calls:
-    a third of the cost, which counts in a file of hundreds of template datasets."""
+    a third of the cost, which counts in a file of hundreds of template datasets.
+
+    Parameters
+    ----------
+    obj : h5py.File, h5py.Group or h5py.Dataset
+        The object, open for writing.
+    key : str
+        Attribute name.
+    value : str
+        Attribute value, stored as its UTF-8 bytes.
+    """
     raw = value.encode("utf-8")
     dtype, tid, space = _text_type(len(raw))
     name = key.encode("utf-8")
@@ -92,7 +113,23 @@ def put(obj: Any, key: str, value: Any) -> None:
 
 
 def text_array(values: Any) -> NDArray[np.bytes_]:
-    """Strings as a fixed-length UTF-8 byte array (for string datasets)."""
+    """Strings as a fixed-length UTF-8 byte array (for string datasets).
+
+    Parameters
+    ----------
+    values : array_like of str, any shape
+        The strings (any other value is turned into one with ``str``).
+
+    Returns
+    -------
+    ndarray of bytes, shape of ``values``
+        dtype ``S<width>``, ``width`` the longest UTF-8 encoding (at least 1).
+
+    Examples
+    --------
+    >>> text_array([["a", "é"]])
+    array([[b'a', b'\\xc3\\xa9']], dtype='|S2')
+    """
     raw = [str(v).encode("utf-8") for v in np.asarray(values, dtype=object).ravel()]
     width = max([1, *(len(r) for r in raw)])
     return np.array(raw, dtype=f"S{width}").reshape(np.shape(values))
@@ -100,6 +137,16 @@ def text_array(values: Any) -> NDArray[np.bytes_]:
 
 def as_text(value: Any) -> str:
     """An attribute or string value as ``str`` (fixed-length strings read as bytes).
+
+    Parameters
+    ----------
+    value : bytes, numpy.bytes_, str, 0-d ndarray or object
+        The value read; bytes are decoded as UTF-8, a 0-d array is unwrapped, anything
+        else goes through ``str``.
+
+    Returns
+    -------
+    str
 
     Raises
     ------
@@ -130,7 +177,18 @@ class Hasher:
 
 
 def digest(arr: NDArray[Any]) -> str:
-    """Hex SHA-256 of ``arr``'s values (C order, its dtype)."""
+    """Hex SHA-256 of ``arr``'s values (C order, its dtype).
+
+    Parameters
+    ----------
+    arr : ndarray, any shape and dtype
+        The values, as stored.
+
+    Returns
+    -------
+    str
+        64 lowercase hex digits.
+    """
     h = Hasher()
     h.update(np.asarray(arr))
     return h.hexdigest()
@@ -151,6 +209,17 @@ def _plain(value: Any) -> Any:
 def attrs_digest(attrs: Any) -> str:
     """Hex SHA-256 of a group's attributes (names, types and values), digests excluded.
 
+    Parameters
+    ----------
+    attrs : mapping of str to object
+        The attributes, e.g. an open group's ``attrs``; :data:`DIGEST` and
+        :data:`ATTRS_DIGEST` are left out.
+
+    Returns
+    -------
+    str
+        64 lowercase hex digits.
+
     Raises
     ------
     OSError, KeyError, ValueError, TypeError
@@ -167,6 +236,14 @@ def put_attrs_digest(obj: Any, texts: dict[str, str] | None = None) -> None:
     Given ``texts``, the attributes ``obj`` holds besides the digests (each written with
     :func:`put_text`), the digest is computed from them as they read back, instead of
     reading them back: the same value, without a read per attribute.
+
+    Parameters
+    ----------
+    obj : h5py.File or h5py.Group
+        The object, open for writing, its other attributes written.
+    texts : dict of str to str, optional
+        Every attribute of ``obj`` besides the digests, all written with
+        :func:`put_text`; default: read the attributes from ``obj``.
     """
     if texts is None:
         hexdigest = attrs_digest(obj.attrs)
@@ -184,7 +261,13 @@ def _texts_digest(items: tuple[tuple[str, str], ...]) -> str:
 
 def strip(f: h5py.File) -> None:
     """Remove every integrity attribute (digests, ``integrity``) from an open file: what
-    files written before digests existed look like (tests of old files use it)."""
+    files written before digests existed look like (tests of old files use it).
+
+    Parameters
+    ----------
+    f : h5py.File
+        The file, open for writing; changed in place.
+    """
 
     def drop(_: str, obj: Any) -> None:
         for key in (DIGEST, ATTRS_DIGEST):

@@ -90,7 +90,29 @@ def visible_enough(visibility: ArrayLike, threshold: float) -> NDArray[np.bool_]
 def gt_keep(
     seq: Sequence, gt_mode: str = "amodal", visibility_threshold: float = 0.0
 ) -> NDArray[np.bool_]:
-    """Ground-truth boxes that count, (T, K) bool: present, and visible enough if ``visible``."""
+    """Ground-truth boxes that count, (T, K) bool: present, and visible enough if ``visible``.
+
+    Parameters
+    ----------
+    seq : Sequence
+        The sequence (its ``gt.present`` and ``gt.visibility`` are used).
+    gt_mode : {"amodal", "visible"}
+        Ground-truth convention (module docstring).
+    visibility_threshold : float
+        ``visible`` mode: a target counts where its visible fraction exceeds this, in
+        [0, 1); must be 0 in ``amodal`` mode.
+
+    Returns
+    -------
+    ndarray of bool, shape (T, K)
+        True where entity k's box counts at frame t (every entity, whatever its role).
+
+    Raises
+    ------
+    ConfigError
+        For an unknown ``gt_mode`` or a bad ``visibility_threshold`` (see
+        :func:`check_gt_mode`).
+    """
     check_gt_mode(gt_mode, visibility_threshold)
     present = np.asarray(seq.gt.present, dtype=bool)
     if gt_mode == "amodal":
@@ -104,6 +126,31 @@ def gt_rows(
     """The MOTChallenge ``gt.txt`` rows of frame ``t`` (0-based), entities in file order.
 
     Columns: ``frame, id, bb_left, bb_top, bb_width, bb_height, conf, class, visibility``.
+
+    Parameters
+    ----------
+    seq : Sequence
+        The sequence.
+    t : int
+        Frame index, 0-based.
+    gt_mode : {"amodal", "visible"}
+        Ground-truth convention (module docstring).
+    visibility_threshold : float
+        ``visible`` mode: a target counts where its visible fraction exceeds this, in
+        [0, 1); must be 0 in ``amodal`` mode.
+
+    Returns
+    -------
+    list of str
+        One row per entity present at frame ``t`` (no newline): the targets in ``amodal``
+        mode; targets, distractors and occluders (:data:`MOT_CLASS`) in ``visible`` mode,
+        ``conf`` 1 only for a target visible enough. Frame and box corner are 1-based.
+
+    Raises
+    ------
+    ConfigError
+        For an unknown ``gt_mode`` or a bad ``visibility_threshold`` (see
+        :func:`check_gt_mode`).
     """
     check_gt_mode(gt_mode, visibility_threshold)
     gt = seq.gt
@@ -149,7 +196,8 @@ def write_mot_tracker(path: str | Path, boxes: ArrayLike, track_ids: ArrayLike) 
     Raises
     ------
     ConfigError
-        If the file cannot be written (naming ``path``) or an id is < 1.
+        If the file cannot be written (naming ``path``), ``boxes`` is not of shape
+        (T, M, 4) for the M ids, or an id is < 1.
     """
     b = np.asarray(boxes, dtype=np.float64)
     ids = np.asarray(track_ids).astype(np.int64).reshape(-1)
@@ -178,6 +226,25 @@ def read_mot_tracker(
 
     :func:`read_mot_tracker_rows` without the row order; see it for the parameters,
     returns and errors.
+
+    Parameters
+    ----------
+    path : str or Path
+        The tracker file.
+    n_frames : int
+        Frames of the sequence it was made on; frame numbers must be in 1..n_frames.
+
+    Returns
+    -------
+    track_ids : ndarray of int, shape (M,)
+        The ids in the file, sorted.
+    boxes : ndarray of shape (n_frames, M, 4)
+        Boxes in scenegen's 0-based pixels, NaN where a track has no row.
+
+    Raises
+    ------
+    DataError
+        As :func:`read_mot_tracker_rows`.
     """
     ids, boxes, _ = read_mot_tracker_rows(path, n_frames)
     return ids, boxes
@@ -192,6 +259,20 @@ _NUMBER = re.compile(
 def read_result_text(path: str | Path, kind: str, read_as: str) -> str:
     """The text of a tracker's result file: UTF-8, a byte-order mark allowed (Notepad,
     Excel's "CSV UTF-8", PowerShell write one; it is not part of the first number).
+
+    Parameters
+    ----------
+    path : str or Path
+        The result file.
+    kind : str
+        What the file should be, for the size message (e.g. ``"tracker file"``).
+    read_as : str
+        What it is read as, for the read message (e.g. ``"a MOTChallenge tracker file"``).
+
+    Returns
+    -------
+    str
+        The decoded text, without a byte-order mark.
 
     Raises
     ------
@@ -216,7 +297,18 @@ def check_number_text(cell: str) -> None:
     """Raise ValueError unless ``cell`` is a number as text files write one: ASCII digits,
     sign, point and exponent (``nan``/``inf`` pass here, for a later, clearer refusal).
     Python's ``int`` and ``float`` also read ``1_0`` as 10 and any script's digits
-    (``１`` fullwidth, ``١`` Arabic-Indic) as numbers, which no tool writes."""
+    (``１`` fullwidth, ``١`` Arabic-Indic) as numbers, which no tool writes.
+
+    Parameters
+    ----------
+    cell : str
+        One cell of a row, surrounding spaces already stripped.
+
+    Raises
+    ------
+    ValueError
+        If ``cell`` is not such a number; the message says why (``_``, or what is allowed).
+    """
     if _NUMBER.fullmatch(cell):
         return
     if "_" in cell:

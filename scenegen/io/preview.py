@@ -33,7 +33,29 @@ _ROLE_COLORS = {
 def annotate(
     seq: Sequence, t: int, *, boxes: NDArray[Any] | None = None, clutter: bool = False
 ) -> NDArray[np.uint8]:
-    """Frame ``t`` (H, W, 3) with ground truth (and optional estimates (M, 4)) drawn."""
+    """Frame ``t`` (H, W, 3) with ground truth (and optional estimates (M, 4)) drawn.
+
+    Each entity present at ``t`` gets its amodal box (1 px) and visible box (2 px) in its
+    role's colour (targets green, distractors red, occluders blue, clutter grey), labelled
+    ``id:depth``; the frame index ``t=…`` is written top left.
+
+    Parameters
+    ----------
+    seq : Sequence
+        The sequence.
+    t : int
+        Frame index, 0-based.
+    boxes : ndarray of shape (M, 4), optional
+        Tracker estimates ``[x, y, w, h]`` of frame ``t``, pixels, drawn white with a
+        black outline; rows with a NaN are skipped.
+    clutter : bool
+        Whether to draw clutter entities too.
+
+    Returns
+    -------
+    ndarray of uint8, shape (H, W, 3)
+        The annotated RGB frame (a copy; ``seq`` is unchanged).
+    """
     img = np.ascontiguousarray(np.asarray(seq.frames[t]).copy())
     gt = seq.gt
     for k in range(len(seq.entities)):
@@ -87,7 +109,25 @@ def _corners(box: NDArray[Any], shape: tuple[int, ...]) -> tuple[tuple[int, int]
 def contact_sheet(
     seq: Sequence, *, n: int = 12, cols: int = 4, boxes: NDArray[Any] | None = None
 ) -> NDArray[np.uint8]:
-    """``n`` evenly spaced annotated frames tiled ``cols`` wide, shape (rows*H, cols*W, 3)."""
+    """``n`` evenly spaced annotated frames tiled ``cols`` wide, shape (rows*H, cols*W, 3).
+
+    Parameters
+    ----------
+    seq : Sequence
+        The sequence.
+    n : int
+        Frames to show, first and last included (all T frames if T < n).
+    cols : int
+        Tiles per row (fewer if there are fewer frames).
+    boxes : ndarray of shape (T, M, 4), optional
+        Tracker estimates per frame, pixels (see :func:`annotate`).
+
+    Returns
+    -------
+    ndarray of uint8, shape (rows*H, cols*W, 3)
+        RGB sheet of :func:`annotate` tiles, row by row; the unused tiles of the last row
+        are white.
+    """
     t_n = seq.n_frames
     idx = np.unique(np.linspace(0, t_n - 1, min(n, t_n)).round().astype(int))
     tiles = [annotate(seq, int(t), boxes=None if boxes is None else boxes[t]) for t in idx]
@@ -108,6 +148,25 @@ def write_preview(
 
     ``boxes`` (T, M, 4): tracker estimates to draw. Animations show at most
     ``max_frames`` evenly spaced frames.
+
+    Parameters
+    ----------
+    seq : Sequence
+        The sequence.
+    out : str or Path
+        Output file, written atomically; its suffix (``.png``, ``.gif`` or ``.mp4``, any
+        case) picks the kind. A PNG is :func:`contact_sheet` with its defaults; a GIF
+        shows 80 ms per frame, an MP4 12.5 frames per second.
+    boxes : ndarray of shape (T, M, 4), optional
+        Tracker estimates per frame, pixels (see :func:`annotate`).
+    max_frames : int
+        Most frames of an animation (ignored for a PNG).
+
+    Raises
+    ------
+    ConfigError
+        For another suffix, a PNG that cannot be encoded, an MP4 whose frames are not
+        2..8191 px a side (:data:`MP4_SIDES`), or an OpenCV build that cannot write MP4.
     """
     out = Path(out)
     ext = out.suffix.lower()

@@ -146,7 +146,9 @@ def write_result(path: str | Path, *results: TrackerResult) -> None:
     ------
     ConfigError
         No result, two results of one tracker, a result whose shapes disagree
-        (:meth:`TrackerResult.problems`), or a missing folder.
+        (:meth:`TrackerResult.problems`, which also refuses repeated target ids, box rows
+        neither finite with w, h >= 0 nor all NaN, and ``order_prob`` values outside
+        [0, 1]), or a missing folder.
     """
     if not results:
         raise ConfigError("write_result needs at least one result")
@@ -182,6 +184,7 @@ def read_result(path: str | Path, tracker: str | None = None) -> TrackerResult:
     ----------
     path : str or Path
     tracker : str, optional
+        The tracker's name; default: the only result in the file.
 
     Returns
     -------

@@ -125,7 +125,20 @@ class Field:
 
 @dataclass(frozen=True)
 class Attribute:
-    """One HDF5 attribute of a group: where, name, type and meaning."""
+    """One HDF5 attribute of a group: where, name, type and meaning.
+
+    Attributes
+    ----------
+    group : str
+        Where it is: ``"/"``, ``"/sequences/<name>/"``, ``"/results/<tracker>/"`` or
+        ``"every dataset"``.
+    name : str
+        Attribute name.
+    type : str
+        Value type: ``"str"`` or ``"int"``.
+    description : str
+        What the value means.
+    """
 
     group: str
     name: str
@@ -202,16 +215,36 @@ _BY_PATH = {f.path: f for f in SEQUENCE_FIELDS} | {f"results/{f.path}": f for f 
 def field(path: str) -> Field:
     """The field at ``path`` (``gt/box``, ``templates/<id>``, ``results/boxes``).
 
+    Parameters
+    ----------
+    path : str
+        Path of a sequence dataset inside its group, or ``results/`` and the path of a
+        result dataset.
+
+    Returns
+    -------
+    Field
+
     Raises
     ------
     KeyError
         If no field has that path.
+
+    Examples
+    --------
+    >>> field("gt/box").shape_text, field("results/boxes").units
+    ('(T, K, 4)', 'px')
     """
     return _BY_PATH[path]
 
 
 def gt_fields() -> tuple[Field, ...]:
-    """The ``gt/*`` fields, in layout order."""
+    """The ``gt/*`` fields, in layout order.
+
+    Returns
+    -------
+    tuple of Field
+    """
     return tuple(f for f in SEQUENCE_FIELDS if f.path.startswith("gt/"))
 
 
@@ -221,7 +254,26 @@ GT_FIELDS: dict[str, Any] = {f.name: f.numpy_dtype for f in gt_fields()}
 
 def schema_problem(value: Any) -> str | None:
     """What is wrong with a file's ``schema`` attribute ``value`` (None: it is
-    :data:`SCHEMA`); the text follows the file's path in a problem line."""
+    :data:`SCHEMA`); the text follows the file's path in a problem line.
+
+    Parameters
+    ----------
+    value : object
+        The attribute as read (str, bytes, a 0-d array of either, or None when it is
+        missing).
+
+    Returns
+    -------
+    str or None
+        The problem, or None.
+
+    Examples
+    --------
+    >>> schema_problem("scenegen/1") is None
+    True
+    >>> schema_problem(b"scenegen/2")
+    "schema is 'scenegen/2', expected 'scenegen/1'"
+    """
     if isinstance(value, np.ndarray) and value.shape == ():
         value = value[()]
     if isinstance(value, (bytes, np.bytes_)):
@@ -241,7 +293,19 @@ def template_size_problem(shapes: list[tuple[int, ...]]) -> str | None:
     """What is wrong with the sizes of a sequence's templates (their ``shapes``) before
     they are read (None: nothing): together they may not exceed the generator's
     :data:`scenegen.config.MAX_TEMPLATE_PIXELS`, so a damaged or foreign file cannot ask a
-    reader for terabytes."""
+    reader for terabytes.
+
+    Parameters
+    ----------
+    shapes : list of tuple of int
+        Shape of each template dataset, (h, w, 4); only the first two sizes count, and a
+        shape of fewer than 2 axes is ignored.
+
+    Returns
+    -------
+    str or None
+        The problem, or None.
+    """
     pixels = sum(int(np.prod(s[:2], dtype=np.float64)) for s in shapes if len(s) >= 2)
     if pixels > MAX_TEMPLATE_PIXELS:
         return (
@@ -252,7 +316,18 @@ def template_size_problem(shapes: list[tuple[int, ...]]) -> str | None:
 
 
 def dataset_attrs(f: Field) -> dict[str, str]:
-    """The attributes the writer stores on the dataset of ``f``."""
+    """The attributes the writer stores on the dataset of ``f``.
+
+    Parameters
+    ----------
+    f : Field
+        The dataset's field.
+
+    Returns
+    -------
+    dict of str to str
+        ``description`` and ``units``.
+    """
     return {"description": f.description, "units": f.units}
 
 

@@ -65,10 +65,25 @@ class Unsealed(DataError):
 def canonical(data: Any) -> bytes:
     """The canonical JSON bytes of ``data`` (sorted keys, no spaces, ASCII, no NaN).
 
+    Parameters
+    ----------
+    data : object
+        A JSON value (dict, list, tuple, str, int, float, bool or None, nested).
+
+    Returns
+    -------
+    bytes
+        ASCII JSON, non-ASCII characters as ``\\u`` escapes.
+
     Raises
     ------
     ValueError
         For NaN or infinite floats; TypeError for values that are not JSON.
+
+    Examples
+    --------
+    >>> canonical({"b": 1, "a": [1.5, "é"]})
+    b'{"a":[1.5,"\\\\u00e9"],"b":1}'
     """
     text = json.dumps(data, sort_keys=True, separators=(",", ":"), ensure_ascii=True,
                       allow_nan=False)  # fmt: skip
@@ -76,7 +91,23 @@ def canonical(data: Any) -> bytes:
 
 
 def content_digest(data: Mapping[str, Any]) -> str:
-    """Hex SHA-256 of the canonical JSON of ``data`` without its :data:`SEAL` key."""
+    """Hex SHA-256 of the canonical JSON of ``data`` without its :data:`SEAL` key.
+
+    Parameters
+    ----------
+    data : mapping
+        A JSON object, sealed or not.
+
+    Returns
+    -------
+    str
+        64 lowercase hex digits.
+
+    Raises
+    ------
+    ValueError, TypeError
+        As :func:`canonical`.
+    """
     body = {k: v for k, v in data.items() if k != SEAL}
     return hashlib.sha256(canonical(body)).hexdigest()
 
@@ -86,6 +117,21 @@ def seal(data: Mapping[str, Any]) -> dict[str, Any]:
 
     The content is normalised through JSON first (tuples become lists, keys strings), so
     the digest is the one a reader of the written file recomputes.
+
+    Parameters
+    ----------
+    data : mapping
+        A JSON object; a :data:`SEAL` key it holds is replaced.
+
+    Returns
+    -------
+    dict
+        The normalised content plus :data:`SEAL`, the hex digest of the rest.
+
+    Raises
+    ------
+    ValueError, TypeError
+        As :func:`canonical`.
     """
     body = json.loads(canonical({k: v for k, v in data.items() if k != SEAL}))
     body[SEAL] = hashlib.sha256(canonical(body)).hexdigest()
@@ -108,10 +154,17 @@ def write_sealed_json(
     parents : bool
         Create missing parent folders first.
 
+    Returns
+    -------
+    str
+        The digest written (64 lowercase hex digits).
+
     Raises
     ------
     ValueError
         For NaN or infinite values.
+    TypeError
+        For values that are not JSON.
     ConfigError
         As :func:`scenegen.io.atomic.write_text`.
     """
@@ -162,6 +215,16 @@ def _parse(p: Path) -> Any:
 def read_sealed_json(path: str | Path) -> dict[str, Any]:
     """The content of the sealed document at ``path``, without its digest.
 
+    Parameters
+    ----------
+    path : str or Path
+        The JSON file.
+
+    Returns
+    -------
+    dict
+        The JSON object without its :data:`SEAL` key.
+
     Raises
     ------
     Unsealed
@@ -192,7 +255,18 @@ def read_sealed_json(path: str | Path) -> dict[str, Any]:
 
 def check_sealed_json(path: str | Path) -> list[str]:
     """Problems of the sealed document at ``path``: empty when it reads and matches its
-    digest, else one line (see :func:`read_sealed_json`)."""
+    digest, else one line (see :func:`read_sealed_json`).
+
+    Parameters
+    ----------
+    path : str or Path
+        The JSON file.
+
+    Returns
+    -------
+    list of str
+        No line, or one naming the file and the problem (an unsealed file included).
+    """
     try:
         read_sealed_json(path)
     except DataError as err:

@@ -94,6 +94,7 @@ class BenchTask:
     root : str
         The dataset folder.
     index : int
+        The sequence's index in the dataset.
     name : str
         Sequence name in its shard.
     file : str
@@ -103,6 +104,7 @@ class BenchTask:
     frames_digest : str
         The manifest's digest of its frames (a changed dataset invalidates stored runs).
     tracker : str
+        A tracker name or a user's factory spec.
     params : tuple of (str, value)
         Tracker parameters (without ``rng``), sorted.
     sequence_params : str
@@ -136,7 +138,27 @@ class BenchTask:
 
 def run_file(tracker: str, index: int) -> str:
     """The record file of ``tracker`` on sequence ``index``, relative to the output folder
-    (a ``path/to/file.py:make`` factory by its file name: ``runs/file.py_make/``)."""
+    (a ``path/to/file.py:make`` factory by its file name: ``runs/file.py_make/``).
+
+    Parameters
+    ----------
+    tracker : str
+        A registered tracker name or a user's ``MODULE:FACTORY`` / ``path/file.py:FACTORY``
+        (:func:`scenegen.lab.run.tracker_label`); characters other than letters, digits,
+        ``.``, ``_`` and ``-`` become ``_``.
+    index : int
+        The sequence's index in the dataset.
+
+    Returns
+    -------
+    str
+        ``"runs/TRACKER/NNNNN.json"`` (index zero-padded to five digits).
+
+    Examples
+    --------
+    >>> run_file("dps", 7)
+    'runs/dps/00007.json'
+    """
     from scenegen.lab.run import tracker_label
 
     return f"runs/{_slug(tracker_label(tracker))}/{index:05d}.json"
@@ -147,7 +169,21 @@ def _slug(name: str) -> str:
 
 
 def run_pair(task: BenchTask) -> dict[str, Any]:
-    """Run one tracker on one sequence and score it (a JSON-ready record, floats rounded)."""
+    """Run one tracker on one sequence and score it (a JSON-ready record, floats rounded).
+
+    Parameters
+    ----------
+    task : BenchTask
+        The tracker, its parameters and the sequence (read lazily from its shard).
+
+    Returns
+    -------
+    dict
+        ``key`` (:meth:`BenchTask.key`), ``tracker_seed``, ``targets`` (count),
+        ``n_frames``, ``scores`` (one value or None per metric of :data:`METRICS`; every
+        one None, and ``targets`` 0, when no target is present at frame 0),
+        ``sequence_params`` and ``deterministic``.
+    """
     from scenegen.evaluation import evaluate
     from scenegen.io import read
     from scenegen.lab.run import run
@@ -252,11 +288,31 @@ def plan_benchmark(
 ) -> tuple[dict[str, Any], list[BenchTask]]:
     """(dataset manifest, every task in a fixed order: trackers x sequences).
 
+    A user's factory (``MODULE:FACTORY``) is built once here with its parameters, so that
+    bad parameters fail before any run.
+
+    Parameters
+    ----------
+    root : pathlib.Path
+        The dataset folder (``scenegen dataset``), complete.
+    trackers : list of str
+        Tracker names or factories, without duplicates.
+    params : dict, optional
+        Tracker parameters; each tracker gets those it accepts, and each must be accepted
+        by at least one tracker.
+
+    Returns
+    -------
+    manifest : dict
+        The dataset's manifest.
+    tasks : list of BenchTask
+        For each tracker in order, every sequence by index.
+
     Raises
     ------
     ConfigError
         No tracker, a duplicate or unknown tracker, two trackers whose run folders would
-        be the same, or a parameter no tracker takes.
+        be the same, a parameter no tracker takes, or an incomplete dataset.
     DataError
         If ``root`` is not a dataset folder.
     """
@@ -333,6 +389,7 @@ def leaderboard(rows: list[dict[str, Any]], trackers: list[str]) -> list[dict[st
     rows : list of dict
         One per (tracker, sequence): ``tracker`` and the metric keys.
     trackers : list of str
+        The trackers to rank (ties in AUC, and no AUC, are ordered by name).
 
     Returns
     -------
@@ -401,7 +458,29 @@ def curves(
     rows: list[dict[str, Any]], axes: list[str], trackers: list[str]
 ) -> list[dict[str, Any]]:
     """Per difficulty axis (names, :func:`dataset_meta`) and metric: the metric's mean per
-    axis level, per tracker."""
+    axis level, per tracker.
+
+    A numeric axis with more than 8 distinct values is binned into 6 quantile bins (the
+    level is the mean value in the bin); a non-numeric one takes its values in order of
+    first appearance.
+
+    Parameters
+    ----------
+    rows : list of dict
+        One per (tracker, sequence): ``tracker``, ``index``, ``params`` (the sequence's
+        axis values) and the metric keys.
+    axes : list of str
+        Axis names, looked up in each row's ``params``.
+    trackers : list of str
+        The trackers to draw, one series each.
+
+    Returns
+    -------
+    list of dict
+        One per axis and curve metric with a value: ``axis``, ``metric``, ``x`` (the level
+        keys), ``labels`` and ``series`` (tracker -> mean per level, None where
+        undefined); floats rounded.
+    """
     out = []
     for axis in axes:
         mine = [r for r in rows if axis in r["params"]]
@@ -470,7 +549,18 @@ _NONE_SCORED_NOTE = (f"{NONE_SCORED[0].upper()}{NONE_SCORED[1:]}: no tracker has
 
 
 def scored(board: list[dict[str, Any]]) -> bool:
-    """True when some tracker of the leaderboard ``board`` was scored on some sequence."""
+    """True when some tracker of the leaderboard ``board`` was scored on some sequence.
+
+    Parameters
+    ----------
+    board : list of dict
+        A leaderboard (:func:`leaderboard`), each entry with ``sequences``.
+
+    Returns
+    -------
+    bool
+        Whether an entry has ``sequences`` > 0.
+    """
     return any(e["sequences"] > 0 for e in board)
 
 
@@ -571,6 +661,11 @@ def run_benchmark(
 ) -> dict[str, Any]:
     """Run every tracker on every sequence of ``dataset`` (resumably) and write the report.
 
+    A stored run is kept when it is sound and of the same key (dataset sequence, tracker,
+    parameters). One that is damaged, edited, malformed, written before records were
+    sealed, or sealed but not the one the folder's ``results.json`` lists for that key, is
+    run again with one warning line (:func:`scenegen.lab.benchmark_outputs.load_record`).
+
     Parameters
     ----------
     dataset : str or Path
@@ -581,18 +676,15 @@ def run_benchmark(
         Output folder.
     params : dict, optional
         Tracker parameters, given to every tracker that takes them.
-    jobs, scheduler
-        Local processes, or a Dask scheduler address (its workers read ``dataset``; results
+    jobs : int, optional
+        Local processes (None: all cores; 1 runs in this process).
+    scheduler : str, optional
+        A Dask scheduler address instead of ``jobs`` (its workers read ``dataset``; results
         come back to this process, which writes ``out``).
-    progress : bool
+    progress : bool, default False
         Show a tqdm bar on stderr.
     on_done : callable, optional
         Called with each task whose record was just stored.
-
-    A stored run is kept when it is sound and of the same key (dataset sequence, tracker,
-    parameters). One that is damaged, edited, malformed, written before records were
-    sealed, or sealed but not the one the folder's ``results.json`` lists for that key, is
-    run again with one warning line (:func:`scenegen.lab.benchmark_outputs.load_record`).
 
     Returns
     -------
@@ -602,7 +694,8 @@ def run_benchmark(
     Raises
     ------
     ConfigError
-        As :func:`plan_benchmark`; a bad ``jobs`` or an unreachable scheduler; ``out``
+        As :func:`plan_benchmark`; a bad ``jobs`` (< 1, or given with ``scheduler``) or an
+        unreachable scheduler; ``out``
         holding a dataset (its ``manifest.json``), an experiment's results or a report of
         ``scenegen experiment all``, or that cannot be created.
     DataError
@@ -670,7 +763,21 @@ def _content(rec: dict[str, Any]) -> dict[str, Any]:
 def dataset_meta(man: dict[str, Any], root: str | Path) -> dict[str, Any]:
     """What the results keep of the dataset: its folder (absolute), family, family digest,
     seed, count and description, its sequence parameters (``scores.csv``'s columns) and its
-    difficulty axes (the swept axes with more than one value, then the drawn paths)."""
+    difficulty axes (the swept axes with more than one value, then the drawn paths).
+
+    Parameters
+    ----------
+    man : dict
+        The dataset's manifest (``manifest.json``).
+    root : str or pathlib.Path
+        The dataset folder.
+
+    Returns
+    -------
+    dict
+        ``path``, ``family``, ``family_digest``, ``seed``, ``count``, ``description``,
+        ``sequence_params`` and ``axes`` (None for a key the manifest lacks).
+    """
     return {
         "path": str(Path(root).resolve()),
         "family": man.get("family"),
@@ -727,7 +834,19 @@ def results_document(
 
 
 def figure_list(results: dict[str, Any]) -> list[tuple[str, str, dict[str, Any]]]:
-    """(file name, caption, curve) of every figure of ``results``' curves."""
+    """(file name, caption, curve) of every figure of ``results``' curves.
+
+    Parameters
+    ----------
+    results : dict
+        A results document (:func:`results_document`); its ``curves`` are used.
+
+    Returns
+    -------
+    list of (str, str, dict)
+        Per curve, in order: ``curve-METRIC-NN-AXIS.png`` (NN its position, AXIS made
+        file-safe and cut to 40 characters), ``"LABEL vs AXIS"`` and the curve.
+    """
     out = []
     for i, c in enumerate(results["curves"]):
         name = f"curve-{c['metric']}-{i:02d}-{_slug(c['axis'])[:40]}.png"
@@ -744,7 +863,18 @@ def _csv_cell(value: Any) -> Any:
 
 
 def texts(results: dict[str, Any]) -> dict[str, str]:
-    """``scores.csv``, ``leaderboard.md`` and ``index.html`` of ``results``, by file name."""
+    """``scores.csv``, ``leaderboard.md`` and ``index.html`` of ``results``, by file name.
+
+    Parameters
+    ----------
+    results : dict
+        A results document (:func:`results_document`).
+
+    Returns
+    -------
+    dict of str to str
+        The text of each of the three files, keyed by its file name.
+    """
     meta, board, rows = results["dataset"], results["leaderboard"], results["scores"]
     metric_cols = [m for m in METRICS if any(m in r for r in rows)]
     pnames = list(meta["sequence_params"])
@@ -765,7 +895,26 @@ def write_outputs(
 ) -> dict[str, Any]:
     """Write the figures, ``results.json`` (sealed), ``scores.csv``, ``leaderboard.md`` and
     ``index.html`` of ``records`` (see :func:`results_document`) into ``out``; return the
-    results."""
+    results.
+
+    Every file is written atomically.
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        The output folder (it must exist).
+    meta : dict
+        :func:`dataset_meta`.
+    trackers : list of str
+        In the order given on the command line.
+    records : list of dict
+        Every run record, trackers x sequences in task order.
+
+    Returns
+    -------
+    dict
+        The results as ``results.json`` holds them, without its digest.
+    """
     from scenegen.io import atomic_path
 
     results = _content(results_document(meta, trackers, records))

@@ -64,7 +64,22 @@ def _is(value: Any, kind: type) -> bool:
 
 
 def record_problems(data: Any) -> list[str]:
-    """What is wrong with the fields of a benchmark run record (empty when none is)."""
+    """What is wrong with the fields of a benchmark run record (empty when none is).
+
+    Parameters
+    ----------
+    data : Any
+        A parsed run record (without its digest).
+
+    Returns
+    -------
+    list of str
+        One line per problem: not an object, a ``key`` without the fields of
+        :meth:`scenegen.lab.benchmark.BenchTask.key`, ``tracker_seed``, ``targets`` or
+        ``n_frames`` not ints, ``scores`` not metrics of
+        :data:`scenegen.lab.benchmark.METRICS` with numbers or null,
+        ``sequence_params`` not a dict, ``deterministic`` not a bool.
+    """
     from scenegen.lab.benchmark import METRICS
 
     if not isinstance(data, dict):
@@ -91,6 +106,16 @@ def record_problems(data: Any) -> list[str]:
 def read_record(path: Path) -> dict[str, Any]:
     """The benchmark run record at ``path`` (without its digest).
 
+    Parameters
+    ----------
+    path : pathlib.Path
+        A sealed run file (``OUT/runs/TRACKER/NNNNN.json``).
+
+    Returns
+    -------
+    dict
+        The record's content, checked by :func:`record_problems`.
+
     Raises
     ------
     DataError
@@ -108,7 +133,18 @@ def _run_file(key: dict[str, Any]) -> str:
 
 def listing(records: list[dict[str, Any]]) -> list[str]:
     """The ``records`` entry of ``results.json``: ``"runs/TRACKER/NNNNN.json SHA256"`` per
-    record (as read back, without digest), in order."""
+    record (as read back, without digest), in order.
+
+    Parameters
+    ----------
+    records : list of dict
+        Run records (:func:`scenegen.lab.benchmark.run_pair`), without digest.
+
+    Returns
+    -------
+    list of str
+        Each record's run file and the SHA-256 of its canonical content.
+    """
     return [f"{_run_file(r['key'])} {content_digest(r)}" for r in records]
 
 
@@ -133,6 +169,17 @@ def _results_problem(data: dict[str, Any]) -> str | None:
 def read_results(path: Path) -> dict[str, Any]:
     """The content of a benchmark's ``results.json`` (without its digest).
 
+    Parameters
+    ----------
+    path : pathlib.Path
+        The ``results.json`` file.
+
+    Returns
+    -------
+    dict
+        Its content, with every top-level key of a benchmark's results, a dataset
+        description, a non-empty list of trackers and a listing of run files.
+
     Raises
     ------
     DataError
@@ -153,7 +200,22 @@ def listed_digests(out: Path, meta: dict[str, Any]) -> dict[str, tuple[str, dict
     """Per run file that ``OUT/results.json`` lists: (its digest, the parameters of its
     tracker then). Empty when there is no sound ``results.json``, or when it was computed
     on another dataset than ``meta`` (:func:`scenegen.lab.benchmark.dataset_meta`)
-    describes (another family digest, seed or count)."""
+    describes (another family digest, seed or count).
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        The benchmark's output folder.
+    meta : dict
+        The description of the dataset about to be run
+        (:func:`scenegen.lab.benchmark.dataset_meta`).
+
+    Returns
+    -------
+    dict of str to (str, dict)
+        Run file name (``runs/TRACKER/NNNNN.json``) -> (its listed SHA-256, its tracker's
+        parameters in ``results.json``).
+    """
     try:
         res = read_results(Path(out) / RESULTS)
     except DataError:
@@ -181,6 +243,20 @@ def load_record(path: Path, task: Any, listed: tuple[str, dict[str, Any]] | None
     of the same file (other tracker parameters, another dataset) or with other sequence
     parameters (a named axis by its grid position, as before its value was recorded):
     None, silently.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The task's run file in the output folder.
+    task : BenchTask
+        The task whose run is looked for.
+    listed : (str, dict), optional
+        The file's entry of :func:`listed_digests` (None: not listed).
+
+    Returns
+    -------
+    dict or None
+        The stored record (without its digest), or None to run the task.
     """
     if not path.exists():
         return None
@@ -206,7 +282,19 @@ def load_record(path: Path, task: Any, listed: tuple[str, dict[str, Any]] | None
 
 def is_benchmark_folder(folder: str | Path) -> bool:
     """True for a folder that ``scenegen benchmark`` wrote (even a damaged one): it has
-    ``scores.csv`` or ``leaderboard.md``, or run folders under ``runs/``."""
+    ``scores.csv`` or ``leaderboard.md``, or run folders under ``runs/``.
+
+    Parameters
+    ----------
+    folder : str or pathlib.Path
+        The folder to look at.
+
+    Returns
+    -------
+    bool
+        False for a path that is not a folder, and for a dataset folder (it has
+        ``manifest.json``).
+    """
     from scenegen.datasets.build import holds_benchmark_outputs
 
     root = Path(folder)

@@ -44,6 +44,21 @@ class Row:
     ``path`` is its place in the experiment's summary (e.g.
     ``presets/dps-occlusion/DPS/hard/success``); ``kind`` is ``"rate"`` (percent, with
     ``k`` of ``n``) or ``"mean"``; ``inside`` is whether ``other`` lies in ``base_ci``.
+
+    Attributes
+    ----------
+    experiment : str
+        The experiment's name.
+    path : str
+        The value's place in the summary, keys joined by ``/``.
+    kind : str
+        ``"rate"`` or ``"mean"``.
+    base, other : float
+        The value on each side (a rate in percent).
+    base_ci, other_ci : (float, float)
+        The interval on each side (``other_ci`` (nan, nan) where undefined).
+    base_n, other_n : int
+        The ``n`` of each side's value (0 where the summary gives none).
     """
 
     experiment: str
@@ -67,7 +82,20 @@ class Row:
 
 
 def load_records(folders: Iterable[Path]) -> list[dict[str, Any]]:
-    """The run records (``runs/*.json``) of the experiment folders, in name order."""
+    """The run records (``runs/*.json``) of the experiment folders, in name order.
+
+    The files are parsed as plain JSON: their seals are neither checked nor removed.
+
+    Parameters
+    ----------
+    folders : iterable of pathlib.Path
+        Experiment folders, in order (a folder without ``runs/`` adds nothing).
+
+    Returns
+    -------
+    list of dict
+        The records, folder by folder, each folder's by file name.
+    """
     out = []
     for folder in folders:
         for path in sorted((Path(folder) / "runs").glob("*.json")):
@@ -76,7 +104,21 @@ def load_records(folders: Iterable[Path]) -> list[dict[str, Any]]:
 
 
 def summary_of(experiment: str, records: list[dict[str, Any]]) -> dict[str, Any]:
-    """The experiment's summary (as in its ``results.json``) of these records."""
+    """The experiment's summary (as in its ``results.json``) of these records.
+
+    Parameters
+    ----------
+    experiment : str
+        The experiment's name.
+    records : list of dict
+        Its run records.
+
+    Returns
+    -------
+    dict
+        The ``summary`` entry of
+        :func:`~scenegen.lab.experiments.summary.summarize`.
+    """
     from scenegen.lab.experiments import get
     from scenegen.lab.experiments.summary import summarize
 
@@ -101,7 +143,23 @@ def _value(leaf: dict[str, Any]) -> tuple[str, float, tuple[float, float], int]:
 
 
 def compare(experiment: str, base: dict[str, Any], other: dict[str, Any]) -> list[Row]:
-    """Rows for every value with an interval present (and defined) in both summaries."""
+    """Rows for every value with an interval present (and defined) in both summaries.
+
+    A value is kept when both sides have it and the base side's interval is defined; an
+    undefined interval on the other side becomes (nan, nan).
+
+    Parameters
+    ----------
+    experiment : str
+        The experiment's name, copied into each row.
+    base, other : dict
+        The two summaries (:func:`summary_of`).
+
+    Returns
+    -------
+    list of Row
+        In the order of the base summary's paths (keys sorted).
+    """
     theirs = dict(_leaves(other))
     rows = []
     for path, leaf in _leaves(base):
@@ -118,7 +176,22 @@ def compare(experiment: str, base: dict[str, Any], other: dict[str, Any]) -> lis
 
 
 def compare_root(root: Path, experiments: Sequence[str] | None = None) -> list[Row]:
-    """Rows of every experiment folder under ``root`` that has both sides."""
+    """Rows of every experiment folder under ``root`` that has both sides.
+
+    Parameters
+    ----------
+    root : pathlib.Path
+        The folder of ``ROOT/<experiment>/{base,other,shared}``.
+    experiments : sequence of str, optional
+        The experiments to compare (default: every subfolder with ``base/`` and
+        ``other/``, by name).
+
+    Returns
+    -------
+    list of Row
+        Experiment by experiment, :func:`compare` of both sides' summaries (the runs of
+        ``shared/``, when present, added to both).
+    """
     root = Path(root)
     names = experiments or sorted(p.name for p in root.iterdir()
                                   if (p / BASE).is_dir() and (p / OTHER).is_dir())
@@ -137,7 +210,24 @@ def _fmt(x: float) -> str:
 
 def render(rows: list[Row], *, base: str = "base", other: str = "other",
            metrics: Iterable[str] | None = None) -> str:
-    """A markdown table of the rows (only ``metrics`` when given), and the count inside."""
+    """A markdown table of the rows (only ``metrics`` when given), and the count inside.
+
+    Parameters
+    ----------
+    rows : list of Row
+        The rows to show.
+    base, other : str, default "base", "other"
+        The sides' labels in the header and the closing line.
+    metrics : iterable of str, optional
+        Keep only the rows whose last path component is one of these (e.g.
+        ``"success"``).
+
+    Returns
+    -------
+    str
+        The table, a blank line, and ``"N of M values of OTHER inside BASE's
+        interval."``, ending with a newline.
+    """
     keep = set(metrics) if metrics else None
     rows = [r for r in rows if keep is None or r.metric in keep]
     lines = [f"| experiment | value | {base} [95% interval] (n) | {other} [95% interval] (n) "
@@ -153,7 +243,19 @@ def render(rows: list[Row], *, base: str = "base", other: str = "other",
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """``python -m scenegen.lab.kernel_quality ROOT [-o FILE]``: print (or write) the table."""
+    """``python -m scenegen.lab.kernel_quality ROOT [-o FILE]``: print (or write) the table.
+
+    Parameters
+    ----------
+    argv : sequence of str, optional
+        The arguments (default: ``sys.argv[1:]``): ``ROOT``, ``--experiment``,
+        ``--metric`` (both repeatable), ``--base-label``, ``--other-label``, ``-o FILE``.
+
+    Returns
+    -------
+    int
+        The exit status, 0 (bad arguments exit through argparse).
+    """
     p = argparse.ArgumentParser(prog="python -m scenegen.lab.kernel_quality",
                                 description=__doc__.split("\n\n")[0])
     p.add_argument("root", type=Path, help="folder of ROOT/<experiment>/{base,other,shared}")

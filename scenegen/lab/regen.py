@@ -39,7 +39,24 @@ __all__ = ["EXPECTED_ATOL", "regen", "tracker_params", "verify"]
 
 
 def tracker_params(name: str) -> dict[str, Any]:
-    """The parameters fixtures run tracker ``name`` with: few particles where it has any."""
+    """The parameters fixtures run tracker ``name`` with: few particles where it has any.
+
+    Parameters
+    ----------
+    name : str
+        A registered tracker name.
+
+    Returns
+    -------
+    dict
+        ``{"n_particles": FAST_PARTICLES}`` (32) for a tracker with that parameter, else
+        ``{}``.
+
+    Raises
+    ------
+    ValueError
+        For an unknown tracker name (from :func:`trackers.registry.parameters`).
+    """
     from trackers.registry import parameters
 
     return {"n_particles": FAST_PARTICLES} if "n_particles" in parameters(name) else {}
@@ -80,6 +97,12 @@ def verify(
         Restrict the check (default: every fixture, every tracker in ``trackers.names()``).
     progress : callable, optional
         Called with a short label before each fixture and tracker run.
+
+    Returns
+    -------
+    list of str
+        One line per mismatch, naming the fixture (and tracker); empty when every
+        fixture is sound.
 
     Raises
     ------

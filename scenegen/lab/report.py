@@ -46,6 +46,13 @@ def check_report_folder(out_dir: str | Path) -> None:
     holds what another verb wrote: a dataset, a benchmark's outputs or one experiment's
     results, whose ``results.json`` and ``index.html`` the report would replace.
 
+    A report folder of an earlier run, an empty folder or a missing one pass.
+
+    Parameters
+    ----------
+    out_dir : str or pathlib.Path
+        The report folder.
+
     Raises
     ------
     ConfigError
@@ -86,8 +93,16 @@ def run_all(
         The report folder (``index.html``, ``results.json``, ``experiments/``).
     runs, scenes : int, optional
         R and S for every experiment (default each experiment's own).
-    jobs, scheduler, seed, quick, progress
-        As :func:`scenegen.lab.experiments.run_experiment`.
+    jobs : int, optional
+        Local worker processes (default all cores), started once for every experiment.
+    scheduler : str, optional
+        Address of a ``dask.distributed`` scheduler to run the tasks on.
+    seed : int, default 0
+        Base seed, as :func:`scenegen.lab.experiments.run_experiment`.
+    quick : bool, default False
+        Scaled-down settings, as :func:`scenegen.lab.experiments.run_experiment`.
+    progress : bool, default False
+        Print each experiment's name on stderr and show progress bars.
     say : callable, optional
         Called with (name, results, table path) after each experiment.
     plan : dict, optional
@@ -135,10 +150,27 @@ def run_demo_experiments(
 ) -> Path:
     """Every experiment at the reduced counts of :data:`DEMO_PLAN`, then the report.
 
+    One line per experiment (its S x R) is printed on stderr; progress bars show when
+    stderr is a terminal.
+
+    Parameters
+    ----------
+    out_dir : str or Path
+        The report folder.
+    jobs : int, optional
+        Local worker processes (default all cores).
+    seed : int, default 0
+        Base seed.
+
     Returns
     -------
     Path
         The ``index.html`` written.
+
+    Raises
+    ------
+    ConfigError
+        As :func:`run_all`.
     """
     def say(name: str, res: dict[str, Any], table: Path) -> None:
         print(f"  experiment {name}: S = {res['scenes']} x R = {res['runs']}", file=sys.stderr,
@@ -162,8 +194,29 @@ def _inline(text: str) -> str:
 
 
 def markdown_to_html(md: str) -> str:
-    """The small Markdown subset of ``table.md`` as HTML: headings, pipe tables, bullet
-    lists, paragraphs, ``**bold**`` and ```code```."""
+    r"""The small Markdown subset of ``table.md`` as HTML: headings, pipe tables, bullet
+    lists, paragraphs, ``**bold**`` and ```code```.
+
+    Parameters
+    ----------
+    md : str
+        The Markdown text (``\|`` in a table cell is a literal ``|``).
+
+    Returns
+    -------
+    str
+        The HTML fragment, one element per line; headings are shifted one level down
+        (``#`` gives ``<h2>``, at most ``<h6>``) and text is HTML-escaped.
+
+    Examples
+    --------
+    >>> print(markdown_to_html("# Title\n\n| a | b |\n|---|---|\n| 1 | **2** |"))
+    <h2>Title</h2>
+    <table>
+    <tr><th>a</th><th>b</th></tr>
+    <tr><td>1</td><td><strong>2</strong></td></tr>
+    </table>
+    """
     lines = md.splitlines()
     out: list[str] = []
     i = 0
@@ -271,13 +324,28 @@ def build_report(out_dir: str | Path) -> Path:
     """Write ``out_dir/index.html`` and ``out_dir/results.json`` from what the folder holds.
 
     Links every ``experiments/<name>/`` table (rendered) and figure, and every preset
-    preview (``presets/*.png``, ``*.gif``); adds the Fidelity section. Missing pieces are
-    listed as missing rather than failing.
+    preview (``presets/*.png``, ``*.gif``). Missing pieces are listed as missing rather
+    than failing. Both files are written atomically.
+
+    Parameters
+    ----------
+    out_dir : str or Path
+        The report folder (created if missing).
 
     Returns
     -------
     Path
         The ``index.html`` written.
+
+    Raises
+    ------
+    DataError
+        An experiment's ``results.json`` that is damaged, edited, unsealed or not its
+        results (:func:`scenegen.lab.experiments.outputs.read_results`).
+
+    See Also
+    --------
+    render_report : the same page and results, without writing them.
     """
     root = Path(out_dir)
     make_output_folder(root)
@@ -291,7 +359,23 @@ def build_report(out_dir: str | Path) -> Path:
 def index_problem(out_dir: str | Path) -> str | None:
     """What is wrong with ``out_dir/index.html``: ``"missing"``, ``"unreadable (...)"``,
     ``"stale"`` (not the page :func:`build_report` writes from the folder as it is: edited,
-    damaged, or written from other results), or None (``scenegen validate``)."""
+    damaged, or written from other results), or None (``scenegen validate``).
+
+    Parameters
+    ----------
+    out_dir : str or pathlib.Path
+        The report folder.
+
+    Returns
+    -------
+    str or None
+        The problem, or None when the page is the one :func:`render_report` gives.
+
+    Raises
+    ------
+    DataError
+        As :func:`render_report`, when the page exists.
+    """
     index = Path(out_dir) / "index.html"
     try:
         text = index.read_text(encoding="utf-8")
@@ -306,7 +390,28 @@ def index_problem(out_dir: str | Path) -> str | None:
 
 def render_report(out_dir: str | Path) -> tuple[str, dict[str, dict[str, Any]]]:
     """The text of ``index.html`` and the experiments' entries of the report's
-    ``results.json``, from what ``out_dir`` holds (nothing is written)."""
+    ``results.json``, from what ``out_dir`` holds (nothing is written).
+
+    Parameters
+    ----------
+    out_dir : str or pathlib.Path
+        The report folder: ``experiments/<name>/`` (``results.json``, ``table.md``,
+        PNGs) and ``presets/`` (previews, HDF5 files).
+
+    Returns
+    -------
+    page : str
+        The text of ``index.html``.
+    results : dict of str to dict
+        Per experiment that has a ``results.json``, in :func:`names` order, its entry
+        (:func:`~scenegen.lab.experiments.outputs.report_entry`).
+
+    Raises
+    ------
+    DataError
+        An experiment's ``results.json`` that is damaged, edited, unsealed, not its
+        results, or whose contents no table can be made of.
+    """
     root = Path(out_dir)
     parts = [
         "<!DOCTYPE html>",

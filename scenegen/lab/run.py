@@ -54,7 +54,19 @@ def resolve_factory(spec: str) -> Callable[..., Any]:
     """The callable named by ``"module:attr"`` or ``"path/to/file.py:attr"``.
 
     The current directory is searched first for ``module`` (as ``python -m`` does), so a
-    user's module next to their data is found.
+    user's module next to their data is found. A ``.py`` file is imported with its folder
+    put first on ``sys.path`` (its sibling modules import, as with ``python FILE``);
+    ``attr`` may be dotted (``module:Class.create``).
+
+    Parameters
+    ----------
+    spec : str
+        ``"MODULE:ATTR"`` or ``"path/to/file.py:ATTR"`` (split at the last colon).
+
+    Returns
+    -------
+    callable
+        The object named, checked to be callable.
 
     Raises
     ------
@@ -113,7 +125,26 @@ def resolve_factory(spec: str) -> Callable[..., Any]:
 def tracker_label(tracker: TrackerSpec) -> str:
     """The name a result records for ``tracker``: the name or ``module:factory`` string
     (a file spec by its file name, since a result group's name holds no ``/``), else
-    ``module:qualname`` of a factory."""
+    ``module:qualname`` of a factory.
+
+    Parameters
+    ----------
+    tracker : str or callable
+        A tracker name, a ``module:factory`` or ``path/to/file.py:factory`` spec, or a
+        factory.
+
+    Returns
+    -------
+    str
+        The label (``"?"`` for a factory without a module).
+
+    Examples
+    --------
+    >>> tracker_label("dps")
+    'dps'
+    >>> tracker_label("path/to/file.py:make")
+    'file.py:make'
+    """
     if isinstance(tracker, str):
         module, sep, attr = tracker.rpartition(":")
         if sep and "/" in module:
@@ -141,11 +172,27 @@ def make_tracker(tracker: TrackerSpec, params: dict[str, Any], seed: int) -> Any
     """Build ``tracker`` (a name, a ``module:factory`` spec or a factory) with ``params``
     and ``rng=seed`` (a factory gets ``rng`` only if it accepts it).
 
+    Parameters
+    ----------
+    tracker : str or callable
+        A tracker name (``trackers.names()``), a ``module:factory`` or
+        ``path/to/file.py:factory`` spec (:func:`resolve_factory`), or a factory.
+    params : dict
+        Keyword parameters, without ``rng``.
+    seed : int
+        The tracker's ``rng``.
+
+    Returns
+    -------
+    trackers.Tracker
+        The tracker, not yet initialised.
+
     Raises
     ------
     ConfigError
-        For an unknown name or parameter (a ``TypeError`` or ``ValueError`` of the
-        factory), or an object that is not a tracker (naming what it lacks).
+        For an ``rng`` in ``params``, a spec that does not resolve, an unknown name or
+        parameter (a ``TypeError`` or ``ValueError`` of the factory), or an object that
+        is not a tracker (a class, or naming the method it lacks).
     TrackerError
         If a user's factory raises anything else.
     """
@@ -209,13 +256,20 @@ def run(
         A tracker name (``trackers.names()``), a ``"module:factory"`` spec, or a factory.
     params : dict, optional
         Tracker parameters (``trackers.make(name, **params)``, or the factory's keywords).
-    seed : int
+    seed : int, default 0
         The tracker's ``rng``.
     progress : callable, optional
         Called with the number of frames done.
-    single_thread : bool
+    single_thread : bool, default False
         Run compiled kernels on one thread (what experiment workers do), restoring the
         thread count afterwards.
+
+    Returns
+    -------
+    Run
+        The result (tracker label, parameters, seed, boxes (T, M, 4) float32 in px, target
+        ids, SHM orderings), the tracked targets' entity indices (M,), the tracker's
+        per-frame extras, and the tracker itself.
 
     Raises
     ------
@@ -225,7 +279,8 @@ def run(
         If the tracker rejects its parameters or the scene (a ``ValueError``).
     TrackerError
         If a user's tracker (a factory or spec, not one of ours) raises anything else
-        while it runs.
+        while it runs; or if a tracker's boxes (finite but beyond the float32 range),
+        ``orderings`` or ``order_prob`` cannot be stored in a result.
     """
     import numba
 
@@ -358,5 +413,29 @@ def run_tracker(
     seed: int = 0,
     progress: Callable[[int], None] | None = None,
 ) -> TrackerResult:
-    """:func:`run`, returning only the :class:`~scenegen.io.TrackerResult`."""
+    """:func:`run`, returning only the :class:`~scenegen.io.TrackerResult`.
+
+    Parameters
+    ----------
+    seq : Sequence
+        The sequence (frames may be lazy).
+    name : str or callable
+        A tracker name, a ``"module:factory"`` spec, or a factory.
+    params : dict, optional
+        Tracker parameters.
+    seed : int, default 0
+        The tracker's ``rng``.
+    progress : callable, optional
+        Called with the number of frames done.
+
+    Returns
+    -------
+    TrackerResult
+        The result of :func:`run` (compiled kernels on the current thread count).
+
+    Raises
+    ------
+    DataError, ConfigError, TrackerError
+        As :func:`run`.
+    """
     return run(seq, name, params, seed, progress=progress).result

@@ -24,7 +24,20 @@ def keyframe_values(
     keys: tuple[tuple[int, float, float], ...], n: int
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """The two values of (frame, a, b) keyframes at frames 0..n-1 (each shape (n,)):
-    linear in between, held before the first and after the last keyframe."""
+    linear in between, held before the first and after the last keyframe.
+
+    Parameters
+    ----------
+    keys : tuple of (int, float, float)
+        At least one keyframe ``(frame, a, b)``, frames increasing.
+    n : int
+        Number of frames.
+
+    Returns
+    -------
+    a, b : ndarray of float64, shape (n,)
+        The two values at each frame.
+    """
     t = np.arange(n, dtype=np.float64)
     f = np.array([k[0] for k in keys], dtype=np.float64)
     a = np.interp(t, f, [k[1] for k in keys])
@@ -38,6 +51,27 @@ def camera_offsets(
     """Camera offsets (dx, dy), each shape (n,) int64, within ``[-extent, extent]``.
 
     ``rng`` is the camera's own stream (AR2 noise); ``None`` gives zeros.
+
+    Parameters
+    ----------
+    cam : Camera or None
+        The camera: scripted ``keyframes``, else an AR2 path per axis from 0 with its
+        initial velocity (an axis without one stays at 0).
+    n : int
+        Number of frames.
+    rng : numpy.random.Generator
+        The camera's own stream (unused with keyframes).
+
+    Returns
+    -------
+    dx, dy : ndarray of int64, shape (n,)
+        The offsets (px), rounded to whole pixels and clipped to the extent.
+
+    Raises
+    ------
+    ConfigError
+        An AR2 path beyond :data:`~scenegen.config.MAX_PATH`, naming ``camera.x`` or
+        ``camera.y`` and the frame.
     """
     if cam is None:
         return np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64)
@@ -59,6 +93,26 @@ def camera_zoom(cam: Camera | None, n: int, rng: np.random.Generator) -> NDArray
     """Zoom factor per frame (n,), within :data:`ZOOM_LIMITS` (ones without a zoom).
 
     ``rng`` is the zoom's own stream.
+
+    Parameters
+    ----------
+    cam : Camera or None
+        The camera; its ``zoom`` AR2 drives the log zoom from 0, within
+        ``[-margin, margin]`` when ``margin > 0`` (and always within the limits).
+    n : int
+        Number of frames.
+    rng : numpy.random.Generator
+        The zoom's own stream.
+
+    Returns
+    -------
+    ndarray of float64, shape (n,)
+        The zoom factor per frame.
+
+    Raises
+    ------
+    ConfigError
+        An AR2 path beyond :data:`~scenegen.config.MAX_PATH`, naming ``camera.zoom``.
     """
     if cam is None or cam.zoom is None:
         return np.ones(n)

@@ -210,7 +210,23 @@ def _tight(tpl: NDArray[np.uint8]) -> NDArray[np.uint8]:
 
 
 def jitter_colors(app: Appearance, std: float, *, rng: np.random.Generator) -> Appearance:
-    """A copy of ``app`` whose colours are offset by N(0, std^2) per channel (distractors)."""
+    """A copy of ``app`` whose colours are offset by N(0, std^2) per channel (distractors).
+
+    Parameters
+    ----------
+    app : Appearance
+        The appearance to copy.
+    std : float
+        Std of the offsets (grey levels); <= 0 returns ``app`` unchanged, drawing nothing.
+    rng : numpy.random.Generator
+        Draws one normal per colour channel (also for an ``image`` pattern, which keeps
+        ``app``: the stream keeps its place).
+
+    Returns
+    -------
+    Appearance
+        ``app`` with its colours offset, rounded and clipped to 0..255.
+    """
     if std <= 0:
         return app
     cols = np.asarray(app.colors, dtype=np.float64)
@@ -227,6 +243,23 @@ def transform_template(
 
     The result is cropped to the tight box of its alpha, so the amodal box of the drawn
     entity is the template's extent. Shape (h', w', 4).
+
+    Parameters
+    ----------
+    tpl : ndarray of uint8, shape (h, w, 4)
+        The RGBA template.
+    scale : float, default 1.0
+        Size factor; each side is rounded and at least 1 px.
+    angle : float, default 0.0
+        Rotation (degrees, counter-clockwise), about the template's centre.
+    shade : float, default 1.0
+        Factor on the RGB channels (clipped to 0..255 and truncated).
+
+    Returns
+    -------
+    ndarray of uint8, shape (h', w', 4)
+        The transformed template, cropped to its alpha; a copy of ``tpl`` when nothing of
+        it remains visible.
     """
     out = tpl
     if scale != 1.0:

@@ -104,6 +104,20 @@ def ar2_stationary_moments(a1: float, a2: float, sigma: float) -> tuple[float, f
     For ``|roots| < 1``: ``rho1 = a1 / (1 - a2)`` and
     ``var = sigma^2 (1 - a2) / ((1 + a2) ((1 - a2)^2 - a1^2))`` (Yule-Walker).
 
+    Parameters
+    ----------
+    a1, a2 : float
+        The AR2 coefficients.
+    sigma : float
+        Std of the noise.
+
+    Returns
+    -------
+    var : float
+        Stationary variance (in the coordinate's units squared).
+    rho1 : float
+        Lag-1 autocorrelation.
+
     Raises
     ------
     ValueError

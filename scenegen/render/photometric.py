@@ -31,6 +31,28 @@ def illumination(
     """Per-frame gain and offset (each shape (n,)); ones and zeros without a change.
 
     ``rng`` is the illumination's own stream (AR2 noise of the log gain, then the offset).
+
+    Parameters
+    ----------
+    p : Photometric or None
+        The photometric config: scripted ``keyframes`` (frame, gain, offset), else AR2
+        paths from 0 of the log gain and of the offset (within ``[-margin, margin]`` when
+        ``margin > 0``); None: no change.
+    n : int
+        Number of frames.
+    rng : numpy.random.Generator
+        The illumination's own stream (unused with keyframes).
+
+    Returns
+    -------
+    gain, offset : ndarray of float64, shape (n,)
+        Gain factor and offset (grey levels) per frame.
+
+    Raises
+    ------
+    ConfigError
+        An AR2 path beyond :data:`~scenegen.config.MAX_PATH`, naming
+        ``photometric.gain`` or ``photometric.offset`` and the frame.
     """
     gain, offset = np.ones(n), np.zeros(n)
     if p is None:
@@ -50,7 +72,23 @@ def illumination(
 
 
 def illuminate(rgb: NDArray[np.uint8], gain: float, offset: float) -> NDArray[np.uint8]:
-    """``clip(rint(gain * rgb + offset))`` of one frame (H, W, 3), through a lookup table."""
+    """``clip(rint(gain * rgb + offset))`` of one frame (H, W, 3), through a lookup table.
+
+    Parameters
+    ----------
+    rgb : ndarray of uint8, shape (H, W, 3)
+        The frame.
+    gain : float
+        Factor on every channel.
+    offset : float
+        Added after the gain (grey levels).
+
+    Returns
+    -------
+    ndarray of uint8, shape (H, W, 3)
+        The lit frame, clipped to 0..255; ``rgb`` itself when ``gain == 1`` and
+        ``offset == 0``.
+    """
     if gain == 1.0 and offset == 0.0:
         return rgb
     lut = np.clip(np.rint(np.arange(256) * gain + offset), 0, 255).astype(np.uint8)
@@ -105,14 +143,19 @@ def motion_blur(
 
     Parameters
     ----------
-    rgb : (H, W, 3) uint8
-    lab : (H, W) uint16
+    rgb : ndarray of uint8, shape (H, W, 3)
+        The frame, changed in place.
+    lab : ndarray of uint16, shape (H, W)
+        The frame's label image.
+    label : int
+        The entity's label in ``lab``.
     box : (c_min, r_min, c_max, r_max)
         Inclusive visible box of the entity.
     velocity : (vx, vy)
         Image velocity, pixels per frame.
     exposure : float
-        The smear is ``exposure * velocity``, rounded to a quarter pixel.
+        The smear is ``exposure * velocity``, rounded to a quarter pixel; a smear
+        shorter than 1 px on both axes leaves the frame unchanged.
     """
     dx = round(velocity[0] * exposure * 4) / 4
     dy = round(velocity[1] * exposure * 4) / 4
@@ -134,7 +177,20 @@ def motion_blur(
 
 
 def jpeg(rgb: NDArray[np.uint8], quality: int) -> NDArray[np.uint8]:
-    """One frame (H, W, 3) through JPEG encoding and decoding at ``quality`` (1..100)."""
+    """One frame (H, W, 3) through JPEG encoding and decoding at ``quality`` (1..100).
+
+    Parameters
+    ----------
+    rgb : ndarray of uint8, shape (H, W, 3)
+        The frame.
+    quality : int
+        JPEG quality, 1..100 (higher: fewer artefacts).
+
+    Returns
+    -------
+    ndarray of uint8, shape (H, W, 3)
+        The decoded frame.
+    """
     bgr = cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR)
     ok, buf = cv2.imencode(".jpg", bgr, [cv2.IMWRITE_JPEG_QUALITY, int(quality)])
     if not ok:  # pragma: no cover - OpenCV encodes any uint8 image

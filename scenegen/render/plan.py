@@ -47,7 +47,23 @@ def _key(name: str) -> int:
 
 
 def entity_rng(seed: int, name: str, *extra: int) -> np.random.Generator:
-    """The random stream of component ``name`` (an entity name, ``background``, ...)."""
+    """The random stream of component ``name`` (an entity name, ``background``, ...).
+
+    Parameters
+    ----------
+    seed : int
+        The scene seed.
+    name : str
+        The component's name; hashed (SHA-256) into the spawn key, so each component's
+        stream depends on its name only, not on the other components.
+    *extra : int
+        Further spawn-key entries (a frame index, say): independent sub-streams.
+
+    Returns
+    -------
+    numpy.random.Generator
+        A new generator, the same for the same arguments.
+    """
     return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(_key(name), *extra)))
 
 
@@ -57,6 +73,16 @@ MAX_SEED = 2**64 - 1
 
 def resolve_seed(seed: int | np.integer | None) -> int:
     """An int seed in [0, :data:`MAX_SEED`]; ``None`` draws a fresh one from the OS.
+
+    Parameters
+    ----------
+    seed : int, numpy.integer or None
+        The seed (not a bool).
+
+    Returns
+    -------
+    int
+        ``seed`` as an int; a fresh one (below 2**63) for None.
 
     Raises
     ------
@@ -101,7 +127,21 @@ def _background(bg: Background, h: int, w: int, rng: np.random.Generator) -> NDA
 @dataclass
 class Chunk:
     """Frames ``start:stop`` of a scenario with their ground truth (shapes as in
-    :class:`~scenegen.sequence.GroundTruth`, with F = stop - start frames)."""
+    :class:`~scenegen.sequence.GroundTruth`, with F = stop - start frames).
+
+    Attributes
+    ----------
+    start : int
+        Index of the first frame.
+    frames : ndarray of shape (F, H, W, 3), uint8
+        RGB frames.
+    labels : ndarray of shape (F, H, W), uint16
+        Entity id of the visible surface; 0 is the background.
+    gt : dict of str to ndarray
+        The :class:`~scenegen.sequence.GroundTruth` arrays by field name (``box``,
+        ``visible_box``, ``center``, ``visibility``, ``present``, ``depth``,
+        ``path_center``), each with F frames.
+    """
 
     start: int
     frames: NDArray[np.uint8]
@@ -147,6 +187,9 @@ class Scenario:
         Camera zoom per frame (ones without a zoom).
     gain, offset : ndarray of shape (T,)
         Global illumination per frame (``gain * pixel + offset``).
+    _static_cache : tuple of ndarray or None
+        The static layer, drawn on the first :meth:`render` and kept (private: leave it
+        None).
     """
 
     config: SceneConfig
@@ -712,6 +755,18 @@ def plan(config: SceneConfig, seed: int | None = None, *, preset: str = "") -> S
         ``None`` draws a fresh seed (recorded in the result).
     preset : str
         The preset name to record ("" if none).
+
+    Returns
+    -------
+    Scenario
+        Everything but the pixels; :meth:`Scenario.render` draws them.
+
+    Raises
+    ------
+    ConfigError
+        A seed out of [0, :data:`MAX_SEED`], an image file that is missing or unreadable,
+        or an AR2 path beyond :data:`~scenegen.config.MAX_PATH` (naming the field and the
+        frame).
     """
     seed = resolve_seed(seed)
     cfg = config
@@ -826,6 +881,12 @@ def generate(
     -------
     Sequence
         ``frames`` (T, H, W, 3) uint8, ``labels`` (T, H, W) uint16, ``gt`` and templates.
+
+    Raises
+    ------
+    ConfigError
+        An unknown preset, an invalid config, ``frames`` not an integer >= 1, or a scene
+        that cannot be planned (:func:`plan`).
 
     Examples
     --------

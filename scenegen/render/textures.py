@@ -93,6 +93,19 @@ def load_source(source: str, field: str) -> NDArray[np.uint8]:
     A relative file path is relative to the current directory (a config file's are made
     absolute when it is loaded: :func:`scenegen.config.load_config`).
 
+    Parameters
+    ----------
+    source : str
+        ``skimage:NAME``, ``skimage:lfw_subset[i]`` or a path to an image file.
+    field : str
+        The config field path that named ``source``, prefixed to an error message.
+
+    Returns
+    -------
+    ndarray of uint8, shape (h, w, 3)
+        The RGB image, read-only: grey replicated to three channels, alpha dropped,
+        16-bit and float images scaled to 0..255.
+
     Raises
     ------
     ConfigError
@@ -115,6 +128,28 @@ def fit_image(
     ``stretch`` resizes (area interpolation when shrinking), ``tile`` repeats the image
     from ``offset`` (x, y), ``crop`` scales it to cover (h, w) keeping the aspect ratio
     and takes the centred window.
+
+    Parameters
+    ----------
+    img : ndarray of uint8, shape (ih, iw, 3)
+        The image.
+    w, h : int
+        Width and height of the result (px).
+    fit : {"stretch", "tile", "crop"}
+        How the image is brought to (h, w).
+    offset : tuple of (int, int), default (0, 0)
+        For ``tile``: the (x, y) pixel of ``img`` at the result's top-left corner (taken
+        modulo the image size); ignored otherwise.
+
+    Returns
+    -------
+    ndarray of uint8, shape (h, w, 3)
+        A new array (a copy even when ``stretch`` keeps the size).
+
+    Raises
+    ------
+    ValueError
+        ``fit`` is none of the three.
     """
     ih, iw = img.shape[:2]
     if fit == "stretch":
@@ -139,7 +174,22 @@ def fit_image(
 def random_window(
     img: NDArray[np.uint8], w: int, h: int, rng: np.random.Generator
 ) -> NDArray[np.uint8]:
-    """A (h, w, 3) window of ``img`` at an offset drawn from ``rng`` (tiled if smaller)."""
+    """A (h, w, 3) window of ``img`` at an offset drawn from ``rng`` (tiled if smaller).
+
+    Parameters
+    ----------
+    img : ndarray of uint8, shape (ih, iw, 3)
+        The image.
+    w, h : int
+        Width and height of the window (px).
+    rng : numpy.random.Generator
+        Draws the offset: x uniform in 0..max(iw - w, 0), y in 0..max(ih - h, 0).
+
+    Returns
+    -------
+    ndarray of uint8, shape (h, w, 3)
+        The window, as :func:`fit_image` with ``fit="tile"`` from the drawn offset.
+    """
     ih, iw = img.shape[:2]
     ox = int(rng.integers(0, max(iw - w, 0) + 1))
     oy = int(rng.integers(0, max(ih - h, 0) + 1))
@@ -151,7 +201,25 @@ def value_noise(
 ) -> NDArray[np.float32]:
     """Perlin-like value noise (h, w) in [0, 1]: ``octaves`` lattices of uniform values
     with spacing ``scale``, ``scale / 2``, ... pixels, smoothly (bicubically) interpolated
-    and summed with halving weights, then stretched to [0, 1]."""
+    and summed with halving weights, then stretched to [0, 1].
+
+    Parameters
+    ----------
+    w, h : int
+        Width and height of the texture (px).
+    scale : float
+        Lattice spacing of the first octave (px); values below 1 count as 1, and no
+        octave's spacing goes below 1.
+    rng : numpy.random.Generator
+        Draws the lattice values.
+    octaves : int, default 3
+        Number of lattices summed.
+
+    Returns
+    -------
+    ndarray of float32, shape (h, w)
+        The noise, its minimum at 0 and its maximum at 1 (all 0 when constant).
+    """
     out = np.zeros((h, w), dtype=np.float32)
     amp, total = 1.0, 0.0
     step = max(float(scale), 1.0)
@@ -177,7 +245,20 @@ def value_noise(
 
 def palette_map(v: NDArray[np.float32], colors: NDArray[np.uint8]) -> NDArray[np.uint8]:
     """Values ``v`` (h, w) in [0, 1] mapped piecewise linearly along ``colors`` (n, 3);
-    one colour is shaded from black (0) to the colour (1)."""
+    one colour is shaded from a quarter of the colour (0) to the colour (1).
+
+    Parameters
+    ----------
+    v : ndarray of float32, shape (h, w)
+        Values in [0, 1].
+    colors : array_like of uint8, shape (n, 3)
+        The RGB colours that ``v`` = 0, 1 / (n - 1), ..., 1 map to, or one colour.
+
+    Returns
+    -------
+    ndarray of uint8, shape (h, w, 3)
+        The RGB image, rounded to the nearest integer.
+    """
     cols = np.asarray(colors, dtype=np.float32)
     if len(cols) == 1:
         cols = np.stack([cols[0] * 0.25, cols[0]])
@@ -189,7 +270,20 @@ def palette_map(v: NDArray[np.float32], colors: NDArray[np.uint8]) -> NDArray[np
 
 
 def tinted(img: NDArray[np.uint8], tint: tuple[int, int, int] | None) -> NDArray[np.uint8]:
-    """``img`` multiplied channel-wise by ``tint`` / 255 (unchanged if None)."""
+    """``img`` multiplied channel-wise by ``tint`` / 255 (unchanged if None).
+
+    Parameters
+    ----------
+    img : ndarray of uint8, shape (h, w, 3)
+        The RGB image.
+    tint : tuple of (int, int, int) or None
+        Per-channel factor times 255 (255 leaves a channel unchanged).
+
+    Returns
+    -------
+    ndarray of uint8, shape (h, w, 3)
+        The tinted image, rounded; ``img`` itself when ``tint`` is None.
+    """
     if tint is None:
         return img
     t = np.asarray(tint, dtype=np.float32) / 255.0

@@ -52,7 +52,13 @@ def _cached(path: Path, expected: dict[str, str]) -> Any:
 
 def cache_dir() -> Path:
     """Where regenerated built-in fixtures are cached: ``$SCENEGEN_CACHE/fixtures``, else
-    ``$XDG_CACHE_HOME/scenegen/fixtures``, else ``~/.cache/scenegen/fixtures``."""
+    ``$XDG_CACHE_HOME/scenegen/fixtures``, else ``~/.cache/scenegen/fixtures``.
+
+    Returns
+    -------
+    Path
+        The folder (not created here; an empty variable counts as unset).
+    """
     if os.environ.get("SCENEGEN_CACHE"):
         return Path(os.environ["SCENEGEN_CACHE"]) / "fixtures"
     base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
@@ -60,7 +66,18 @@ def cache_dir() -> Path:
 
 
 def shipped_digests() -> dict[str, dict[str, Any]]:
-    """Name -> ``{"seed": int, "digests": {HDF5 path: SHA-256}}`` as shipped."""
+    """Name -> ``{"seed": int, "digests": {HDF5 path: SHA-256}}`` as shipped.
+
+    Returns
+    -------
+    dict of str to dict
+        The entries of :data:`DIGESTS_FILE`, by fixture name.
+
+    Raises
+    ------
+    DataError
+        The shipped file is unreadable, not JSON or of another schema.
+    """
     try:
         doc = json.loads(DIGESTS_FILE.read_text(encoding="utf-8"))
     except (OSError, json.JSONDecodeError) as err:
@@ -71,13 +88,38 @@ def shipped_digests() -> dict[str, dict[str, Any]]:
 
 
 def builtin_names() -> list[str]:
-    """Names of the built-in fixtures (the presets' ``-small`` versions, the edge cases)."""
+    """Names of the built-in fixtures (the presets' ``-small`` versions, the edge cases).
+
+    Returns
+    -------
+    list of str
+        The names, in the shipped file's order.
+
+    Raises
+    ------
+    DataError
+        As :func:`shipped_digests`.
+    """
     return list(shipped_digests())
 
 
 def write_digests(entries: dict[str, dict[str, Any]], path: Path | None = None) -> bool:
     """Write the shipped digests from registry ``entries`` (name -> entry with ``seed``
-    and ``digests``); returns True if the file changed."""
+    and ``digests``); returns True if the file changed.
+
+    Parameters
+    ----------
+    entries : dict of str to dict
+        Name -> registry entry; only its ``seed`` and ``digests`` are written.
+    path : Path, optional
+        The file to write (default :data:`DIGESTS_FILE`); written atomically, and not
+        rewritten when it already holds the same text.
+
+    Returns
+    -------
+    bool
+        True if the file was written.
+    """
     from scenegen.io.atomic import write_text
 
     path = DIGESTS_FILE if path is None else path
@@ -96,7 +138,20 @@ def write_digests(entries: dict[str, dict[str, Any]], path: Path | None = None) 
 
 
 def differing(seq: Any, expected: dict[str, str]) -> list[str]:
-    """The arrays of ``seq`` whose digests differ from ``expected`` (sorted)."""
+    """The arrays of ``seq`` whose digests differ from ``expected`` (sorted).
+
+    Parameters
+    ----------
+    seq : Sequence
+        The sequence (in memory or read from a file).
+    expected : dict of str to str
+        HDF5 path -> SHA-256 digest (as :func:`scenegen.testing.fixtures.digests` gives).
+
+    Returns
+    -------
+    list of str
+        The HDF5 paths whose digest differs or that only one side has, sorted.
+    """
     from scenegen.testing.fixtures import digests
 
     actual = digests(seq)
@@ -113,6 +168,12 @@ def builtin_fixture(name: str, *, cache: str | Path | None = None) -> Any:
         One of :func:`builtin_names`, e.g. ``"one-pixel"``.
     cache : str or Path, optional
         The cache folder (default :func:`cache_dir`).
+
+    Returns
+    -------
+    Sequence
+        The fixture, read from its cached HDF5 file (regenerated and cached first when
+        missing, damaged or stale).
 
     Raises
     ------

@@ -126,6 +126,16 @@ def label(factory: Any) -> str:
     given one; else a partial ``functools.partial(f, a, k=v)`` is ``f(a, k=v)``, and
     another object with no name is named by its type (a ``repr`` may hold a memory
     address, which changes from run to run).
+
+    Parameters
+    ----------
+    factory : callable
+        A tracker factory (a class, a function, a ``functools.partial``, ...).
+
+    Returns
+    -------
+    str
+        The name.
     """
     name = getattr(factory, "__qualname__", None) or getattr(factory, "__name__", None)
     if isinstance(name, str) and name:  # a partial given a name keeps it
@@ -237,6 +247,19 @@ def _writes_hint(call: Callable[[Any], Any], frame: NDArray[np.uint8]) -> str:
 
 
 def first_line(err: BaseException) -> str:
+    """The first line of an exception's message, for one-line reports.
+
+    Parameters
+    ----------
+    err : BaseException
+        The exception.
+
+    Returns
+    -------
+    str
+        The first line of ``str(err)`` with surrounding whitespace stripped; "" when the
+        message is empty.
+    """
     text = str(err).strip().splitlines()
     return text[0] if text else ""
 

@@ -20,6 +20,17 @@ def load_expected(path: Any) -> NDArray[Any] | None:
 
     An empty, truncated or foreign file (text, a pickle) is None rather than numpy's own
     error, so callers can name the file (or, when regenerating, rewrite it).
+
+    Parameters
+    ----------
+    path : str or Path
+        The ``.npy`` file (read without pickles).
+
+    Returns
+    -------
+    ndarray or None
+        The stored array, of its stored shape and dtype; None if the file is missing or
+        not a readable ``.npy`` array.
     """
     try:
         with open(path, "rb") as f:

@@ -86,7 +86,18 @@ __all__ = [
 
 @dataclass(frozen=True)
 class CheckResult:
-    """One check's outcome: ``status`` is ``"passed"``, ``"failed"`` or ``"skipped"``."""
+    """One check's outcome: ``status`` is ``"passed"``, ``"failed"`` or ``"skipped"``.
+
+    Attributes
+    ----------
+    name : str
+        The check's name (a key of :data:`CHECKS`).
+    status : {"passed", "failed", "skipped"}
+        Its outcome.
+    message : str
+        What it found: why it failed or was skipped, or a note when it passed ("" if
+        none).
+    """
 
     name: str
     status: str
@@ -95,7 +106,17 @@ class CheckResult:
 
 @dataclass(frozen=True)
 class ConformanceReport:
-    """What :func:`check_tracker` found, one :class:`CheckResult` per check run."""
+    """What :func:`check_tracker` found, one :class:`CheckResult` per check run.
+
+    Attributes
+    ----------
+    tracker : str
+        The factory's name (:func:`~scenegen.testing.checks.label`).
+    results : tuple of CheckResult
+        One per check run, in the order run.
+    options : Options
+        The options the checks ran with.
+    """
 
     tracker: str
     results: tuple[CheckResult, ...]
@@ -161,16 +182,19 @@ def check_tracker(
         A class or function returning a new tracker; called as ``factory(rng=seed)``
         when it accepts ``rng`` (or ``**kwargs``), else ``factory()``. Use
         ``functools.partial`` (or a lambda taking ``rng``) to fix other parameters.
-    report : bool
+    report : bool, default False
         Return the report even when a check fails, instead of raising.
-    **options
+    **options : Any
         The fields of :class:`Options` (``repeats``, ``min_pass_rate``,
         ``deterministic``, ``handles_occlusion``, ``iou_threshold``,
-        ``equivariance_tol``, ``seed``, ``checks``).
+        ``equivariance_tol``, ``seed``, ``checks``; ``checks`` may be one name or a
+        list).
 
     Returns
     -------
     ConformanceReport
+        One result per check run; when ``protocol`` fails, every later check is
+        skipped.
 
     Raises
     ------
@@ -246,6 +270,17 @@ def parametrize_with_checks(factories: Iterable[Any]) -> Any:
         (``checks`` chooses the tests made for that factory; a bad option is a
         ``ValueError`` when the tests are collected).
 
+    Returns
+    -------
+    pytest.MarkDecorator
+        The ``parametrize`` mark over the arguments ``factory`` and ``check``, with test
+        ids ``<factory label>-<check name>``.
+
+    Raises
+    ------
+    ValueError
+        For an unknown option or check name, or a bad option value, naming the factory.
+
     Examples
     --------
     ::
@@ -290,7 +325,19 @@ class _Check:
 
 
 def checks_table(reports: Iterable[ConformanceReport]) -> str:
-    """A Markdown table: one row per report, one column per check (pass / FAIL / skip)."""
+    """A Markdown table: one row per report, one column per check (pass / FAIL / skip).
+
+    Parameters
+    ----------
+    reports : iterable of ConformanceReport
+        The reports, one row each in the order given.
+
+    Returns
+    -------
+    str
+        The table, without a final newline: a column for every check of :data:`CHECKS`,
+        its cell ``pass``, ``FAIL``, ``–`` (skipped) or empty (not run).
+    """
     reports = list(reports)
     names = list(CHECKS)
     mark = {"passed": "pass", "failed": "FAIL", "skipped": "–"}

@@ -40,7 +40,33 @@ def distribution_difference(
     samples: ArrayLike, stored: ArrayLike, *, z: float = DEFAULT_Z, atol: float = 0.0
 ) -> str | None:
     """What is out of band between new ``samples`` (R, ...) and ``stored`` (R0, ...), or
-    None if every element's mean is within the band (see the module docstring)."""
+    None if every element's mean is within the band (see the module docstring).
+
+    Parameters
+    ----------
+    samples : array_like of float, shape (R, ...)
+        The new runs' summaries, R >= 2; NaN: not available.
+    stored : array_like of float, shape (R0, ...)
+        The stored runs' summaries, R0 >= 2, of the same per-run shape.
+    z : float, default :data:`DEFAULT_Z`
+        Width of the band in standard errors, > 0.
+    atol : float, default 0.0
+        Added to the band, >= 0.
+
+    Returns
+    -------
+    str or None
+        One line: the number of elements out of band and the first one (means, spread,
+        allowed difference), or an element that is NaN in some runs only or on one side
+        only; None if they agree.
+
+    Raises
+    ------
+    ValueError
+        Fewer than 2 runs on either side, ``z <= 0`` or ``atol < 0``.
+    AssertionError
+        The per-run shapes differ.
+    """
     if z <= 0 or atol < 0:
         raise ValueError(f"need z > 0 and atol >= 0, got z={z}, atol={atol}")
     new, old = _runs(samples, "samples"), _runs(stored, "the stored samples")
@@ -87,12 +113,31 @@ def assert_distribution_matches(
     """Compare ``samples`` (R, ...) with the runs stored at ``path`` (``.npy``), or store
     them (``regen``; always rewritten, since new runs differ). Returns True if written.
 
+    Parameters
+    ----------
+    path : Path
+        The ``.npy`` file of the stored runs.
+    samples : array_like of float, shape (R, ...)
+        The new runs' summaries, R >= 2.
+    z : float, default :data:`DEFAULT_Z`
+        Width of the band in standard errors (:func:`distribution_difference`).
+    atol : float, default 0.0
+        Added to the band.
+    regen : bool, default False
+        Store ``samples`` (as float64, creating the folders) instead of comparing.
+
+    Returns
+    -------
+    bool
+        True if the file was written (``regen``), False after a successful comparison.
+
     Raises
     ------
     AssertionError
-        Naming the file and the first element out of band.
+        Naming the file and the first element out of band; or a missing or unreadable
+        file (run pytest with ``--scenegen-regen``).
     ValueError
-        Fewer than 2 runs, or bad ``z``/``atol``.
+        Fewer than 2 runs, or bad ``z``/``atol`` (checked when comparing).
     """
     from scenegen.io.atomic import write_npy
     from scenegen.testing.compare import load_expected

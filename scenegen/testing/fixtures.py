@@ -65,7 +65,21 @@ FAST_PARTICLES = 32
 
 @dataclass(frozen=True)
 class FixtureDef:
-    """One regression fixture: a config and a seed, with what it exercises."""
+    """One regression fixture: a config and a seed, with what it exercises.
+
+    Attributes
+    ----------
+    name : str
+        The fixture's name (also its config's ``name``).
+    description : str
+        What it exercises, one line.
+    config : SceneConfig
+        The scene.
+    seed : int
+        The scene seed.
+    preset : str
+        The preset it was made from ("" for an edge case).
+    """
 
     name: str
     description: str
@@ -139,7 +153,25 @@ def downsized(
 
     Positions, sizes, speeds, noise stds, margins and texture scales are scaled by
     ``factor``; clutter counts by ``factor**2`` (same density), capped at
-    ``max_clutter``. Frame-indexed fields (appear, disappear, depth keyframes) are kept.
+    ``max_clutter``. Frame-indexed fields (appear, disappear, depth keyframes) are kept,
+    and so are the camera, the photometric settings, the sensor noise and an
+    appearance's ``noise_scale``.
+
+    Parameters
+    ----------
+    config : SceneConfig
+        The scene.
+    factor : float
+        Scale of the canvas, in (0, 1]; sizes are rounded and at least 1 px.
+    n_frames : int
+        Frames of the result, >= 1.
+    max_clutter : int, optional
+        Most items per clutter group (None: no cap).
+
+    Returns
+    -------
+    SceneConfig
+        The downsized config (validated again on construction).
 
     Raises
     ------
@@ -322,7 +354,14 @@ def _edge_cases() -> list[FixtureDef]:
 
 
 def definitions() -> dict[str, FixtureDef]:
-    """Every fixture by name: one per preset (``<preset>-small``), then the edge cases."""
+    """Every fixture by name: one per preset (``<preset>-small``), then the edge cases.
+
+    Returns
+    -------
+    dict of str to FixtureDef
+        The definitions: each preset of :func:`scenegen.presets.names` at half size,
+        8 frames, at most 60 clutter items per group, seed 1; then the edge cases.
+    """
     from scenegen import presets
 
     out: dict[str, FixtureDef] = {}
@@ -360,6 +399,17 @@ def digests(seq: Any) -> dict[str, str]:
 
     Each digest covers the dtype, the shape and the bytes; the templates share one digest
     (``templates``, over all of them in id order).
+
+    Parameters
+    ----------
+    seq : Sequence
+        The sequence (in memory or read from a file).
+
+    Returns
+    -------
+    dict of str to str
+        ``frames``, ``labels``, ``entities/id``, ``entities/role``, ``entities/name``,
+        every ``gt/<field>`` and ``templates``, each to a 64-character hex digest.
     """
     out = {
         "frames": digest_array(seq.frames),
@@ -381,7 +431,19 @@ def digests(seq: Any) -> dict[str, str]:
 def compare_boxes(actual: NDArray[Any], expected: NDArray[Any]) -> str | None:
     """None if equal within :data:`EXPECTED_ATOL` pixels (NaN matching NaN), else what
     differs (:func:`scenegen.testing.compare.difference`; the index is (frame, target,
-    coordinate))."""
+    coordinate)).
+
+    Parameters
+    ----------
+    actual, expected : ndarray of float, shape (T, M, 4)
+        Boxes [x, y, w, h] (px) per frame and target.
+
+    Returns
+    -------
+    str or None
+        One line saying what differs (shape, NaN placement or the largest difference),
+        or None.
+    """
     return difference(actual, expected, atol=EXPECTED_ATOL)
 
 
@@ -390,12 +452,39 @@ def compare_boxes(actual: NDArray[Any], expected: NDArray[Any]) -> str | None:
 
 
 def default_dir() -> Path:
-    """The repository's ``fixtures/`` folder in a source checkout, else ``./fixtures``."""
+    """The repository's ``fixtures/`` folder in a source checkout, else ``./fixtures``.
+
+    Returns
+    -------
+    Path
+        The checkout's folder (absolute) when it holds ``registry.json``, else the
+        relative ``fixtures``.
+    """
     repo = Path(__file__).resolve().parents[2] / "fixtures"
     return repo if (repo / "registry.json").exists() else Path("fixtures")
 
 
 def load_registry(folder: Path, *, missing_ok: bool) -> dict[str, Any]:
+    """The fixture registry ``folder/registry.json``.
+
+    Parameters
+    ----------
+    folder : Path
+        The fixtures folder.
+    missing_ok : bool
+        Give an empty registry when the file is missing, instead of raising.
+
+    Returns
+    -------
+    dict
+        The registry: ``schema`` and ``fixtures`` (name -> entry).
+
+    Raises
+    ------
+    DataError
+        The file is missing (unless ``missing_ok``), unreadable, not JSON, or of another
+        schema.
+    """
     path = folder / "registry.json"
     if not path.exists():
         if missing_ok:
@@ -411,6 +500,27 @@ def load_registry(folder: Path, *, missing_ok: bool) -> dict[str, Any]:
 
 
 def select_names(names: Iterable[str] | None, what: str, valid: Iterable[str]) -> list[str]:
+    """The names asked for, checked against the valid ones.
+
+    Parameters
+    ----------
+    names : iterable of str or None
+        The names asked for; None: every valid name.
+    what : str
+        What they name, for the message ("fixture").
+    valid : iterable of str
+        The valid names.
+
+    Returns
+    -------
+    list of str
+        ``names`` in the order given, or every valid name in its order.
+
+    Raises
+    ------
+    ConfigError
+        ``unknown WHAT 'NAME'; valid: ...`` for the first unknown name.
+    """
     valid = list(valid)
     if names is None:
         return valid

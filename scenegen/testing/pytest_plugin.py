@@ -186,6 +186,11 @@ def cache_key(config: Any, seed: int, frames: int | None = None) -> str:
     seed : int
     frames : int, optional
         A frame-count override applied on top of ``config``.
+
+    Returns
+    -------
+    str
+        The first 20 hex characters of the SHA-256 of those four, as sorted-key JSON.
     """
     from scenegen.config import to_dict
 
@@ -208,6 +213,11 @@ def frozen(seq: Any) -> Any:
     ----------
     seq : Sequence
         Possibly with lazy (file-backed) arrays; those are read and their file closed.
+
+    Returns
+    -------
+    Sequence
+        A copy of ``seq`` whose arrays are read-only in-memory copies.
     """
     from scenegen.sequence import GroundTruth
 
@@ -348,6 +358,17 @@ def assert_close_to_expected(
     ``|actual - expected| <= atol + rtol * |expected|``. With ``regen`` the file is written
     instead (atomically, and only if its contents change).
 
+    Parameters
+    ----------
+    path : Path
+        The ``.npy`` file.
+    actual : array_like
+        The new values.
+    atol, rtol : float, default 0.0
+        Absolute and relative tolerances, >= 0.
+    regen : bool, default False
+        Write ``actual`` (creating the folders) instead of comparing.
+
     Returns
     -------
     bool
@@ -357,7 +378,10 @@ def assert_close_to_expected(
     ------
     AssertionError
         Naming the file, how many elements differ, the largest difference, the first
-        differing element and the tolerances.
+        differing element and the tolerances; or a missing or unreadable file (run
+        pytest with ``--scenegen-regen``).
+    ValueError
+        If a tolerance is negative.
     """
     from scenegen.io.atomic import write_npy
     from scenegen.testing.compare import difference, load_expected

@@ -761,7 +761,20 @@ def _draw_photometric(draw: Any) -> Photometric | None:
 
 def example_file(config: SceneConfig) -> tuple[str, Path]:
     """``config`` as YAML and the file it is saved in (``<tmp>/scenegen-examples/``, named
-    by the SHA-256 of the text, written once)."""
+    by the SHA-256 of the text, written once).
+
+    Parameters
+    ----------
+    config : SceneConfig
+        The config of a failing example.
+
+    Returns
+    -------
+    text : str
+        The config as YAML (:func:`scenegen.config.dump_yaml`).
+    path : Path
+        ``<tmp>/scenegen-examples/scene-<first 12 hex characters of the digest>.yaml``.
+    """
     import hashlib
     import tempfile
 

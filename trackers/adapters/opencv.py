@@ -63,7 +63,14 @@ def _lookup(name: str) -> tuple[Any, Any]:
 
 
 def opencv_names() -> list[str]:
-    """OpenCV tracker names this cv2 build offers that need no model files."""
+    """OpenCV tracker names this cv2 build offers that need no model files.
+
+    Returns
+    -------
+    list of str
+        The names among MIL, KCF, CSRT, Boosting, MedianFlow, TLD and MOSSE (in that
+        order) found as ``cv2.Tracker<name>`` or ``cv2.legacy.Tracker<name>``.
+    """
     import cv2
 
     out = []
@@ -82,10 +89,13 @@ class OpenCVTracker:
     ----------
     name : str
         ``cv2.Tracker<name>``, e.g. ``"MIL"``.
-    rng : numpy.random.Generator, int or None
-        Seed of OpenCV's global random state, set at ``init`` (:func:`cv2_seed`).
-    **params
-        Fields of ``cv2.Tracker<name>_Params``.
+    rng : numpy.random.Generator, int or None, optional
+        Seed of OpenCV's global random state, set at ``init`` (:func:`cv2_seed`); None
+        (the default) leaves that state alone.
+    **params : Any
+        Fields of ``cv2.Tracker<name>_Params``. A numeric field must be finite; one whose
+        default is positive must lie in (0, ``MAX_PARAM_FACTOR`` x default], and an int
+        field takes integral values only. MIL's are checked by :func:`check_mil`.
 
     Raises
     ------
@@ -238,10 +248,22 @@ def cv2_seed(rng: np.random.Generator | int | None) -> int | None:
     give) is mapped to 31 bits through ``numpy.random.SeedSequence``; a Generator draws
     one; None leaves OpenCV's state alone.
 
+    Parameters
+    ----------
+    rng : numpy.random.Generator, int or None
+        The tracker's ``rng`` argument.
+
+    Returns
+    -------
+    int or None
+        A seed in [-2**31, 2**31) (in [0, 2**31) when drawn or mapped), or None for
+        ``rng=None``.
+
     Raises
     ------
     ValueError
-        For a negative int below -2**31, or anything else than an int, a Generator or None.
+        For a negative int below -2**31, or anything else than an int, a Generator or None
+        (a bool included).
 
     Examples
     --------
@@ -267,6 +289,23 @@ def opencv(name: str, **kw: Any) -> OpenCVTracker:
     """An OpenCV tracker behind the protocol: ``opencv("MIL", rng=0, **params)``.
 
     See :class:`OpenCVTracker`.
+
+    Parameters
+    ----------
+    name : str
+        ``cv2.Tracker<name>``, e.g. ``"MIL"`` (:func:`opencv_names`).
+    **kw : Any
+        ``rng`` and the fields of ``cv2.Tracker<name>_Params``.
+
+    Returns
+    -------
+    OpenCVTracker
+        A new tracker, not yet initialised.
+
+    Raises
+    ------
+    ValueError
+        As :class:`OpenCVTracker`.
     """
     return OpenCVTracker(name, **kw)
 
@@ -321,6 +360,12 @@ def check_mil(p: Any) -> None:
     over a window that the frame does not clip must be at least :data:`MIN_MIL_NEGATIVES`
     (the defaults, 25, 3 and 65, give 49.7). A box too large for its frame can still
     leave no room for samples: that fails at ``init``, naming the box.
+
+    Parameters
+    ----------
+    p : cv2.TrackerMIL_Params
+        The parameters (read: ``samplerSearchWinSize``, ``samplerInitInRadius``,
+        ``samplerInitMaxNegNum``).
 
     Raises
     ------

@@ -38,7 +38,17 @@ def uniqueness(particles: NDArray[np.floating]) -> NDArray[np.float64]:
     Parameters
     ----------
     particles : ndarray of shape (N, K, 3)
-        Particle states (u, v, a).
+        Particle states (u, v, a), N >= 1.
+
+    Returns
+    -------
+    ndarray of float64, shape (K,)
+        Number of distinct (u, v, a) rows of each object over N, in (0, 1].
+
+    Raises
+    ------
+    ValueError
+        If ``particles`` is not of shape (N, K, 3) with N >= 1.
 
     Examples
     --------
@@ -57,10 +67,21 @@ def effective_dynamics(particles: NDArray[np.floating], sigma: NDArray[np.floati
     Parameters
     ----------
     particles : ndarray of shape (N, K, 3)
-        Particle states (u, v, a).
+        Particle states (u, v, a), N >= 1.
     sigma : array_like of shape (3,)
         σ of the tracking dynamics per parameter; a parameter with σ = 0 gives 1 (no
         spread to lose).
+
+    Returns
+    -------
+    ndarray of float64, shape (K, 3)
+        Population variance (ddof 0) of u, v, a over the N particles divided by σ²;
+        1 where σ = 0.
+
+    Raises
+    ------
+    ValueError
+        If ``particles`` is not of shape (N, K, 3) with N >= 1, or ``sigma`` not (3,).
 
     Examples
     --------

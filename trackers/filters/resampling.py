@@ -59,7 +59,23 @@ RESAMPLERS: tuple[str, ...] = ("multinomial", "systematic", "stratified", "resid
 
 
 def group_starts(sizes: NDArray[np.integer]) -> NDArray[np.int64]:
-    """First index of each group, shape (C,), for group lengths ``sizes`` (C,)."""
+    """First index of each group, shape (C,), for group lengths ``sizes`` (C,).
+
+    Parameters
+    ----------
+    sizes : array_like of int, shape (C,)
+        Lengths of the contiguous groups (not checked).
+
+    Returns
+    -------
+    ndarray of int64, shape (C,)
+        The exclusive cumulative sum of ``sizes``: 0, sizes[0], sizes[0] + sizes[1], ...
+
+    Examples
+    --------
+    >>> group_starts([3, 1, 2]).tolist()
+    [0, 3, 4]
+    """
     sizes = np.asarray(sizes, dtype=np.int64)
     return np.cumsum(sizes) - sizes
 
@@ -187,9 +203,19 @@ def resample(
 ) -> NDArray[np.int64]:
     """Draw N ancestor indices from weights (N,) by ``method`` (one group).
 
+    Parameters
+    ----------
+    weights : ndarray of shape (N,)
+        Non-negative weights, N >= 1 (normalised here).
+    method : {"multinomial", "systematic", "stratified", "residual"}, optional
+        Resampling scheme (module docstring); default ``"systematic"``.
+    rng : numpy.random.Generator
+        Source of randomness.
+
     Returns
     -------
     ndarray of shape (N,), int64
+        Ancestor index of each new particle.
 
     Raises
     ------
@@ -269,6 +295,30 @@ def weighted_resample(
     rng: np.random.Generator,
 ) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
     """Weighted resampling of one set: ``weighted_resample_groups`` with one group.
+
+    Parameters
+    ----------
+    weights : ndarray of shape (N,)
+        Current weights π, non-negative (normalised here).
+    g : ndarray of shape (N,)
+        Non-negative weighting function at each particle (e.g. one object's likelihood),
+        up to a constant factor.
+    method : {"multinomial", "systematic", "stratified", "residual"}, optional
+        Resampler for the draw; default ``"systematic"``.
+    rng : numpy.random.Generator
+        Source of randomness.
+
+    Returns
+    -------
+    indices : ndarray of shape (N,), int64
+        Ancestor of each new particle, drawn with probability ∝ π g.
+    new_weights : ndarray of shape (N,)
+        π_k / ρ_k, normalised to sum 1.
+
+    Raises
+    ------
+    ValueError
+        As ``weighted_resample_groups``.
 
     Examples
     --------

@@ -46,6 +46,29 @@ def log_sum_exp_groups(x: NDArray[np.float64], starts: NDArray[np.int64],
 
     ``starts`` (C,) and ``sizes`` (C,) give each group's first index and length (the
     groups of ``trackers.filters.resampling``).
+
+    Parameters
+    ----------
+    x : ndarray of float64, shape (N,)
+        Values (log-weights), grouped in contiguous slices.
+    starts : ndarray of int64, shape (C,)
+        First index of each group, increasing (``group_starts(sizes)``).
+    sizes : ndarray of int64, shape (C,)
+        Length of each group, >= 1, summing to N. Not checked against ``starts``.
+
+    Returns
+    -------
+    ndarray of float64, shape (C,)
+        log Σ exp(x) of each group (the group's maximum subtracted first); NaN for a
+        group that is all -inf.
+
+    Examples
+    --------
+    >>> from trackers.filters.resampling import group_starts
+    >>> sizes = np.array([2, 1])
+    >>> x = np.log(np.array([1.0, 3.0, 5.0]))
+    >>> np.exp(log_sum_exp_groups(x, group_starts(sizes), sizes)).round(12).tolist()
+    [4.0, 5.0]
     """
     m = np.maximum.reduceat(x, starts)
     return m + np.log(np.add.reduceat(np.exp(x - np.repeat(m, sizes)), starts))

@@ -431,6 +431,23 @@ class PreparedReferences(NamedTuple):
 
     Build with ``prepare_references``; pass to ``prepared_distances`` to score many sets
     of boxes against the same references (a tracker, every frame) without redoing it.
+
+    Attributes
+    ----------
+    refs : ndarray of shape (R, n_parts * n_bins)
+        The reference histograms, float64, C-contiguous.
+    sqrt_refs : ndarray of shape (R, n_parts * n_bins)
+        Their square roots.
+    nz : ndarray of shape (R, n_parts * n_bins), int64
+        Each reference's bins with q > 0, first, in order.
+    nz_start : ndarray of shape (R, n_parts + 1), int64
+        Where each band's bins start in ``nz``.
+    empty_rho : ndarray of shape (R, n_parts)
+        ρ of a band with no pixel (the uniform histogram).
+    n_bins : int
+        Bins per band.
+    n_parts : int
+        Horizontal bands.
     """
 
     refs: NDArray[np.float64]
@@ -456,6 +473,11 @@ def prepare_references(refs: NDArray[np.floating], n_parts: int = 1) -> Prepared
         Reference histograms (each summing to 1), one per object.
     n_parts : int, optional
         Horizontal bands, as in ``region_histograms``.
+
+    Returns
+    -------
+    PreparedReferences
+        The references with their square roots, supports and empty-band ρ.
 
     Raises
     ------
@@ -491,6 +513,23 @@ def prepared_distances(
     in [0, ``prepared.n_bins``), as ``quantize_rgb`` / ``quantize_hsv`` give (an index out
     of range reads out of bounds). Boxes must be finite with positive sizes and
     ``ref_index`` must index ``prepared.refs``: both are checked.
+
+    Parameters
+    ----------
+    bin_img : ndarray of shape (H, W), uint8, uint16 or int32
+        Bin index of every pixel, in [0, ``prepared.n_bins``) (not checked).
+    boxes : ndarray of shape (P, 4)
+        Candidate boxes [x, y, w, h] in pixels.
+    prepared : PreparedReferences
+        From ``prepare_references``.
+    ref_index : ndarray of shape (P,), integer
+        Row of ``prepared.refs`` that box p is compared with.
+    kernel : int
+        Kernel code, as in ``region_histograms``.
+    method : {"auto", "direct", "integral"}, optional
+        Evaluation path, as in ``region_distances``.
+    box_levels : int, optional
+        Levels L of ``KERNEL_BOX`` (ignored by the other kernels).
 
     Returns
     -------

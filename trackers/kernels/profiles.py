@@ -54,6 +54,11 @@ def box_kernel_levels(levels: int = DEFAULT_BOX_LEVELS) -> tuple[NDArray[np.floa
                                                                  NDArray[np.float64]]:
     """Scales and weights of the nested-rectangle kernel with ``levels`` levels.
 
+    Parameters
+    ----------
+    levels : int, optional
+        Levels L, in [1, 16].
+
     Returns
     -------
     fractions : ndarray of shape (L,)

@@ -124,7 +124,24 @@ def _quantize_hsv(frame, h_bins, s_bins, v_bins, s_thr, v_thr):
 
 
 def hsv_n_bins(h_bins: int = 10, s_bins: int = 10, v_bins: int = 10) -> int:
-    """Number of bins of the HSV quantisation: ``h_bins * s_bins + v_bins``."""
+    """Number of bins of the HSV quantisation: ``h_bins * s_bins + v_bins``.
+
+    Parameters
+    ----------
+    h_bins, s_bins, v_bins : int, optional
+        Hue, saturation and value bins, as in ``quantize_hsv``.
+
+    Returns
+    -------
+    int
+        The hue-saturation bins of coloured pixels followed by the value bins of the
+        greyish or dark ones.
+
+    Examples
+    --------
+    >>> hsv_n_bins()
+    110
+    """
     return h_bins * s_bins + v_bins
 
 

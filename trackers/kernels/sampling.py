@@ -147,5 +147,26 @@ def _count_distinct(particles):
 
 
 def count_distinct(particles: NDArray[np.floating]) -> NDArray[np.int64]:
-    """Number of distinct rows (u, v, a) per object of particles (N, K, 3), shape (K,)."""
+    """Number of distinct rows (u, v, a) per object of particles (N, K, 3), shape (K,).
+
+    Rows are compared with ``==`` (so -0.0 equals 0.0); a row holding a NaN equals no
+    row and counts as distinct.
+
+    Parameters
+    ----------
+    particles : ndarray of shape (N, K, 3)
+        Particle states (u, v, a); converted to float64. The shape is not checked here
+        (``trackers.filters.diagnostics.uniqueness`` checks it).
+
+    Returns
+    -------
+    ndarray of int64, shape (K,)
+        Distinct rows of each object, in [1, N] for N >= 1.
+
+    Examples
+    --------
+    >>> p = np.zeros((4, 2, 3)); p[:, 1, 0] = [0.0, 1.0, 1.0, np.nan]
+    >>> count_distinct(p).tolist()
+    [1, 3]
+    """
     return _count_distinct(np.ascontiguousarray(particles, dtype=np.float64))

@@ -158,7 +158,18 @@ def _numpy_reduceat_sum(a, lo, n):
 
 
 def numpy_sum(a: NDArray[np.float64]) -> float:
-    """``np.sum`` of a 1-D float64 array computed by the compiled replica (tests)."""
+    """``np.sum`` of a 1-D float64 array computed by the compiled replica (tests).
+
+    Parameters
+    ----------
+    a : array_like of float, shape (N,)
+        The values (converted to C-contiguous float64).
+
+    Returns
+    -------
+    float
+        ``np.sum(a)``, to the bit (0.0 for N = 0).
+    """
     a = np.ascontiguousarray(a, dtype=np.float64)
     return float(_numpy_sum(a, 0, a.shape[0]))
 
@@ -166,7 +177,20 @@ def numpy_sum(a: NDArray[np.float64]) -> float:
 def numpy_reduceat_sum(a: NDArray[np.float64], sizes: NDArray[np.integer]
                        ) -> NDArray[np.float64]:
     """``np.add.reduceat(a, starts)`` of contiguous groups of lengths ``sizes`` (C,), shape
-    (C,), computed by the compiled replica (tests)."""
+    (C,), computed by the compiled replica (tests).
+
+    Parameters
+    ----------
+    a : array_like of float, shape (N,)
+        The values (converted to C-contiguous float64).
+    sizes : array_like of int, shape (C,)
+        Lengths of the contiguous groups, each >= 1, summing to at most N (not checked).
+
+    Returns
+    -------
+    ndarray of float64, shape (C,)
+        The sum of each group: its first element plus the pairwise sum of the rest.
+    """
     a = np.ascontiguousarray(a, dtype=np.float64)
     sizes = np.asarray(sizes, dtype=np.int64)
     out = np.empty(sizes.shape[0])
@@ -250,6 +274,22 @@ def state_boxes(states: NDArray[np.float64], scale: NDArray[np.float64],
 
     ``scale`` (N,) is exp(a) of each state, taken by the caller with numpy's exp;
     ``sizes`` (K, 2) the objects' base (w0, h0).
+
+    Parameters
+    ----------
+    states : ndarray of float64, shape (N, 3)
+        States (u, v, a): centre in px and log scale (only u and v are read).
+    scale : ndarray of float64, shape (N,)
+        exp(a) of each state.
+    sizes : ndarray of float64, shape (K, 2)
+        Base size (w0, h0) of each object, in px.
+    obj : ndarray of int64, shape (N,)
+        The object of each state, in [0, K) (not checked).
+
+    Returns
+    -------
+    ndarray of float64, shape (N, 4)
+        Boxes [u - w/2, v - h/2, w, h] with (w, h) = scale * sizes[obj], in px.
     """
     return _state_boxes(states, scale, sizes, obj)
 
@@ -291,6 +331,29 @@ def stage_log_weights(stage: NDArray[np.float64], ll: NDArray[np.float64],
     False if a log-weight is NaN (the caller then takes the checked numpy path, which
     raises). Shapes: stage, log_g, logpi (N,), ll (N, K); ``sizes`` (C,) the contiguous
     groups' lengths.
+
+    Parameters
+    ----------
+    stage : ndarray of float64, shape (N,)
+        The stage's log-likelihood of each particle's stage object.
+    ll : ndarray of float64, shape (N, K)
+        Per-object log-likelihoods of every particle, updated in place.
+    log_g : ndarray of float64, shape (N,)
+        Accumulated log weighting function of every particle, updated in place.
+    logpi : ndarray of float64, shape (N,)
+        Log-weights log π of every particle.
+    obj : ndarray of int64, shape (N,)
+        The stage's object of each particle, in [0, K).
+    sizes : array_like of int, shape (C,)
+        Lengths of the contiguous groups, summing to N.
+
+    Returns
+    -------
+    shifted : ndarray of float64, shape (2, N)
+        Row 0: logpi minus its group's maximum; row 1: the updated log_g minus its
+        group's maximum.
+    ok : bool
+        False if an entry of ``logpi`` or of the updated ``log_g`` is NaN.
     """
     return _stage_log_weights(stage, ll, log_g, logpi, obj,
                               np.ascontiguousarray(sizes, dtype=np.int64))
@@ -315,7 +378,23 @@ def _normalise_groups(w, sizes):
 def normalise_groups(w: NDArray[np.float64], sizes: NDArray[np.int64]
                      ) -> tuple[NDArray[np.float64], bool]:
     """Weights (N,) divided by their group's sum (``np.add.reduceat``), and whether every
-    group's sum was positive. ``sizes`` (C,) are the contiguous groups' lengths."""
+    group's sum was positive. ``sizes`` (C,) are the contiguous groups' lengths.
+
+    Parameters
+    ----------
+    w : ndarray of float64, shape (N,)
+        Weights (not checked).
+    sizes : ndarray of int64, shape (C,)
+        Lengths of the contiguous groups, each >= 1, summing to N.
+
+    Returns
+    -------
+    weights : ndarray of float64, shape (N,)
+        ``w`` normalised to sum 1 in each group; when ``ok`` is False, only the groups
+        before the first failing one are filled (the rest is uninitialised).
+    ok : bool
+        False at the first group whose sum is not > 0 (zero, negative or NaN).
+    """
     return _normalise_groups(w, sizes)
 
 
@@ -332,7 +411,22 @@ def _normalise_groups_checked(w, sizes):
 def normalise_groups_checked(w: NDArray[np.float64], sizes: NDArray[np.int64]
                              ) -> tuple[NDArray[np.float64], bool]:
     """``normalise_groups`` for C-contiguous float64 weights (N,), also False unless every
-    weight is finite and >= 0 and their sum finite."""
+    weight is finite and >= 0 and their sum finite.
+
+    Parameters
+    ----------
+    w : ndarray of float64, shape (N,)
+        Weights, C-contiguous.
+    sizes : ndarray of int64, shape (C,)
+        Lengths of the contiguous groups, each >= 1, summing to N.
+
+    Returns
+    -------
+    weights : ndarray of float64, shape (N,) or (0,)
+        As ``normalise_groups``; empty when a weight or the total failed the checks.
+    ok : bool
+        True when every check passed and every group's sum was positive.
+    """
     return _normalise_groups_checked(w, sizes)
 
 
@@ -364,7 +458,20 @@ def _gather_pair(x, prev, idx):
 def gather_pair(x: NDArray[np.float64], prev: NDArray[np.float64], idx: NDArray[np.int64]
                 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """``x[idx]``, ``prev[idx]`` of two (N, K, D) arrays by ancestors ``idx`` (P,), as new
-    C-contiguous float64 arrays (P, K, D)."""
+    C-contiguous float64 arrays (P, K, D).
+
+    Parameters
+    ----------
+    x, prev : array_like of float, shape (N, K, D)
+        The two particle arrays (X_{t−1} and X_{t−2}).
+    idx : array_like of int, shape (P,)
+        Ancestor indices, in [0, N) (not checked).
+
+    Returns
+    -------
+    x_new, prev_new : ndarray of float64, shape (P, K, D)
+        ``x[idx]`` and ``prev[idx]``.
+    """
     return _gather_pair(np.ascontiguousarray(x, dtype=np.float64),
                         np.ascontiguousarray(prev, dtype=np.float64),
                         np.ascontiguousarray(idx, dtype=np.int64))
@@ -514,6 +621,45 @@ def resample_propagate(
     None, the scope of the gather). Returns (new weights
     (N,), x, prev, ll, log_g gathered, with x and prev propagated, and the new states
     (N, 3) of the stage's objects), or None where ``weighted_resample_gather`` is None.
+
+    Parameters
+    ----------
+    a : ndarray of float64, shape (N,)
+        Current weights π (any positive scale per group).
+    b : ndarray of float64, shape (N,)
+        The weighting function g at each particle.
+    sizes : ndarray of int64, shape (C,)
+        Lengths of the contiguous groups.
+    uniforms : ndarray of float64, shape (C,) or (N,)
+        One uniform per group (systematic) or per particle (multinomial, stratified).
+    mode : int
+        ``trackers.kernels.sampling`` MULTINOMIAL, STRATIFIED or SYSTEMATIC.
+    x, prev : ndarray of float64, shape (N, K, 3)
+        X_{t−1} and X_{t−2} of every particle (not modified: the gathered copies are
+        propagated).
+    ll : ndarray of float64, shape (N, K)
+        Per-object log-likelihoods, gathered.
+    log_g : ndarray of float64, shape (N,)
+        Accumulated log weighting function, gathered.
+    obj : ndarray of int64, shape (N,)
+        The next stage's object of each particle.
+    noise : ndarray of float64, shape (N, 3)
+        The next stage's standard normals.
+    mean : ndarray of float64, shape (K, 3)
+        X̄ per object (the AR2 mean).
+    sigma : ndarray of float64, shape (3,)
+        σ of (u, v, a).
+    a1, a2 : float
+        AR2 coefficients.
+    placed : ndarray of bool, shape (N, K), optional
+        The scope of the gather, as in ``weighted_resample_gather``; None: joint.
+
+    Returns
+    -------
+    tuple of ndarray or None
+        (weights (N,), x (N, K, 3), prev (N, K, 3), ll (N, K), log_g (N,), new states
+        (N, 3)); None when ``a`` or ``b`` is negative or not finite or a group's π g
+        sums to zero.
     """
     out = _resample_propagate(a, b, sizes, uniforms, int(mode), x, prev, ll, log_g, obj,
                               noise, mean, sigma, float(a1), float(a2), *_scope(placed))
@@ -544,6 +690,18 @@ def group_weights(logw: NDArray[np.float64], sizes: NDArray[np.int64]) -> NDArra
     ``logw`` (N,) holds contiguous groups of lengths ``sizes`` (C,); the largest weight
     of every group is 1, so a group far below the others (log π_c → −∞) can still be
     resampled within itself.
+
+    Parameters
+    ----------
+    logw : array_like of float, shape (N,)
+        Log-weights.
+    sizes : array_like of int, shape (C,)
+        Lengths of the contiguous groups, each >= 1, summing to N (not checked).
+
+    Returns
+    -------
+    ndarray of float64, shape (N,)
+        The shifted weights, in [0, 1], not normalised.
     """
     shifted, _ = _group_max_shift(np.ascontiguousarray(logw, dtype=np.float64),
                                   np.ascontiguousarray(sizes, dtype=np.int64))
@@ -689,7 +847,18 @@ def _row_max_shift(x):
 
 
 def row_max_shift(x: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Each row of x (K, N) minus its maximum, as a new C-contiguous array (K, N)."""
+    """Each row of x (K, N) minus its maximum, as a new C-contiguous array (K, N).
+
+    Parameters
+    ----------
+    x : array_like of float, shape (K, N)
+        Log-weights, one row per object, N >= 1.
+
+    Returns
+    -------
+    ndarray of float64, shape (K, N)
+        ``x - x.max(axis=1, keepdims=True)``.
+    """
     return _row_max_shift(np.asarray(x, dtype=np.float64))
 
 
@@ -705,7 +874,18 @@ def _normalise_rows(e):
 
 def normalise_rows(e: NDArray[np.float64]) -> NDArray[np.float64]:
     """Each row of e (K, N) divided by its ``np.sum``; with ``row_max_shift`` and numpy's
-    exp between them, ``normalised_weights`` of every row."""
+    exp between them, ``normalised_weights`` of every row.
+
+    Parameters
+    ----------
+    e : array_like of float, shape (K, N)
+        Non-negative weights, one row per object (not checked).
+
+    Returns
+    -------
+    ndarray of float64, shape (K, N)
+        ``e / e.sum(axis=1, keepdims=True)``, to the bit.
+    """
     return _normalise_rows(np.ascontiguousarray(e, dtype=np.float64))
 
 
@@ -724,7 +904,20 @@ def _effective_uv(var, sig2):
 def effective_uv(var: NDArray[np.float64], sigma: NDArray[np.float64]) -> NDArray[np.float64]:
     """Mean over (u, v) of the effective dynamics var / σ² (1 where σ = 0), shape (K,),
     from the variances ``var`` (K, 3) and σ (3,) (``effective_dynamics(...)[:, :2]
-    .mean(axis=1)``)."""
+    .mean(axis=1)``).
+
+    Parameters
+    ----------
+    var : ndarray of float64, shape (K, 3)
+        Variance of (u, v, a) of each object over the particle set (only u and v read).
+    sigma : array_like of float, shape (3,)
+        σ of the tracking dynamics per parameter (only u and v read).
+
+    Returns
+    -------
+    ndarray of float64, shape (K,)
+        (var_u / σ_u² + var_v / σ_v²) / 2, a term being 1 where its σ is 0.
+    """
     return _effective_uv(var, np.asarray(sigma, dtype=np.float64) ** 2)
 
 
@@ -735,6 +928,20 @@ def weighted_mean_states(weights: NDArray[np.float64], particles: NDArray[np.flo
     ``weights`` is (N, K) (column k weights object k: ``(weights[:, :, None] *
     particles).sum(axis=0)``) or (N, 1), one column shared by every object; the variance
     is ``particles.var(axis=0)``.
+
+    Parameters
+    ----------
+    weights : array_like of float, shape (N, K) or (N, 1)
+        Normalised weights (not checked).
+    particles : array_like of float, shape (N, K, 3)
+        Particle states (u, v, a), N >= 1.
+
+    Returns
+    -------
+    mean : ndarray of float64, shape (K, 3)
+        Σ_n weights[n, k] particles[n, k] per object.
+    var : ndarray of float64, shape (K, 3)
+        The unweighted population variance (ddof 0) over the N particles.
     """
     return _weighted_mean_states(np.asarray(weights, dtype=np.float64),
                                  np.ascontiguousarray(particles, dtype=np.float64))

@@ -46,6 +46,20 @@ def check_ar2(sigma: object, a1: object, a2: object
               ) -> tuple[tuple[float, float, float], float, float]:
     """Validate AR2 tracking dynamics; return (σ_u, σ_v, σ_a), A1, A2 as floats.
 
+    Parameters
+    ----------
+    sigma : sequence of 3 float
+        Noise standard deviations (σ_u, σ_v, σ_a): px, px, log scale per frame.
+    a1, a2 : float
+        AR coefficients A1, A2.
+
+    Returns
+    -------
+    sigma : tuple of 3 float
+        (σ_u, σ_v, σ_a).
+    a1, a2 : float
+        A1, A2.
+
     Raises
     ------
     ValueError
@@ -87,6 +101,16 @@ def check_ar2_coefficients(a1: object, a2: object) -> tuple[float, float]:
     (``trackers.kalman.KalmanParams``), whose covariance grew without bound (NaN boxes)
     under an explosive model.
 
+    Parameters
+    ----------
+    a1, a2 : float
+        AR coefficients A1, A2 (booleans are refused).
+
+    Returns
+    -------
+    a1, a2 : float
+        A1, A2 as floats.
+
     Raises
     ------
     ValueError
@@ -123,7 +147,26 @@ def check_ar2_coefficients(a1: object, a2: object) -> tuple[float, float]:
 
 def states_from_boxes(boxes: NDArray[np.floating]) -> tuple[NDArray[np.float64],
                                                             NDArray[np.float64]]:
-    """States (K, 3) = (u, v, 0) and base sizes (K, 2) = (w0, h0) of boxes (K, 4)."""
+    """States (K, 3) = (u, v, 0) and base sizes (K, 2) = (w0, h0) of boxes (K, 4).
+
+    Parameters
+    ----------
+    boxes : array_like of float, shape (K, 4)
+        Boxes [x, y, w, h] in px (not checked).
+
+    Returns
+    -------
+    states : ndarray of float64, shape (K, 3)
+        (u, v, a) = box centre in px, log scale 0.
+    sizes : ndarray of float64, shape (K, 2)
+        Base size (w0, h0) in px, a copy of ``boxes[:, 2:4]``.
+
+    Examples
+    --------
+    >>> states, sizes = states_from_boxes(np.array([[8.0, 17.0, 4.0, 6.0]]))
+    >>> states.tolist(), sizes.tolist()
+    ([[10.0, 20.0, 0.0]], [[4.0, 6.0]])
+    """
     b = np.asarray(boxes, dtype=np.float64)
     states = np.column_stack([b[:, 0] + b[:, 2] / 2, b[:, 1] + b[:, 3] / 2,
                               np.zeros(b.shape[0])])
@@ -135,6 +178,18 @@ def boxes_from_states(states: NDArray[np.floating], sizes: NDArray[np.floating]
     """Boxes [x, y, w, h] (..., 4) of states (..., 3) with base sizes (..., 2).
 
     ``sizes`` broadcasts against ``states[..., :2]`` (e.g. (K, 2) for states (N, K, 3)).
+
+    Parameters
+    ----------
+    states : array_like of float, shape (..., 3)
+        States (u, v, a): centre in px, log scale.
+    sizes : array_like of float, shape (..., 2)
+        Base sizes (w0, h0) in px, broadcasting against ``states[..., :2]``.
+
+    Returns
+    -------
+    ndarray of float64, shape (..., 4)
+        Boxes [u - w/2, v - h/2, w, h] with (w, h) = (w0, h0) exp(a), in px.
 
     Examples
     --------

@@ -59,10 +59,25 @@ def orderings(n_objects: int) -> NDArray[np.int16]:
     Row ``j`` lists object indices nearest first; rows are in lexicographic order, so
     row 0 is the identity (object 0 in front).
 
+    Parameters
+    ----------
+    n_objects : int
+        Number of objects n, in [1, ``MAX_OBJECTS``].
+
+    Returns
+    -------
+    ndarray of int16, shape (n!, n)
+        One ordering per row.
+
     Raises
     ------
     ValueError
         If ``n_objects`` is below 1 or above ``MAX_OBJECTS``.
+
+    Examples
+    --------
+    >>> orderings(3).tolist()
+    [[0, 1, 2], [0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]]
     """
     if n_objects < 1:
         raise ValueError(f"need at least 1 object for depth orderings, got {n_objects}")
@@ -303,10 +318,24 @@ def check_matcher_params(
 ) -> None:
     """Validate the matcher's parameters (shared by the trackers' constructors).
 
+    Parameters
+    ----------
+    search_radius : int
+        Half-size of the search window, in [1, 200] px.
+    step : int
+        Coarse-to-fine stride, in [1, 8].
+    min_visible : float
+        Smallest visible fraction of a support, in (0, 1].
+    support : {"box", "ellipse"}
+        Template support.
+    blur : float
+        Std of the Gaussian pre-smoothing, in [0, 20] px.
+
     Raises
     ------
     ValueError
-        Naming the first bad value.
+        Naming the first bad value (``search_radius`` and ``step`` must be ints, not
+        integral floats; booleans and non-finite numbers are refused).
     """
     if not isinstance(search_radius, (int, np.integer)) or not 1 <= search_radius <= 200:
         raise ValueError(f"search_radius must be an int in [1, 200], got {search_radius!r}")

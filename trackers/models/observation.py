@@ -95,7 +95,14 @@ __all__ = [
 
 @runtime_checkable
 class FrameLikelihood(Protocol):
-    """One frame seen by an observation model (module docstring: the protocol)."""
+    """One frame seen by an observation model (module docstring: the protocol).
+
+    Parameters
+    ----------
+    *args, **kwargs : Any
+        None accepted: ``typing.Protocol`` refuses to instantiate a protocol (TypeError);
+        it is checked with ``isinstance``.
+    """
 
     def log_likelihoods(self, boxes: NDArray[np.floating], objects: NDArray[np.integer]
                         ) -> NDArray[np.float64]:
@@ -105,7 +112,14 @@ class FrameLikelihood(Protocol):
 
 @runtime_checkable
 class ObservationModel(Protocol):
-    """What the particle filters' ``observation`` keyword takes (module docstring)."""
+    """What the particle filters' ``observation`` keyword takes (module docstring).
+
+    Parameters
+    ----------
+    *args, **kwargs : Any
+        None accepted: ``typing.Protocol`` refuses to instantiate a protocol (TypeError);
+        it is checked with ``isinstance``.
+    """
 
     def set_references(self, frame: NDArray[np.uint8], boxes: NDArray[np.floating]) -> None:
         """Initialise on the first frame (H, W, 3) with the objects' boxes (K, 4)."""

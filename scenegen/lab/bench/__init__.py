@@ -30,7 +30,23 @@ MODULES = (
 def run_all(
     repeats: int = 5, *, only: str | None = None, log: Callable[[str], None] | None = None
 ) -> list[BenchRow]:
-    """Run every module's rows (or those whose module name contains ``only``)."""
+    """Run every module's rows (or those whose module name contains ``only``).
+
+    Parameters
+    ----------
+    repeats : int, default 5
+        Timings per figure, passed to each module's ``run``.
+    only : str, optional
+        Run only the modules of :data:`MODULES` whose name contains this substring
+        (None or "": all of them).
+    log : callable, optional
+        Called with one progress line (``"bench: <module> ..."``) before each module.
+
+    Returns
+    -------
+    list of BenchRow
+        The rows of the modules run, in the order of :data:`MODULES`.
+    """
     rows: list[BenchRow] = []
     for name in MODULES:
         if only and only not in name:

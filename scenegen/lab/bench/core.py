@@ -58,7 +58,23 @@ class BenchRow:
 
 
 def median_time(fn: Callable[[], object], repeats: int, *, warmup: int = 1) -> float:
-    """Median wall time of ``fn()`` over ``repeats`` calls, after ``warmup`` untimed calls."""
+    """Median wall time of ``fn()`` over ``repeats`` calls, after ``warmup`` untimed calls.
+
+    Parameters
+    ----------
+    fn : callable
+        The work to time, called with no arguments; its result is discarded.
+    repeats : int
+        Number of timed calls (at least one is made whatever the value).
+    warmup : int, default 1
+        Untimed calls made first (compilation, caches).
+
+    Returns
+    -------
+    float
+        The median of the timed calls, in seconds (``time.perf_counter``); the mean of
+        the two middle ones for an even count.
+    """
     for _ in range(warmup):
         fn()
     times = []

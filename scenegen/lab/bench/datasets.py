@@ -43,7 +43,25 @@ def _inv(rate: float) -> float:
 
 
 def measure(variant: str, folder: Path, **executor: Any) -> dict[str, float]:
-    """Build the bench dataset once; its end-to-end and steady-state rates (sequences/s)."""
+    """Build the bench dataset once; its end-to-end and steady-state rates (sequences/min).
+
+    Parameters
+    ----------
+    variant : str
+        Name of the variant: the dataset is built into ``folder / variant``.
+    folder : pathlib.Path
+        Parent folder of the build (a fresh, temporary one).
+    **executor : Any
+        Passed to ``build_dataset`` (``jobs=``, ``scheduler=``).
+
+    Returns
+    -------
+    dict of str to float
+        ``"wall"``: the build's wall time (s); ``"rate"``: end-to-end sequences per
+        minute; ``"steady"``: steady-state sequences per minute (NaN when no worker made
+        two shards); ``"rss"``: the largest peak resident memory of a worker (MiB);
+        ``"cpu"``: CPU seconds per sequence.
+    """
     from scenegen.datasets import build_dataset
 
     results: list[tuple[float, dict[str, Any]]] = []
@@ -60,6 +78,20 @@ def measure(variant: str, folder: Path, **executor: Any) -> dict[str, float]:
 
 
 def run(repeats: int = 5) -> list[BenchRow]:
+    """All rows of this module: one build per variant (1 and 2 local workers, Dask).
+
+    Parameters
+    ----------
+    repeats : int, default 5
+        Ignored: each variant is built once (a build takes seconds).
+
+    Returns
+    -------
+    list of BenchRow
+        End-to-end and steady-state rates (seq/min) of each variant, with ratios against
+        one local worker; CPU time per sequence of each variant; the peak memory of a
+        worker (MiB).
+    """
     import distributed
 
     with tempfile.TemporaryDirectory() as d:

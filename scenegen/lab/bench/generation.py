@@ -23,7 +23,20 @@ __all__ = ["numpy_render", "realistic_rows", "run", "sizes"]
 
 
 def numpy_render(scn) -> np.ndarray:
-    """Reference compositor in plain numpy: every entity, every frame, back to front."""
+    """Reference compositor in plain numpy: every entity, every frame, back to front.
+
+    Parameters
+    ----------
+    scn : scenegen.render.plan.Scenario
+        A planned scenario (:func:`scenegen.render.plan.plan`): its background,
+        templates, centres, depths and liveness are used; photometric effects are not.
+
+    Returns
+    -------
+    ndarray of uint8, shape (T, H, W, 3)
+        The frames, each template pasted at its rounded position where its alpha is
+        non-zero.
+    """
     t_n, k_n = scn.cx.shape
     h, w = scn.config.height, scn.config.width
     out = np.empty((t_n, h, w, 3), dtype=np.uint8)
@@ -48,6 +61,20 @@ def numpy_render(scn) -> np.ndarray:
 
 
 def run(repeats: int = 5) -> list[BenchRow]:
+    """All rows of this module; every figure is a median over ``repeats`` timings.
+
+    Parameters
+    ----------
+    repeats : int, default 5
+        Timings per figure (the baselines and HDF5 writes use ``max(1, repeats // 2)``).
+
+    Returns
+    -------
+    list of BenchRow
+        Generation of ``kams-d`` and ``dps-synthetic`` against :func:`numpy_render`, the
+        rows of :func:`realistic_rows`, and writing ``kams-d`` with each compression
+        against plain h5py, all in frames/s.
+    """
     rows: list[BenchRow] = []
     for preset, goal in (("kams-d", 2000.0), ("dps-synthetic", 1000.0)):
         t_n = presets.get(preset).n_frames
@@ -104,7 +131,19 @@ def run(repeats: int = 5) -> list[BenchRow]:
 def realistic_rows(repeats: int = 5) -> list[BenchRow]:
     """The realistic preset ``tiger-like`` (320x240: textured target and clutter, camera
     pan, motion blur, JPEG) beside the flat ``kams-d`` at the same size, OpenCV on one
-    thread: the ratio says what realism costs on the same machine in the same run."""
+    thread: the ratio says what realism costs on the same machine in the same run.
+
+    Parameters
+    ----------
+    repeats : int, default 5
+        Timings per figure.
+
+    Returns
+    -------
+    list of BenchRow
+        Frames/s of ``kams-d`` (the baseline), ``tiger-like`` (goal >= 500 frames/s) and
+        ``tiger-like`` without JPEG, with ratios against the baseline.
+    """
     flat = presets.get("kams-d")
     real = presets.get("tiger-like")
     assert real.photometric is not None
@@ -140,7 +179,18 @@ def realistic_rows(repeats: int = 5) -> list[BenchRow]:
 
 
 def sizes() -> list[dict[str, object]]:
-    """Stored size of frames and labels per compression, for a noisy and a clean preset."""
+    """Stored size of frames and labels per compression, for a noisy and a clean preset.
+
+    The presets are ``dps-synthetic``, ``kams-d`` and ``shm-crossing`` (seed 0), each
+    written once per compression of :data:`scenegen.io.COMPRESSIONS` into a temporary
+    folder.
+
+    Returns
+    -------
+    list of dict
+        One per preset and compression: ``"preset"``, ``"compression"``, and
+        ``"frames_ratio"``, ``"labels_ratio"`` (raw bytes / stored bytes).
+    """
     out = []
     with tempfile.TemporaryDirectory() as d:
         for preset in ("dps-synthetic", "kams-d", "shm-crossing"):

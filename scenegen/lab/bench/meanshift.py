@@ -102,5 +102,18 @@ def _kams_rows(repeats: int) -> list[BenchRow]:
 
 
 def run(repeats: int = 5) -> list[BenchRow]:
-    """All rows of this module; every figure is a median over ``repeats`` timings."""
+    """All rows of this module; every figure is a median over ``repeats`` timings.
+
+    Parameters
+    ----------
+    repeats : int, default 5
+        Timings per figure.
+
+    Returns
+    -------
+    list of BenchRow
+        One mean-shift iteration (``cv2.meanShift`` baseline, ours per call, ours per
+        window in a batch), in iterations/s; whole ``kams`` steps on kams-a and kams-d,
+        in frames/s.
+    """
     return _iteration_rows(repeats) + _kams_rows(repeats)

@@ -251,7 +251,19 @@ def _against_cv2(likelihood: list[BenchRow], steps: list[BenchRow]) -> list[Benc
 
 
 def run(repeats: int = 5) -> list[BenchRow]:
-    """All rows of this module; every figure is a median over ``repeats`` timings."""
+    """All rows of this module; every figure is a median over ``repeats`` timings.
+
+    Parameters
+    ----------
+    repeats : int, default 5
+        Timings per figure.
+
+    Returns
+    -------
+    list of BenchRow
+        The likelihood-stage rows (RGB and HSV models, boxes/s), the tracker-step rows
+        (frames/s), and each step against the per-patch cv2 loop of the HSV group.
+    """
     likelihood = _likelihood_rows(repeats)
     steps = _step_rows(repeats)
     return likelihood + steps + _against_cv2(likelihood, steps)

@@ -80,7 +80,20 @@ def _points(rows: list[BenchRow], axis: str, kernel: str) -> list[tuple[float, f
 
 
 def exponents(rows: list[BenchRow]) -> dict[tuple[str, str], float]:
-    """Fitted exponent b of cost ∝ x^b per (axis, kernel), from this module's rows."""
+    """Fitted exponent b of cost ∝ x^b per (axis, kernel), from this module's rows.
+
+    Parameters
+    ----------
+    rows : list of BenchRow
+        Rows of :func:`run`; those with ``params`` ``"axis"``, ``"kernel"`` and ``"x"``
+        are used, the others ignored.
+
+    Returns
+    -------
+    dict of (str, str) to float
+        The least-squares slope of log seconds against log x, per (axis, kernel) with at
+        least two points (x: particles per object, objects, or frame area in pixels).
+    """
     out = {}
     for axis in AXES:
         for kernel in _KERNELS:
@@ -92,7 +105,20 @@ def exponents(rows: list[BenchRow]) -> dict[tuple[str, str], float]:
 
 
 def run(repeats: int = 5) -> list[BenchRow]:
-    """One row per (axis, value, kernel), then one row per fitted exponent."""
+    """One row per (axis, value, kernel), then one row per fitted exponent.
+
+    Parameters
+    ----------
+    repeats : int, default 5
+        Timings per figure, clipped to 1..3 (the sweep is long).
+
+    Returns
+    -------
+    list of BenchRow
+        Seconds per ``dps`` step (frames/s as the rate) for each value of :data:`AXES`
+        and each kernel, ``params`` giving the axis, kernel and x; then the fitted
+        exponents of :func:`exponents` (unit ``"exponent"``, seconds 0).
+    """
     rows: list[BenchRow] = []
     repeats = max(1, min(repeats, 3))  # the sweep is long; medians of 3 suffice here
     for axis, values in AXES.items():
@@ -117,7 +143,20 @@ def run(repeats: int = 5) -> list[BenchRow]:
 
 
 def write_figure(rows: list[BenchRow], path: str | Path) -> Path:
-    """A PNG with one log-log panel per axis (both kernels, fitted exponents in the legend)."""
+    """A PNG with one log-log panel per axis (both kernels, fitted exponents in the legend).
+
+    Parameters
+    ----------
+    rows : list of BenchRow
+        Rows of :func:`run` (the sweep rows are plotted, in ms per step).
+    path : str or pathlib.Path
+        The PNG to write (atomically); missing parent folders are created.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+    """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 

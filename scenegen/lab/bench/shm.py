@@ -20,6 +20,19 @@ GOAL_FPS = 200.0
 
 
 def run(repeats: int = 5) -> list[BenchRow]:
+    """All rows of this module; every figure is a median over ``repeats`` timings.
+
+    Parameters
+    ----------
+    repeats : int, default 5
+        Timed runs of each tracker over the whole sequence.
+
+    Returns
+    -------
+    list of BenchRow
+        Frames/s of ``kalman`` (the baseline), ``shm``, ``shm-fast`` (goal
+        :data:`GOAL_FPS`) and ``shm-fast`` with ``step=1``, ratios against the baseline.
+    """
     import trackers
 
     seq = generate("shm-crossing", seed=0)

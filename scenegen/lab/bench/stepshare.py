@@ -7,7 +7,7 @@ in compiled stages called from Python: docs/algorithms.md, implementation notes)
 row times whole steps over the sequence and, in the same steps, the time spent inside the
 histogram stage, as CPU time of the calling thread on one numba thread (so a loaded
 machine's waiting does not count, and every kernel runs on the timed thread); the row's
-``ratio`` is step / histogram stage, its name gives the non-histogram share
+``ratio`` is histogram stage / step, its name gives the non-histogram share
 1 − histogram / step. Goal: ``dps`` at most 0.15.
 
 Particle filters with 7 objects x 300 particles on dps-synthetic (360x288, 24 steps);
@@ -74,7 +74,25 @@ def histogram_clock() -> Iterator[list[float]]:
 
 def step_split(name: str, preset: str, params: dict, repeats: int) -> tuple[float, float]:
     """(step, histogram stage) CPU seconds per step of ``name`` on ``preset`` (seed 0), the
-    median run of ``repeats`` (after one untimed run), on one numba thread."""
+    median run of ``repeats`` (after one untimed run), on one numba thread.
+
+    Parameters
+    ----------
+    name : str
+        Registered tracker name (``trackers.make``), built with ``rng=0``.
+    preset : str
+        Preset whose sequence is tracked from the ground-truth boxes of its targets.
+    params : dict
+        Keyword arguments of the tracker.
+    repeats : int
+        Timed runs (at least one); the run of median total time is kept.
+
+    Returns
+    -------
+    step, histogram : float
+        Thread CPU seconds per step: whole step, and inside the histogram stage
+        (:func:`histogram_clock`).
+    """
     seq = generate(preset, seed=0)
     frames = np.asarray(seq.frames)
     init = np.asarray(seq.gt.box[0, seq.target_indices()], dtype=np.float64)
@@ -97,7 +115,20 @@ def step_split(name: str, preset: str, params: dict, repeats: int) -> tuple[floa
 
 
 def run(repeats: int = 5) -> list[BenchRow]:
-    """One row per tracker of ``TRACKERS``."""
+    """One row per tracker of ``TRACKERS``.
+
+    Parameters
+    ----------
+    repeats : int, default 5
+        Timed runs per tracker (:func:`step_split`).
+
+    Returns
+    -------
+    list of BenchRow
+        Per tracker: seconds per step, ``ratio`` = histogram stage / step, and in
+        ``params`` the tracker, ``"histogram_seconds"`` and the non-histogram
+        ``"share"``; goal for ``dps``: share <= 0.15.
+    """
     group = "tracker step against its own histogram stage (CPU time, 1 thread)"
     rows = []
     for name, preset, params in TRACKERS:

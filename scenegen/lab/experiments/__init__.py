@@ -106,6 +106,23 @@ def results_document(exp: Experiment, records: list[dict[str, Any]]) -> dict[str
     Everything in it derives from the records: S, R, the base seed and the quick flag from
     their keys, the summary from their measures, and the ``records`` listing (every run
     file with its digest), so ``scenegen validate DIR`` can compute it again.
+
+    Parameters
+    ----------
+    exp : Experiment
+        The experiment the runs belong to.
+    records : list of dict
+        The run records of one sweep (non-empty), in run order, without digest.
+
+    Returns
+    -------
+    dict
+        ``experiment``, ``title``, ``runs``, ``scenes``, ``indicative`` (quick mode or
+        fewer runs x scenes than the experiment's), ``seed``, ``quick``, ``presets``,
+        ``sweep``, ``methods`` (those run), the summary's keys
+        (:func:`~scenegen.lab.experiments.summary.summarize`), :data:`RECORDS`,
+        :data:`WRITTEN_BY`, and ``overrides`` when the runs had any; floats rounded to
+        :data:`RESULT_DECIMALS` decimals, NaN and inf as None.
     """
     keys = [r["key"] for r in records]
     r, s, seed, quick = sweep_of(keys)

@@ -58,6 +58,7 @@ class Experiment:
     presets : tuple of str
         Sequence presets.
     methods : tuple of Method
+        The compared methods (the table's columns).
     sweep : tuple of (str, tuple)
         At most one swept tracker parameter and its values (e.g. λ for DPS); empty for
         none. Every method runs at every value.
@@ -336,12 +337,33 @@ PAPER: dict[str, Any] = {
 
 
 def names() -> list[str]:
-    """The experiment names: the contract's five in its order, then ``dps-dancers``."""
+    """The experiment names: the contract's five in its order, then ``dps-dancers``.
+
+    Returns
+    -------
+    list of str
+        The keys of :data:`EXPERIMENTS`, in order.
+
+    Examples
+    --------
+    >>> names()[-1]
+    'dps-dancers'
+    """
     return list(EXPERIMENTS)
 
 
 def get(name: str) -> Experiment:
     """The experiment called ``name``.
+
+    Parameters
+    ----------
+    name : str
+        One of :func:`names`.
+
+    Returns
+    -------
+    Experiment
+        Its definition in :data:`EXPERIMENTS`.
 
     Raises
     ------

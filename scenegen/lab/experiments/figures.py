@@ -248,7 +248,25 @@ def _shm_depth(res: dict[str, Any], out: Path, records: list[dict[str, Any]]) ->
 
 def write_figures(name: str, results: dict[str, Any], records: list[dict[str, Any]],
                   out: Path) -> list[str]:
-    """Write the PNG figures of experiment ``name`` into ``out``; return their file names."""
+    """Write the PNG figures of experiment ``name`` into ``out``; return their file names.
+
+    Parameters
+    ----------
+    name : str
+        The experiment (:func:`scenegen.lab.experiments.definitions.names`); a name other
+        than the DPS and KAMS ones gets the SHM depth-ordering figure.
+    results : dict
+        The experiment's summary, as written to ``results.json``.
+    records : list of dict
+        The run records (used by the SHM figure only).
+    out : pathlib.Path
+        The output folder; each figure is written atomically.
+
+    Returns
+    -------
+    list of str
+        The file names written (e.g. ``"success_recovery.png"``), relative to ``out``.
+    """
     if name == "dps-synthetic":
         return _dps_synthetic(results, out)
     if name in ("dps-occlusion", "dps-dancers"):

@@ -83,7 +83,13 @@ _warned: set[str] = set()
 
 def warn(line: str) -> None:
     """Print one warning line on stderr (once per process: a resumed sweep may look at a
-    damaged record both when it plans its tasks and when it collects them)."""
+    damaged record both when it plans its tasks and when it collects them).
+
+    Parameters
+    ----------
+    line : str
+        The warning, printed after ``"scenegen: warning: "``.
+    """
     if line in _warned:
         return
     _warned.add(line)
@@ -91,7 +97,20 @@ def warn(line: str) -> None:
 
 
 def write_record(path: Path, record: dict[str, Any]) -> str:
-    """Write a run record sealed and atomically (creating ``runs/``); return its digest."""
+    """Write a run record sealed and atomically (creating ``runs/``); return its digest.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The run file (``DIR/runs/NAME.json``); missing parent folders are created.
+    record : dict
+        The run record (JSON-ready).
+
+    Returns
+    -------
+    str
+        The SHA-256 of its canonical content (hex), the digest stored in the file.
+    """
     return write_sealed_json(path, record, parents=True)
 
 
@@ -111,7 +130,21 @@ def _numbers(x: Any, allow_bool: bool = True) -> bool:
 
 
 def record_problems(data: Any) -> list[str]:
-    """What is wrong with the fields of a run record (empty when none is)."""
+    """What is wrong with the fields of a run record (empty when none is).
+
+    Parameters
+    ----------
+    data : Any
+        A parsed run record (without its digest).
+
+    Returns
+    -------
+    list of str
+        One line per problem: not an object, a ``key`` that is not a
+        :class:`~scenegen.lab.experiments.runner.Task`'s, a missing or mistyped field, a
+        target whose per-frame lists are not ``n_frames`` numbers, a non-numeric
+        diagnostic, no ``failure_threshold``.
+    """
     from scenegen.lab.experiments.runner import Task
 
     if not isinstance(data, dict):
@@ -158,6 +191,16 @@ def record_problems(data: Any) -> list[str]:
 def read_record(path: Path) -> dict[str, Any]:
     """The run record at ``path`` (without its digest).
 
+    Parameters
+    ----------
+    path : pathlib.Path
+        A sealed run file (``DIR/runs/NAME.json``).
+
+    Returns
+    -------
+    dict
+        The record's content, checked by :func:`record_problems`.
+
     Raises
     ------
     DataError
@@ -171,7 +214,28 @@ def read_checked(path: Path, problems_of: Callable[[Any], list[str]], what: str
                  ) -> dict[str, Any]:  # fmt: skip
     """The sealed document at ``path`` (without its digest) when ``problems_of`` finds
     nothing wrong with its content, else one DataError line: ``PATH: not WHAT (the first
-    problem)``; as :func:`scenegen.io.sealed.read_sealed_json` for a damaged file."""
+    problem)``; as :func:`scenegen.io.sealed.read_sealed_json` for a damaged file.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        A sealed JSON document.
+    problems_of : callable
+        Takes the content, returns the list of its problems (empty when sound).
+    what : str
+        What the document should be, for the error line (``"a run record"``).
+
+    Returns
+    -------
+    dict
+        The content, without its digest.
+
+    Raises
+    ------
+    DataError
+        Missing, unreadable, damaged or edited, unsealed
+        (:class:`scenegen.io.sealed.Unsealed`), or a content with a problem.
+    """
     data = read_sealed_json(path)
     problems = problems_of(data)
     if problems:
@@ -180,7 +244,19 @@ def read_checked(path: Path, problems_of: Callable[[Any], list[str]], what: str
 
 
 def listing(records: list[dict[str, Any]]) -> list[str]:
-    """The :data:`RECORDS` entry of ``results.json`` for ``records`` (in run order)."""
+    """The :data:`RECORDS` entry of ``results.json`` for ``records`` (in run order).
+
+    Parameters
+    ----------
+    records : list of dict
+        Run records, without digest.
+
+    Returns
+    -------
+    list of str
+        ``"NAME SHA256"`` per record: its run file name and the SHA-256 of its canonical
+        content.
+    """
     from scenegen.lab.experiments.runner import Task
 
     return [f"{Task(**r['key']).filename()} {content_digest(r)}" for r in records]
@@ -192,7 +268,25 @@ def _entries(results: dict[str, Any]) -> list[tuple[str, str]] | None:
 
 def parse_listing(entries: Any) -> list[tuple[str, str]] | None:
     """``[(NAME, SHA256), ...]`` of a :data:`RECORDS` listing, or None when it is not a
-    non-empty list of ``"NAME SHA256"`` strings."""
+    non-empty list of ``"NAME SHA256"`` strings.
+
+    Parameters
+    ----------
+    entries : Any
+        The listing as read (the digest is the last word; a name may hold spaces).
+
+    Returns
+    -------
+    list of (str, str) or None
+        The name and the 64-hex-digit digest of each entry, in order.
+
+    Examples
+    --------
+    >>> parse_listing(["a b.json " + "0" * 64])[0][0]
+    'a b.json'
+    >>> parse_listing([]) is None
+    True
+    """
     if not isinstance(entries, list) or not entries:
         return None
     out = []
@@ -217,7 +311,22 @@ def _listed(path: Path, version: tuple[int, int, int]) -> tuple[int, bool, dict[
 
 def listed_digest(record_path: Path, seed: int, quick: bool) -> str | None:
     """The digest that ``DIR/results.json`` lists for the run file ``DIR/runs/NAME``, or
-    None (no sound ``results.json`` of that base seed and mode, or the run not listed)."""
+    None (no sound ``results.json`` of that base seed and mode, or the run not listed).
+
+    Parameters
+    ----------
+    record_path : pathlib.Path
+        The run file, ``DIR/runs/NAME``.
+    seed : int
+        The sweep's base seed.
+    quick : bool
+        The sweep's quick flag.
+
+    Returns
+    -------
+    str or None
+        The listed SHA-256 (hex).
+    """
     res = record_path.parent.parent / "results.json"
     try:
         st = res.stat()
@@ -306,7 +415,19 @@ def written_by() -> dict[str, str]:
 
 def versions_text(who: dict[str, str]) -> str:
     """A :data:`WRITTEN_BY` entry as a phrase, ``"scenegen 0.1.0, python 3.11.7, ..."``, in
-    :func:`written_by`'s order whatever the file's key order (sealed files sort keys)."""
+    :func:`written_by`'s order whatever the file's key order (sealed files sort keys).
+
+    Parameters
+    ----------
+    who : dict of str to str
+        Software name -> version; names :func:`written_by` does not give come last, by
+        name.
+
+    Returns
+    -------
+    str
+        ``"NAME VERSION"`` per entry, joined by ``", "``.
+    """
     known = [name for name, _ in _versions()]
     order = sorted(who, key=lambda k: (known.index(k) if k in known else len(known), k))
     return ", ".join(f"{k} {who[k]}" for k in order)
@@ -323,7 +444,15 @@ def _version_change(then: Any, now: dict[str, str]) -> str:
 
 
 def write_results(path: Path, results: dict[str, Any]) -> None:
-    """Write ``results.json`` sealed and atomically (indented: users read it)."""
+    """Write ``results.json`` sealed and atomically (indented: users read it).
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The file to write.
+    results : dict
+        The experiment's results (JSON-ready).
+    """
     write_sealed_json(path, results, indent=1)
 
 
@@ -333,8 +462,16 @@ def read_results(path: Path, name: str | None = None) -> dict[str, Any]:
     Parameters
     ----------
     path : Path
+        The ``results.json`` file.
     name : str, optional
         The experiment it must belong to.
+
+    Returns
+    -------
+    dict
+        Its content: a known ``experiment``, ``runs``, ``scenes``, ``seed``, ``quick``,
+        ``indicative``, ``claims`` (each with a verdict), ``summary``, a :data:`RECORDS`
+        listing, and :data:`WRITTEN_BY` when present.
 
     Raises
     ------
@@ -387,7 +524,21 @@ def _more(problems: list[str]) -> list[str]:
 
 
 def sweep_of(keys: list[dict[str, Any]]) -> tuple[int, int, int, bool]:
-    """R, S, the base seed and the quick flag of a sweep, from its runs' ``key``s."""
+    """R, S, the base seed and the quick flag of a sweep, from its runs' ``key``s.
+
+    Parameters
+    ----------
+    keys : list of dict
+        The ``key`` of each run record (non-empty); the seed and quick flag are the
+        first one's.
+
+    Returns
+    -------
+    runs, scenes, seed : int
+        The largest ``run`` + 1, the largest ``scene`` + 1, the base seed.
+    quick : bool
+        The quick flag.
+    """
     runs = max(k["run"] for k in keys) + 1
     scenes = max(k["scene"] for k in keys) + 1
     return runs, scenes, int(keys[0]["seed"]), bool(keys[0]["quick"])
@@ -598,7 +749,22 @@ def check_report(folder: str | Path,
     """Check a report folder (``scenegen experiment all -o DIR``): every experiment in
     ``DIR/experiments/`` (:func:`check_experiment`) and ``DIR/results.json``, which must
     hold exactly their results; and, given ``index_problem`` (what is wrong with
-    ``DIR/index.html``, or None: :func:`scenegen.lab.report.index_problem`), the page."""
+    ``DIR/index.html``, or None: :func:`scenegen.lab.report.index_problem`), the page.
+
+    Parameters
+    ----------
+    folder : str or pathlib.Path
+        The report folder.
+    index_problem : callable, optional
+        Takes the folder, returns what is wrong with its ``index.html`` (``"stale"`` for
+        a page that is not this folder's report) or None; None: the page is not checked.
+
+    Returns
+    -------
+    list of str
+        One line per problem, naming the file at fault (with the command that writes it
+        again when one command can); empty when the folder is sound.
+    """
     from scenegen.lab.experiments.definitions import names
 
     root = Path(folder)
@@ -639,5 +805,16 @@ def check_report(folder: str | Path,
 
 
 def report_entry(results: dict[str, Any]) -> dict[str, Any]:
-    """An experiment's results as the report's ``results.json`` holds them (no listing)."""
+    """An experiment's results as the report's ``results.json`` holds them (no listing).
+
+    Parameters
+    ----------
+    results : dict
+        The content of an experiment's ``results.json``.
+
+    Returns
+    -------
+    dict
+        A copy without the :data:`RECORDS` key.
+    """
     return {k: v for k, v in results.items() if k != RECORDS}

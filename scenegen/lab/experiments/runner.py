@@ -59,6 +59,17 @@ def derive_seed(*parts: Any) -> int:
 
     The parts are joined as text, hashed with SHA-256 and fed to ``np.random.SeedSequence``.
 
+    Parameters
+    ----------
+    *parts : Any
+        The key; each part is taken as ``str(part)``, so ``1`` and ``"1"`` give the same
+        seed.
+
+    Returns
+    -------
+    int
+        A seed in [0, 2**63).
+
     Examples
     --------
     >>> derive_seed("dps-synthetic", "dps", "lam=20.0", 3) == derive_seed(
@@ -171,12 +182,36 @@ def plan_tasks(
     ``overrides`` (tracker parameter -> value) is set on every chosen method's tracker
     (see ``Task.overrides``); each method's tracker must accept it with that value.
 
+    Parameters
+    ----------
+    exp : Experiment
+        The experiment.
+    runs : int
+        Tracker runs R per scene (>= 1).
+    scenes : int, optional
+        Scenes S per preset (>= 1); default the experiment's.
+    seed : int
+        Base seed (>= 0).
+    quick : bool
+        Scaled-down mode; without ``values``, the quick sweep values.
+    methods : iterable of str, optional
+        Method slugs or labels, each at most once (default all).
+    values : iterable of float, optional
+        Values of the swept parameter, from the full sweep (default all).
+    overrides : dict, optional
+        Tracker parameter -> value, set on every chosen method.
+
+    Returns
+    -------
+    list of Task
+        Ordered by method, swept value, preset, scene, then run.
+
     Raises
     ------
     ConfigError
-        For runs or scenes < 1, a negative seed, an unknown method or a value outside the sweep
-        (listing the valid ones), or an override that a chosen method's tracker does not
-        accept (naming the method).
+        For runs or scenes < 1, a negative seed, an unknown method, a method given twice,
+        or a value outside the sweep (listing the valid ones), or an override that a chosen
+        method's tracker does not accept (naming the method).
     """
     if runs < 1:
         raise ConfigError(f"runs must be >= 1, got {runs}")
@@ -283,7 +318,24 @@ def _round(x: Any) -> Any:
 
 
 def tracker_params(exp: Experiment, task: Task) -> dict[str, Any]:
-    """The keyword parameters of the task's tracker (without ``rng``)."""
+    """The keyword parameters of the task's tracker (without ``rng``).
+
+    The method's own parameters, then the swept value, then in quick mode
+    ``n_particles`` capped at the experiment's ``quick_particles``, then the task's
+    overrides (which win over the cap).
+
+    Parameters
+    ----------
+    exp : Experiment
+        The task's experiment.
+    task : Task
+        The run.
+
+    Returns
+    -------
+    dict
+        Parameter name -> value.
+    """
     params = exp.method(task.method).param_dict()
     if task.param:
         params[task.param] = task.value
@@ -312,6 +364,20 @@ def run_task(task: Task) -> dict[str, Any]:
     uniqueness and effective dynamics per target, SHM trackers the ordering probabilities,
     the true ordering per frame and the depth-order accuracy. Numba kernels run on one
     thread here, so results do not depend on the executor.
+
+    Parameters
+    ----------
+    task : Task
+        The run; its sequence is generated from its scene seed (cached per process).
+
+    Returns
+    -------
+    dict
+        ``key``, ``tracker``, ``params``, ``scene_seed``, ``scene_digest``,
+        ``tracker_seed``, ``n_frames``, ``failure_threshold`` and ``targets`` (per target:
+        ``name`` and per-frame lists of length ``n_frames``: ``state``, ``precision``,
+        ``recall``, ``iou``, ``centre_error`` in px, and ``path_error`` in px when the
+        sequence has a noise-free path); plus the tracker's diagnostics named above.
     """
     from scenegen.evaluation import metrics
     from scenegen.evaluation.evaluate import failure_threshold, frame_measures
@@ -391,6 +457,15 @@ def write_json_atomic(path: Path, data: Any, *, indent: int | None = None) -> No
 
     Uses :func:`scenegen.io.atomic.write_json`: a temporary file in the same folder,
     flushed and renamed into place, so a killed process never leaves a half-written file.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The file to write; missing parent folders are created.
+    data : Any
+        A JSON-serialisable value.
+    indent : int, optional
+        Indentation of the JSON text (None: compact).
     """
     from scenegen.io.atomic import write_json
 
@@ -409,6 +484,18 @@ def load_record(path: Path, task: Task) -> dict[str, Any] | None:
     sound, fresh record that the folder's ``results.json`` (of the same seed and mode)
     lists with another digest was edited (its digest recomputed) or replaced after the
     results were computed: it is computed again, with a warning.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The task's run file, ``DIR/runs/`` + :meth:`Task.filename`.
+    task : Task
+        The run looked for.
+
+    Returns
+    -------
+    dict or None
+        The stored record (without its digest), or None to compute the run.
     """
     from scenegen.errors import DataError
     from scenegen.io.sealed import content_digest
@@ -458,6 +545,7 @@ def execute(
     Parameters
     ----------
     tasks : list of Task
+        The runs to do (:func:`plan_tasks`).
     runs_dir : Path
         One JSON file per finished run; existing valid files are reused, not rerun.
     jobs : int or None
@@ -539,6 +627,23 @@ def batches(tasks: list[Task], size: int = BATCH) -> list[list[Task]]:
     ``size``: a worker running a chunk generates its sequence once (and keeps the last few
     in memory, so the next chunk of the same scene reuses it).
 
+    Parameters
+    ----------
+    tasks : list of Task
+        The tasks; a scene is (experiment, preset, scene, seed, quick).
+    size : int, default BATCH
+        Most tasks per chunk (>= 1).
+
+    Returns
+    -------
+    list of list of Task
+        The chunks, each of one scene, in the order of ``tasks`` within it.
+
+    Raises
+    ------
+    ConfigError
+        For ``size`` < 1.
+
     Examples
     --------
     >>> from scenegen.lab.experiments.definitions import get
@@ -555,7 +660,18 @@ def batches(tasks: list[Task], size: int = BATCH) -> list[list[Task]]:
 
 
 def run_batch(tasks: list[Task]) -> list[dict[str, Any]]:
-    """:func:`run_task` of each task, in order (what a local worker runs per call)."""
+    """:func:`run_task` of each task, in order (what a local worker runs per call).
+
+    Parameters
+    ----------
+    tasks : list of Task
+        Usually one chunk of :func:`batches`.
+
+    Returns
+    -------
+    list of dict
+        The records, in the order of ``tasks``.
+    """
     return [run_task(t) for t in tasks]
 
 
@@ -577,6 +693,19 @@ def workers(jobs: int | None = None, scheduler: str | None = None) -> Workers:
 
     Records are the same as without the block (each task derives its seeds from its key).
 
+    Parameters
+    ----------
+    jobs : int, optional
+        Local worker processes (None: all cores; 1 runs in this process).
+    scheduler : str, optional
+        Address of a ``dask.distributed`` scheduler (connected when the block starts).
+
+    Returns
+    -------
+    Workers
+        To use in a ``with`` block; an :func:`execute` inside it with the same ``jobs``
+        and ``scheduler`` runs on them.
+
     Raises
     ------
     ConfigError
@@ -593,6 +722,17 @@ class Workers:
     Local workers run :data:`BATCH` tasks of one scene per call (:func:`batches`); a Dask
     client gets one task per call (retried up to 3 times if its worker is lost). Use
     :func:`workers`.
+
+    Parameters
+    ----------
+    jobs : int or None
+        Local worker processes (None: all cores; 1 runs in this process, as does a
+        single-task collection with no pool started).
+    scheduler : str or None
+        Address of a ``dask.distributed`` scheduler; when given, tasks run on its workers.
+    active : bool, default False
+        Register the workers while the ``with`` block runs, so that :func:`execute` with
+        the same settings uses them.
     """
 
     def __init__(self, jobs: int | None, scheduler: str | None, *, active: bool = False):

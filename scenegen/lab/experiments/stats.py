@@ -87,12 +87,49 @@ class Test:
 
 
 def norm_sf(z: float) -> float:
-    """P(Z > z) for a standard normal Z."""
+    """P(Z > z) for a standard normal Z.
+
+    Parameters
+    ----------
+    z : float
+        The threshold.
+
+    Returns
+    -------
+    float
+        The upper-tail probability, in [0, 1].
+
+    Examples
+    --------
+    >>> norm_sf(0.0)
+    0.5
+    """
     return 0.5 * math.erfc(z / math.sqrt(2.0))
 
 
 def norm_ppf(q: float) -> float:
-    """The standard normal quantile: z with P(Z <= z) = q, 0 < q < 1 (bisection, 1e-12)."""
+    """The standard normal quantile: z with P(Z <= z) = q, 0 < q < 1 (bisection, 1e-12).
+
+    Parameters
+    ----------
+    q : float
+        The probability, in (0, 1).
+
+    Returns
+    -------
+    float
+        The quantile z (within [-40, 40]).
+
+    Raises
+    ------
+    ValueError
+        For ``q`` outside (0, 1).
+
+    Examples
+    --------
+    >>> round(norm_ppf(0.975), 4)
+    1.96
+    """
     if not 0.0 < q < 1.0:
         raise ValueError(f"q must be in (0, 1), got {q}")
     lo, hi = -40.0, 40.0
@@ -106,7 +143,33 @@ def norm_ppf(q: float) -> float:
 
 
 def wilson(k: int, n: int, level: float = LEVEL) -> tuple[float, float]:
-    """Wilson score interval of a rate k/n, as fractions in [0, 1]; (nan, nan) for n = 0."""
+    """Wilson score interval of a rate k/n, as fractions in [0, 1]; (nan, nan) for n = 0.
+
+    Parameters
+    ----------
+    k : int
+        Successes.
+    n : int
+        Trials.
+    level : float, default LEVEL
+        Coverage of the interval (0.95).
+
+    Returns
+    -------
+    low, high : float
+        The interval's bounds, clipped to [0, 1].
+
+    Raises
+    ------
+    ValueError
+        For ``k`` outside [0, n] (with n > 0).
+
+    Examples
+    --------
+    >>> low, high = wilson(8, 10)
+    >>> round(low, 3), round(high, 3)
+    (0.49, 0.943)
+    """
     if n <= 0:
         return (float("nan"), float("nan"))
     if not 0 <= k <= n:
@@ -121,7 +184,29 @@ def wilson(k: int, n: int, level: float = LEVEL) -> tuple[float, float]:
 
 def newcombe_diff(k1: int, n1: int, k2: int, n2: int,
                   level: float = LEVEL) -> tuple[float, float]:
-    """Newcombe's hybrid score interval of p1 − p2 (from the two Wilson intervals)."""
+    """Newcombe's hybrid score interval of p1 − p2 (from the two Wilson intervals).
+
+    Parameters
+    ----------
+    k1, n1 : int
+        Successes and trials of the first sample.
+    k2, n2 : int
+        Successes and trials of the second sample.
+    level : float, default LEVEL
+        Coverage of the interval (0.95).
+
+    Returns
+    -------
+    low, high : float
+        The interval's bounds for p1 − p2, as fractions.
+
+    Raises
+    ------
+    ZeroDivisionError
+        For ``n1`` or ``n2`` of 0.
+    ValueError
+        For a ``k`` outside [0, n].
+    """
     p1, p2 = k1 / n1, k2 / n2
     l1, u1 = wilson(k1, n1, level)
     l2, u2 = wilson(k2, n2, level)
@@ -143,6 +228,18 @@ def newcombe_paired_diff(n_ss: int, n_sf: int, n_fs: int, n_ff: int,
     products) when the cross-product exceeds n/2, 0 when it lies in [0, n/2], and the
     plain correlation below 0; φ = 0 (the independent-sample interval) when a margin is
     empty. Returns (nan, nan) without cases.
+
+    Parameters
+    ----------
+    n_ss, n_sf, n_fs, n_ff : int
+        Counts of the paired cases by outcome, as above.
+    level : float, default LEVEL
+        Coverage of the interval (0.95).
+
+    Returns
+    -------
+    low, high : float
+        The interval's bounds for p_A − p_B, as fractions.
     """
     n = n_ss + n_sf + n_fs + n_ff
     if n <= 0:
@@ -166,7 +263,26 @@ def newcombe_paired_diff(n_ss: int, n_sf: int, n_fs: int, n_ff: int,
 
 
 def two_proportion_z(k1: int, n1: int, k2: int, n2: int) -> Test:
-    """Pooled two-proportion z test of p1 > p2 (one-sided)."""
+    """Pooled two-proportion z test of p1 > p2 (one-sided).
+
+    Parameters
+    ----------
+    k1, n1 : int
+        Successes and trials of the first sample.
+    k2, n2 : int
+        Successes and trials of the second sample.
+
+    Returns
+    -------
+    Test
+        Statistic z (±inf for a difference with zero pooled variance, 0 for none) and
+        p-value P(Z > z).
+
+    Raises
+    ------
+    ZeroDivisionError
+        For ``n1`` or ``n2`` of 0.
+    """
     p = (k1 + k2) / (n1 + n2)
     se = math.sqrt(p * (1 - p) * (1 / n1 + 1 / n2))
     d = k1 / n1 - k2 / n2
@@ -182,6 +298,21 @@ def mcnemar_exact(n_sf: int, n_fs: int) -> Test:
 
     ``n_sf``: cases where A succeeds and B fails; ``n_fs``: the reverse. The p-value is
     P(X >= n_sf) for X ~ Binomial(n_sf + n_fs, 1/2); 1.0 without discordant pairs.
+
+    Parameters
+    ----------
+    n_sf, n_fs : int
+        Discordant counts, as above.
+
+    Returns
+    -------
+    Test
+        Statistic ``n_sf`` and the exact p-value.
+
+    Examples
+    --------
+    >>> mcnemar_exact(5, 0).p_value
+    0.03125
     """
     n = n_sf + n_fs
     p = sum(math.comb(n, i) for i in range(n_sf, n + 1)) / 2.0**n if n else 1.0
@@ -189,13 +320,46 @@ def mcnemar_exact(n_sf: int, n_fs: int) -> Test:
 
 
 def binomial_greater(k: int, n: int, p0: float) -> Test:
-    """Exact binomial test that a rate exceeds p0: P(X >= k) for X ~ Binomial(n, p0)."""
+    """Exact binomial test that a rate exceeds p0: P(X >= k) for X ~ Binomial(n, p0).
+
+    Parameters
+    ----------
+    k : int
+        Successes.
+    n : int
+        Trials.
+    p0 : float
+        The level the rate is tested against, in [0, 1].
+
+    Returns
+    -------
+    Test
+        Statistic ``k`` and the exact p-value.
+    """
     p = sum(math.comb(n, i) * p0**i * (1 - p0) ** (n - i) for i in range(k, n + 1))
     return Test(f"exact binomial (rate > {p0:g}, one-sided)", float(k), min(1.0, p))
 
 
 def chi2_sf(x: float, df: int) -> float:
-    """P(X > x) for X ~ χ² with integer ``df`` >= 1 (closed forms, no special functions)."""
+    """P(X > x) for X ~ χ² with integer ``df`` >= 1 (closed forms, no special functions).
+
+    Parameters
+    ----------
+    x : float
+        The threshold (1.0 is returned for x <= 0).
+    df : int
+        Degrees of freedom, >= 1.
+
+    Returns
+    -------
+    float
+        The upper-tail probability, in [0, 1].
+
+    Raises
+    ------
+    ValueError
+        For ``df`` < 1.
+    """
     if df < 1:
         raise ValueError(f"df must be >= 1, got {df}")
     if x <= 0:
@@ -216,7 +380,25 @@ def chi2_sf(x: float, df: int) -> float:
 
 
 def chi2_homogeneity(successes: Sequence[int], totals: Sequence[int]) -> Test:
-    """Pearson χ² test that k rates are equal (k x 2 table, df = k − 1)."""
+    """Pearson χ² test that k rates are equal (k x 2 table, df = k − 1).
+
+    Parameters
+    ----------
+    successes : sequence of int, shape (k,)
+        Successes per rate.
+    totals : sequence of int, shape (k,)
+        Trials per rate.
+
+    Returns
+    -------
+    Test
+        Statistic χ² and its upper-tail p-value (0 and 1 when the pooled rate is 0 or 1).
+
+    Raises
+    ------
+    ValueError
+        For fewer than two rates.
+    """
     s = np.asarray(successes, dtype=np.float64)
     n = np.asarray(totals, dtype=np.float64)
     if s.size < 2:
@@ -238,6 +420,21 @@ def cochran_q(outcomes: ArrayLike) -> Test:
     every method agrees carry no information and drop out, so the scene's own difficulty,
     shared by the methods run on it, does not count as a difference between them.
     Q = 0, p = 1 when no case is discordant.
+
+    Parameters
+    ----------
+    outcomes : array_like of 0/1, shape (n, k)
+        Outcome of each case (row) for each method (column), k >= 2.
+
+    Returns
+    -------
+    Test
+        Statistic Q and its χ² upper-tail p-value.
+
+    Raises
+    ------
+    ValueError
+        For ``outcomes`` not two-dimensional or with fewer than two columns.
     """
     x = np.asarray(outcomes, dtype=np.float64)
     if x.ndim != 2 or x.shape[1] < 2:
@@ -264,11 +461,29 @@ def bootstrap_clustered_diff(a: dict[Any, Sequence[float]], b: dict[Any, Sequenc
     from resampling clusters with replacement, so runs that share a scene are not taken
     as independent evidence.
 
+    Parameters
+    ----------
+    a, b : dict of hashable to sequence of float
+        Per cluster, its outcomes under each arm.
+    rng : int or numpy.random.Generator
+        Seed or generator of the resampling (the same seed gives the same result).
+    n_boot : int, default N_BOOT
+        Bootstrap resamples (2000).
+    level : float, default LEVEL
+        Coverage of the interval (0.95).
+
     Returns
     -------
     effect : float
+        The mean over shared clusters of mean(a_c) − mean(b_c).
     interval : (float, float)
+        Its percentile bootstrap interval.
     test : Test
+        One-sided test of effect > 0 (``min_n`` :data:`MIN_RUNS`).
+
+    See Also
+    --------
+    bootstrap_paired_diff : the same over the per-cluster differences.
     """
     keys = sorted(set(a) & set(b))  # type: ignore[type-var]
     d = np.array([np.mean(a[c]) - np.mean(b[c]) for c in keys], dtype=np.float64)
@@ -289,6 +504,22 @@ def bootstrap_mean(values: ArrayLike, rng: int | np.random.Generator, *,
     """Percentile bootstrap interval of the mean of ``values`` (shape (n,), NaN dropped).
 
     Seeded through ``rng``: the same seed gives the same interval. (nan, nan) if empty.
+
+    Parameters
+    ----------
+    values : array_like of float, shape (n,)
+        The values; non-finite ones (NaN, inf) are dropped.
+    rng : int or numpy.random.Generator
+        Seed or generator of the resampling.
+    n_boot : int, default N_BOOT
+        Bootstrap resamples (2000).
+    level : float, default LEVEL
+        Coverage of the interval (0.95).
+
+    Returns
+    -------
+    low, high : float
+        The percentile interval of the resampled means.
     """
     v = np.asarray(values, dtype=np.float64)
     v = v[np.isfinite(v)]
@@ -314,11 +545,26 @@ def bootstrap_paired_diff(a: ArrayLike, b: ArrayLike, rng: int | np.random.Gener
     The test's p-value is the share of resampled means <= 0 (one-sided: mean(a − b) > 0),
     at least 1 / n_boot. Pairs with a NaN are dropped.
 
+    Parameters
+    ----------
+    a, b : array_like of float, shape (n,)
+        Paired values; pairs whose difference is not finite are dropped.
+    rng : int or numpy.random.Generator
+        Seed or generator of the resampling.
+    n_boot : int, default N_BOOT
+        Bootstrap resamples (2000).
+    level : float, default LEVEL
+        Coverage of the interval (0.95).
+
     Returns
     -------
     mean : float
+        Mean of a − b (NaN without pairs).
     interval : (float, float)
+        Its percentile bootstrap interval ((nan, nan) without pairs).
     test : Test
+        Statistic the mean, p-value as above (1.0 without pairs), ``min_n``
+        :data:`MIN_RUNS`.
     """
     d = np.asarray(a, dtype=np.float64) - np.asarray(b, dtype=np.float64)
     d = d[np.isfinite(d)]
@@ -351,8 +597,9 @@ def verdict(p_value: float, interval: tuple[float, float], delta: float, n: int,
         matters where the paper prints none.
     n : int
         Runs (or paired cases) of the smaller compared arm.
-    alpha : float
-    min_n : int
+    alpha : float, default ALPHA
+        Significance level (0.05).
+    min_n : int, default 0
         Fewest cases for a significant p-value to count (``Test.min_n``).
 
     Returns

@@ -70,7 +70,20 @@ _RECORD_SERIES = ("order_prob", "true_order", "overlap")
 
 
 def drop_first_frame(record: dict[str, Any]) -> dict[str, Any]:
-    """A copy of ``record`` without frame 0 in any per-frame series."""
+    """A copy of ``record`` without frame 0 in any per-frame series.
+
+    Parameters
+    ----------
+    record : dict
+        A run record (:func:`scenegen.lab.experiments.runner.run_task`).
+
+    Returns
+    -------
+    dict
+        A shallow copy whose per-target series (``state``, ``precision``, ``recall``,
+        ``iou``, ``centre_error``, ``path_error``) and ``order_prob``, ``true_order``,
+        ``overlap`` (where present) start at frame 1; ``n_frames`` is left as it was.
+    """
     out = dict(record)
     out["targets"] = [
         {k: (v[1:] if k in _TARGET_SERIES else v) for k, v in t.items()}
@@ -96,7 +109,19 @@ def _state(target: dict[str, Any]) -> np.ndarray:
 
 def succeeded(target: dict[str, Any]) -> bool:
     """Whether a run tracked ``target`` (an entry of the ``targets`` of a record passed
-    through :func:`drop_first_frame`) in every scored frame: the success of DPS §3.1."""
+    through :func:`drop_first_frame`) in every scored frame: the success of DPS §3.1.
+
+    Parameters
+    ----------
+    target : dict
+        A target entry, with its per-frame ``state`` (None where the target is absent).
+
+    Returns
+    -------
+    bool
+        True when the target is present in some frame and tracked in every frame where
+        it is present.
+    """
     s = _state(target)
     return bool(s.size) and metrics.success_rate(s[None]) == 100.0
 
@@ -933,6 +958,20 @@ def summarize(exp: Experiment, records: Records) -> dict[str, Any]:
     """Summary, paper comparisons and claims of an experiment's run records.
 
     Frame 0 is dropped from every record first (:func:`drop_first_frame`).
+
+    Parameters
+    ----------
+    exp : Experiment
+        The experiment (one of the six definitions: each has its own summariser).
+    records : list of dict
+        Its run records.
+
+    Returns
+    -------
+    dict
+        ``summary`` (the experiment's own tables), ``comparisons`` (ours against each
+        number the paper prints; empty where it prints none) and ``claims`` (each with its
+        test and verdict).
     """
     return _SUMMARIZERS[exp.name][0](exp, [drop_first_frame(r) for r in records])
 

@@ -22,7 +22,23 @@ VERDICT_RULE = (
 
 
 def verdict_counts(results: dict[str, Any]) -> dict[str, int]:
-    """How many claims got each verdict."""
+    """How many claims got each verdict.
+
+    Parameters
+    ----------
+    results : dict
+        The content of ``results.json`` (its ``claims``; none: every count 0).
+
+    Returns
+    -------
+    dict of str to int
+        Counts keyed by ``"reproduced"``, ``"not reproduced"`` and ``"inconclusive"``.
+
+    Examples
+    --------
+    >>> verdict_counts({"claims": [{"verdict": "reproduced"}]})
+    {'reproduced': 1, 'not reproduced': 0, 'inconclusive': 0}
+    """
     out = {"reproduced": 0, "not reproduced": 0, "inconclusive": 0}
     for c in results.get("claims", []):
         out[c["verdict"]] += 1
@@ -71,10 +87,16 @@ def render_table(exp: Experiment, results: dict[str, Any], why: str = "") -> str
     Parameters
     ----------
     exp : Experiment
+        The experiment the results belong to.
     results : dict
         The content of ``results.json``.
-    why : str
+    why : str, default ""
         The "where we differ and why" paragraph (empty: none is printed).
+
+    Returns
+    -------
+    str
+        The Markdown text, ending with a newline.
     """
     s, r = results["scenes"], results["runs"]
     per = "method, λ and preset" if exp.sweep else "method and preset"
