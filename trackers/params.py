@@ -134,8 +134,9 @@ def check_number(params: TrackerParams, name: str, *, low: float | None = None,
     """Check that field ``name`` is a finite number in its interval and store it as ``float``.
 
     ``low``/``high`` bound the interval, closed unless ``low_open``/``high_open``.
-    The value is converted with ``float()`` (so a numeric string such as ``"30"`` is
-    accepted); booleans, unconvertible values and NaN/inf are rejected.
+    The value is converted with ``float()``; booleans, text (``"30"``: a number written as
+    text is refused, as by :func:`check_integer`, rather than read), unconvertible values
+    and NaN/inf are rejected.
 
     Parameters
     ----------
@@ -159,7 +160,7 @@ def check_number(params: TrackerParams, name: str, *, low: float | None = None,
         x = float(value)
     except (TypeError, ValueError):
         x = float("nan")
-    if isinstance(value, bool):
+    if isinstance(value, (bool, str, bytes)):
         x = float("nan")
     ok = np.isfinite(x)
     if low is not None:

@@ -20,10 +20,12 @@ recursion limit, duplicate keys or NaN are refused with one line.
 Examples
 --------
 >>> import tempfile, pathlib
->>> p = pathlib.Path(tempfile.mkdtemp()) / "run.json"
+>>> folder = tempfile.TemporaryDirectory()
+>>> p = pathlib.Path(folder.name) / "run.json"
 >>> digest = write_sealed_json(p, {"a": [1, 2.5]})
 >>> read_sealed_json(p)
 {'a': [1, 2.5]}
+>>> folder.cleanup()
 """
 
 from __future__ import annotations

@@ -45,6 +45,11 @@ import trackers
         ("shm", {"lam": 1e308}, "lam must be in [0, 1e+06], got 1e+308"),
         ("shm-fast", {"lam": 1e7}, "lam must be in [0, 1e+06]"),
         ("shm", {"mse_floor": 5e-324}, "mse_floor must be finite and >= 1e-06, got 5e-324"),
+        # A number written as text was read (lam="30" tracked as 30) where an integer
+        # written as text is refused: a typed field takes numbers only.
+        ("dps", {"lam": "30"}, "lam must be finite and > 0, got '30'"),
+        ("kalman", {"process_std": "1"}, "process_std must be in [0, 1e+06], got '1'"),
+        ("annealed", {"alpha": b"0.5"}, "alpha must be in (0, 1), got b'0.5'"),
     ],
 )
 def test_bad_values_name_the_parameter(name, params, needle):

@@ -244,8 +244,9 @@ def weighted_resample_groups(
     weights : ndarray of shape (N,)
         Current weights π (normalised here, per group).
     g : ndarray of shape (N,)
-        Positive weighting function at each particle (e.g. one object's likelihood); it
-        may be scaled by any constant per group.
+        Non-negative weighting function at each particle (e.g. one object's likelihood),
+        with π g of positive sum in every group; it may be scaled by any constant per
+        group. A particle with g = 0 is never drawn.
     sizes : ndarray of shape (C,), optional
         Lengths of the contiguous groups; None is one group.
     method : str, optional
