@@ -44,7 +44,23 @@ class Entities:
         return int(self.id.shape[0])
 
     def index_of(self, name: str) -> int:
-        """Index (into K) of the entity called ``name``."""
+        """Index (into K) of the entity called ``name``.
+
+        Parameters
+        ----------
+        name : str
+            The entity's name (an entry of :attr:`name`).
+
+        Returns
+        -------
+        int
+            Its index into K; the first one if several share the name.
+
+        Raises
+        ------
+        KeyError
+            If no entity is called ``name``.
+        """
         hits = np.flatnonzero(self.name == name)
         if hits.size == 0:
             raise KeyError(f"no entity named {name!r}")
@@ -87,7 +103,15 @@ class GroundTruth:
     path_center: NDArray[np.float32]
 
     def as_dict(self) -> dict[str, NDArray[Any]]:
-        """Every array keyed by its name under ``gt/``."""
+        """Every array keyed by its name under ``gt/``.
+
+        Returns
+        -------
+        dict of str to ndarray
+            The seven arrays (not copies), keyed ``box``, ``visible_box``, ``center``,
+            ``visibility``, ``present``, ``depth``, ``path_center``; shapes (T, K, 4),
+            (T, K, 2) or (T, K) as in the attributes.
+        """
         return {f.name: getattr(self, f.name) for f in fields(self)}
 
 
@@ -125,22 +149,37 @@ class Sequence:
 
     @property
     def n_frames(self) -> int:
+        """Number of frames T, an int (``frames.shape[0]``)."""
         return int(self.frames.shape[0])
 
     @property
     def height(self) -> int:
+        """Frame height H in pixels, an int (``frames.shape[1]``)."""
         return int(self.frames.shape[1])
 
     @property
     def width(self) -> int:
+        """Frame width W in pixels, an int (``frames.shape[2]``)."""
         return int(self.frames.shape[2])
 
     def target_indices(self) -> NDArray[np.intp]:
-        """Indices (into K) of the entities whose role is ``target``, in id order."""
+        """Indices (into K) of the entities whose role is ``target``, in id order.
+
+        Returns
+        -------
+        ndarray of shape (M,), intp
+            Ascending indices into K of the M targets (whether present or not).
+        """
         return np.flatnonzero(self.entities.role == "target")
 
     def target_ids(self) -> NDArray[np.int32]:
-        """Ids of the targets, shape (M,)."""
+        """Ids of the targets, shape (M,).
+
+        Returns
+        -------
+        ndarray of shape (M,), int32
+            ``entities.id`` at :meth:`target_indices`.
+        """
         return self.entities.id[self.target_indices()]
 
     def initial_targets(self, frame: int = 0) -> NDArray[np.intp]:
@@ -148,12 +187,33 @@ class Sequence:
 
         This is the one definition of "which targets are tracked": ``scenegen track``, the
         experiments and the fixtures all start from these.
+
+        Parameters
+        ----------
+        frame : int, default 0
+            The frame index (0 <= frame < T; negative counts from the end).
+
+        Returns
+        -------
+        ndarray of shape (M,), intp
+            Ascending indices into K of the targets with ``gt.present[frame]`` true.
         """
         idx = self.target_indices()
         return idx[np.asarray(self.gt.present[frame, idx], dtype=bool)]
 
     def init_boxes(self, frame: int = 0) -> NDArray[np.float64]:
-        """Amodal boxes (M, 4) of :meth:`initial_targets` at ``frame``: what trackers start from."""
+        """Amodal boxes (M, 4) of :meth:`initial_targets` at ``frame``: what trackers start from.
+
+        Parameters
+        ----------
+        frame : int, default 0
+            The frame index (0 <= frame < T; negative counts from the end).
+
+        Returns
+        -------
+        ndarray of shape (M, 4), float64
+            ``gt.box`` of those targets at ``frame``, [x, y, w, h] in pixels.
+        """
         return np.asarray(self.gt.box[frame, self.initial_targets(frame)], dtype=np.float64)
 
     def __repr__(self) -> str:

@@ -290,7 +290,14 @@ class AnnealedParams(ColourParams):
                   else tuple(sigmas.tolist()))
 
     def layer_sigmas(self) -> NDArray[np.float64]:
-        """Noise standard deviation (n_layers,) of each layer, first layer first."""
+        """Noise standard deviation (n_layers,) of each layer, first layer first.
+
+        Returns
+        -------
+        ndarray of float64, shape (n_layers,)
+            In px: ``sigma * sigma_decay ** j`` for layer j when ``sigma`` is a number,
+            else ``sigma`` itself (a new array).
+        """
         return _layer_sigmas(self.sigma, self.sigma_decay, self.n_layers)
 
 

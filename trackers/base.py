@@ -359,19 +359,56 @@ class BaseTracker(ABC):
         """Initialise on ``frame`` (H, W, 3) with one box per target, ``boxes`` (K, 4).
 
         An ``init`` that raises leaves the tracker uninitialised (``step`` refuses to run
-        until an ``init`` succeeds), never half-set-up for the new boxes.
+        until an ``init`` succeeds), never half-set-up for the new boxes nor still on the
+        state of a previous ``init``, whether the frame, the boxes or the tracker's own
+        ``_init`` refused them.
+
+        Parameters
+        ----------
+        frame : array_like of uint8, shape (H, W, 3)
+            The first frame, RGB (:func:`check_frame`); its shape is the one every
+            ``step`` frame must have.
+        boxes : array_like of float, shape (K, 4) or (4,)
+            Initial box [x, y, w, h] per target, in px, K >= 1 (:func:`check_boxes`);
+            sets ``self.n_targets`` = K.
+
+        Raises
+        ------
+        ValueError
+            For a bad frame (:func:`check_frame`) or bad boxes (:func:`check_boxes`), and
+            whatever the tracker's ``_init`` refuses (e.g. too many targets).
         """
+        # Unset first: a refused init (a box outside the frame; SHM's 5 targets, DPS's
+        # groups in _init) had left step running on the old state or failing with an
+        # IndexError.
+        self._frame_shape = None
         frame = check_frame(frame)
         boxes = check_boxes(boxes, frame.shape)
-        # Unset first: a _init refusing the new boxes (SHM's 5 targets, DPS's groups) had
-        # left step running on the old state or failing with an IndexError.
-        self._frame_shape = None
         self.n_targets = boxes.shape[0]
         self._init(frame, boxes)
         self._frame_shape = frame.shape
 
     def step(self, frame: Any) -> Estimate:
-        """Advance one frame (H, W, 3) and return the estimate."""
+        """Advance one frame (H, W, 3) and return the estimate.
+
+        Parameters
+        ----------
+        frame : array_like of uint8, shape (H, W, 3)
+            The next frame, RGB, of the shape of the ``init`` frame (:func:`check_frame`).
+
+        Returns
+        -------
+        Estimate
+            ``boxes`` of shape (K, 4), [x, y, w, h] in px in the order of ``init``, each
+            box moved (size unchanged) so that its centre lies inside the frame, in
+            [0, W] x [0, H]; ``extras``, the tracker's diagnostics.
+
+        Raises
+        ------
+        ValueError
+            If ``init`` has not succeeded yet, or for a bad frame or one whose shape
+            differs from the ``init`` frame's.
+        """
         if self._frame_shape is None:
             raise ValueError(f"tracker {self.name!r}: call init() before step()")
         frame = check_frame(frame, self._frame_shape)

@@ -149,12 +149,27 @@ class KalmanParams(TrackerParams):
                              self.blur)
 
     def motion_model(self) -> MotionModel:
-        """The per-object motion model these parameters name."""
+        """The per-object motion model these parameters name.
+
+        Returns
+        -------
+        MotionModel
+            ``MotionModel.constant_velocity(accel_std=process_std, velocity_std=...)``
+            for ``motion="cv"``, ``MotionModel.ar2(a1=..., a2=..., noise_std=process_std,
+            velocity_std=...)`` for ``"ar2"``; state dimension 4, ``position_std`` 1 px.
+        """
         return motion_model(self.motion, self.process_std, self.a1, self.a2,
                             self.velocity_std)
 
     def matcher_params(self) -> dict[str, Any]:
-        """Keyword arguments of ``LayeredMatcher``."""
+        """Keyword arguments of ``LayeredMatcher``.
+
+        Returns
+        -------
+        dict of str to Any
+            ``search_radius``, ``step``, ``min_visible``, ``support`` and ``blur``, as
+            stored in these parameters.
+        """
         return dict(search_radius=self.search_radius, step=self.step,
                     min_visible=self.min_visible, support=self.support, blur=self.blur)
 

@@ -54,16 +54,48 @@ class TrackerParams:
 
     @classmethod
     def names(cls) -> list[str]:
-        """Field names, in declaration order (base classes' fields first)."""
+        """Field names, in declaration order (base classes' fields first).
+
+        Returns
+        -------
+        list of str
+            The names of the dataclass's fields (the tracker's keyword parameters but
+            ``rng``).
+        """
         return [f.name for f in dataclasses.fields(cls)]
 
     @classmethod
     def defaults(cls) -> dict[str, Any]:
-        """Field name -> default value."""
+        """Field name -> default value.
+
+        Returns
+        -------
+        dict of str to Any
+            Each field's default as the dataclass declares it, in declaration order.
+        """
         return {f.name: f.default for f in dataclasses.fields(cls)}
 
     def replace(self, **changes: Any) -> TrackerParams:
-        """A copy with ``changes`` applied (validated again)."""
+        """A copy with ``changes`` applied (validated again).
+
+        Parameters
+        ----------
+        **changes : Any
+            New values of fields, by name.
+
+        Returns
+        -------
+        TrackerParams
+            A new instance of the same class (``dataclasses.replace``); ``self`` is
+            unchanged.
+
+        Raises
+        ------
+        TypeError
+            For a name that is not a field.
+        ValueError
+            From ``__post_init__``, for a bad value, naming the parameter.
+        """
         return dataclasses.replace(self, **changes)
 
     def _set(self, name: str, value: Any) -> None:

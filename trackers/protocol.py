@@ -66,7 +66,27 @@ class Tracker(Protocol):
     """
 
     def init(self, frame: Any, boxes: Any) -> None:
-        """Start on ``frame`` (H, W, 3) with one box per target, ``boxes`` (K, 4)."""
+        """Start on ``frame`` (H, W, 3) with one box per target, ``boxes`` (K, 4).
+
+        Parameters
+        ----------
+        frame : array_like of uint8, shape (H, W, 3)
+            The first frame, RGB.
+        boxes : array_like of float, shape (K, 4)
+            Initial box [x, y, w, h] per target, in px.
+        """
 
     def step(self, frame: Any) -> EstimateLike:
-        """Advance one frame (H, W, 3); return an estimate whose ``boxes`` is (K, 4)."""
+        """Advance one frame (H, W, 3); return an estimate whose ``boxes`` is (K, 4).
+
+        Parameters
+        ----------
+        frame : array_like of uint8, shape (H, W, 3)
+            The next frame, RGB, of the shape of the first.
+
+        Returns
+        -------
+        EstimateLike
+            Its ``boxes``, array-like of shape (K, 4): box [x, y, w, h] per target in px,
+            in the order of ``init``, NaN rows where the tracker has lost a target.
+        """

@@ -123,7 +123,18 @@ class EntitySpec:
             )
 
     def depth_at(self, t: int) -> int:
-        """Depth value at frame ``t`` (the last keyframe at or before ``t``)."""
+        """Depth value at frame ``t`` (the last keyframe at or before ``t``).
+
+        Parameters
+        ----------
+        t : int
+            Frame index (frames); before 0 it gives the first keyframe's depth.
+
+        Returns
+        -------
+        int
+            The ``depth`` of the last keyframe whose frame is <= ``t`` (smaller is nearer).
+        """
         d = self.depth[0][1]
         for f, v in self.depth:
             if f <= t:

@@ -105,6 +105,7 @@ class ShardTask:
 
     @property
     def file(self) -> str:
+        """The shard's file name, a str relative to ``root``: ``shard-NNNNN.h5``."""
         return shard_name(self.shard)
 
 

@@ -297,6 +297,21 @@ class LocalPool:
         """Run ``fn(task)`` on a worker; ``label`` says what it does (``"making FILE"``), for
         :meth:`death`.
 
+        Parameters
+        ----------
+        fn : callable
+            A module-level (picklable) function of one argument.
+        task : object
+            Its (picklable) argument.
+        label : str
+            What running it does, in words (``"making shard-00002.h5 (sequences 8-11)"``):
+            the end of the line :meth:`death` gives if its worker dies while running it.
+
+        Returns
+        -------
+        concurrent.futures.Future
+            The future of ``fn(task)``'s result (or its exception).
+
         Raises
         ------
         BrokenProcessPool
@@ -343,7 +358,15 @@ class LocalPool:
     def close(self, *, interrupt: bool = False) -> None:
         """Drop the queued tasks and stop the workers: let the running tasks finish, or
         (``interrupt``, after Ctrl-C) stop them at once (SIGTERM: each worker removes the
-        temporary file it was writing and exits)."""
+        temporary file it was writing and exits).
+
+        Returns when every worker has exited.
+
+        Parameters
+        ----------
+        interrupt : bool, default False
+            Send SIGTERM to the workers running a task before shutting the pool down.
+        """
         if interrupt:
             for pid in self._running():
                 with contextlib.suppress(OSError):

@@ -104,7 +104,19 @@ class Axis:
 
     def level(self, j: int) -> Any:
         """The axis's value at grid position ``j``: that of its field, the one all its
-        fields share (``occluder_width``: 36, 44, ...), or the list of its fields' values."""
+        fields share (``occluder_width``: 36, 44, ...), or the list of its fields' values.
+
+        Parameters
+        ----------
+        j : int
+            Grid position along the axis, in ``0 .. len(axis) - 1``.
+
+        Returns
+        -------
+        object or list
+            ``values[j][0]`` when every field of the axis takes the same value there,
+            else the list ``values[j]`` (one value per path, in ``paths`` order).
+        """
         vals = list(self.values[j])
         return vals[0] if all(v == vals[0] for v in vals) else vals
 
@@ -127,7 +139,19 @@ class Distribution:
     args: tuple[Any, ...]
 
     def draw(self, rng: np.random.Generator) -> Any:
-        """One value, drawn from ``rng`` (floats kept to 6 significant digits)."""
+        """One value, drawn from ``rng`` (floats kept to 6 significant digits).
+
+        Parameters
+        ----------
+        rng : numpy.random.Generator
+            The stream to draw from (one draw is taken from it).
+
+        Returns
+        -------
+        float, int or object
+            A float for uniform, loguniform and normal; an int in ``[low, high]``
+            (inclusive) for randint; a deep copy of one of the options for choice.
+        """
         if self.kind == "uniform":
             return _tidy(rng.uniform(self.args[0], self.args[1]))
         if self.kind == "loguniform":
@@ -233,6 +257,17 @@ class Family:
 
         Its ``spec`` stays the family as given.
 
+        Parameters
+        ----------
+        overrides : dict of str to object
+            Field path (``n_frames``, ``entities[0].position_noise``) -> value; an entry
+            replaces a ``set`` entry of the same path.
+
+        Returns
+        -------
+        Family
+            A new, validated family; this one is unchanged.
+
         Raises
         ------
         ConfigError
@@ -253,7 +288,16 @@ class Family:
         return dataclasses.replace(fam, spec=copy.deepcopy(self.spec))
 
     def digest(self) -> str:
-        """SHA-256 (hex) of everything that defines the sequences except the count and seed."""
+        """SHA-256 (hex) of everything that defines the sequences except the count and seed.
+
+        The name, bases, ``set``, ``sweep`` and ``vary`` sections are hashed; the
+        description, source, spec and folder are not.
+
+        Returns
+        -------
+        str
+            64 lowercase hex digits.
+        """
         ident = {
             "name": self.name,
             "bases": self.bases,
@@ -269,7 +313,18 @@ class Family:
         return [*words, int(seed)]
 
     def grid_point(self, index: int) -> list[int]:
-        """Position along each axis of sequence ``index`` (last axis fastest)."""
+        """Position along each axis of sequence ``index`` (last axis fastest).
+
+        Parameters
+        ----------
+        index : int
+            Sequence index (>= 0); it takes grid point ``index mod grid_size``.
+
+        Returns
+        -------
+        list of int
+            One position per axis, in ``axes`` order (empty without ``sweep``).
+        """
         j = index % self.grid_size
         out = []
         for a in reversed(self.axes):
@@ -280,12 +335,27 @@ class Family:
     def draw(self, index: int, seed: int | None = None, *, _entropy: Any = None) -> Draw:
         """Sequence ``index``: its parameters, seed and validated config.
 
+        Parameters
+        ----------
+        index : int
+            Sequence index (>= 0); any index is valid, not only those below ``count``.
+        seed : int, optional
+            The family seed; None: :attr:`seed`.
+
+        Returns
+        -------
+        Draw
+            Its name ``FAMILY-NNNNN``, scene seed, parameters and config.
+
         Raises
         ------
         ConfigError
-            If the resulting config is invalid (naming the sequence, its parameters and
-            the field).
+            If ``index`` is not an integer >= 0, or the resulting config is invalid
+            (naming the sequence, its parameters and the field).
         """
+        if isinstance(index, bool) or not isinstance(index, (int, np.integer)) or index < 0:
+            raise ConfigError(f"index must be an integer >= 0, got {index!r}")
+        index = int(index)
         seed = self.seed if seed is None else seed
         entropy = self._entropy(seed) if _entropy is None else _entropy
         rng = np.random.default_rng(np.random.SeedSequence(entropy, spawn_key=(index, 0)))
@@ -328,7 +398,25 @@ class Family:
             raise ConfigError(f"{self.source}: {what}{detail}: {err}") from None
 
     def draws(self, count: int | None = None, seed: int | None = None) -> list[Draw]:
-        """Draws of sequences ``0 .. count-1`` (default: the family's count)."""
+        """Draws of sequences ``0 .. count-1`` (default: the family's count).
+
+        Parameters
+        ----------
+        count : int, optional
+            Number of sequences (>= 1); None: :attr:`count`.
+        seed : int, optional
+            The family seed; None: :attr:`seed`.
+
+        Returns
+        -------
+        list of Draw
+            ``count`` draws, in index order (as :meth:`draw` gives them).
+
+        Raises
+        ------
+        ConfigError
+            If ``count < 1``, or a sequence's config is invalid (:meth:`draw`).
+        """
         n = self.count if count is None else count
         if n < 1:
             raise ConfigError(f"count must be >= 1, got {n}")

@@ -129,7 +129,25 @@ class Dataset:
             yield self[i]
 
     def path(self, i: int) -> Path:
-        """The shard file holding sequence ``i``."""
+        """The shard file holding sequence ``i``.
+
+        Parameters
+        ----------
+        i : int
+            Index into this dataset (or selection), ``-len(ds) <= i < len(ds)``.
+
+        Returns
+        -------
+        Path
+            ``root / <its shard file>`` (``shard-NNNNN.h5``); the file is not opened.
+
+        Raises
+        ------
+        TypeError
+            If ``i`` is not an integer.
+        IndexError
+            If ``i`` is out of range.
+        """
         return self.root / self._entry(i)["file"]
 
     def _param_key(self, key: str) -> str:
@@ -153,7 +171,7 @@ class Dataset:
         ----------
         where : dict, optional
             Conditions keyed by full parameter name (``{"clutter[0].count": 300}``).
-        **params
+        **params : Any
             Conditions keyed by name or by the last field of a path (``count=300``,
             ``position_noise=(4, 8)``). A value matches by equality (a list or a dict
             matches a parameter of that value, such as a swept size ``[44, 44]``; tuples
@@ -162,12 +180,18 @@ class Dataset:
             accepted values; a callable is a predicate. Every condition must hold, also
             two on the same parameter (one in ``where``, one here).
 
+        Returns
+        -------
+        Dataset
+            The matching entries, in this dataset's order (same root and manifest); no
+            condition: all of them.
+
         Raises
         ------
         ConfigError
-            For a parameter the dataset does not record, a ``where`` that is not a
-            mapping, or a range whose bounds are not numbers (one line naming the
-            parameter and the value).
+            For a parameter the dataset does not record (or a last field that several
+            parameters end with), a ``where`` that is not a mapping, or a range whose
+            bounds are not numbers (one line naming the parameter and the value).
         """
         if where is not None and not isinstance(where, dict):
             raise ConfigError(
@@ -187,6 +211,28 @@ class Dataset:
         """Map-style samples ``(frames, boxes)``, for a PyTorch-style loader.
 
         See :class:`Samples`.
+
+        Parameters
+        ----------
+        clip : int, optional
+            Window length L (frames), >= 1; None: whole sequences.
+        stride : int, optional
+            Frames between window starts, >= 1 (default: ``clip``); unused without
+            ``clip``.
+        gt : {'box', 'visible_box'}, default 'box'
+            Amodal or visible boxes.
+
+        Returns
+        -------
+        Samples
+            Samples of (frames of shape (L, H, W, 3), uint8; boxes of shape (L, M, 4),
+            float32) over this dataset's sequences.
+
+        Raises
+        ------
+        ConfigError
+            If ``clip`` or ``stride`` is not an integer >= 1 (or None), or ``gt`` is not
+            one of the two names.
         """
         return Samples(self, clip=clip, stride=stride, gt=gt)
 

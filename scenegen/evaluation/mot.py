@@ -113,10 +113,12 @@ class MotFrames:
 
     @property
     def n_gt_dets(self) -> int:
+        """Ground-truth detections of the sequence, an int (ids present, summed over frames)."""
         return int(sum(len(g) for g in self.gt_ids))
 
     @property
     def n_tracker_dets(self) -> int:
+        """Tracker detections of the sequence, an int (ids present, summed over frames)."""
         return int(sum(len(h) for h in self.tracker_ids))
 
 

@@ -72,6 +72,18 @@ class MotSummary:
 
     @classmethod
     def from_scores(cls, s: MotScores) -> MotSummary:
+        """The summary of the scores of :func:`scenegen.evaluation.mot.score_all`.
+
+        Parameters
+        ----------
+        s : MotScores
+            CLEAR MOT, identity and HOTA scores of one sequence (or one target).
+
+        Returns
+        -------
+        MotSummary
+            The same numbers, unchanged (undefined ones stay NaN until :meth:`to_dict`).
+        """
         c, i, h = s.clear, s.identity, s.hota
         return cls(
             mota=c.mota, motp=c.motp, moda=c.moda, tp=c.tp, fp=c.fp, fn=c.fn, idsw=c.idsw,
@@ -80,6 +92,14 @@ class MotSummary:
         )  # fmt: skip
 
     def to_dict(self) -> dict[str, Any]:
+        """The numbers as plain JSON types.
+
+        Returns
+        -------
+        dict of str to float, int or None
+            One key per attribute (``mota`` ... ``loca``), in field order; floats that are
+            NaN or infinite become None, counts stay ints.
+        """
         return {k: (_finite(v) if isinstance(v, float) else v) for k, v in asdict(self).items()}
 
 
@@ -129,6 +149,16 @@ class TargetScores:
     mot: MotSummary
 
     def to_dict(self) -> dict[str, Any]:
+        """The target's scores as one flat dict of plain JSON types.
+
+        Returns
+        -------
+        dict of str to int, str, float, bool or None
+            Every attribute but ``mot`` (``id``, ``name``, ``track_id``, ``frames``,
+            ``tracked``, ... ``failure_frame``), then the keys of
+            :meth:`MotSummary.to_dict` (``mota``, ``idf1``, ``hota``, ...) at the same
+            level; floats that are NaN or infinite become None.
+        """
         out = {k: v for k, v in asdict(self).items() if k != "mot"}
         for k, v in out.items():
             if isinstance(v, float):
@@ -167,6 +197,15 @@ class OverallScores:
     depth_order_accuracy: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
+        """The overall scores as one flat dict of plain JSON types.
+
+        Returns
+        -------
+        dict of str to float, int, str or None
+            ``mean_iou``, ``auc``, ``precision_20``, ``otb_average``, then the keys of
+            :meth:`MotSummary.to_dict` at the same level, then ``depth_order_accuracy``
+            only when it is not None; floats that are NaN or infinite become None.
+        """
         out: dict[str, Any] = {
             "mean_iou": _finite(self.mean_iou),
             "auc": _finite(self.auc),
@@ -204,7 +243,15 @@ class SequenceReport:
     overall: OverallScores
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types; undefined numbers are None."""
+        """Plain JSON types; undefined numbers are None.
+
+        Returns
+        -------
+        dict of str to object
+            ``sequence``, ``tracker``, ``n_frames``, ``gt_mode``, ``visibility_threshold``
+            (as stored), ``targets`` (a list of :meth:`TargetScores.to_dict`, in order)
+            and ``overall`` (:meth:`OverallScores.to_dict`).
+        """
         return {
             "sequence": self.sequence,
             "tracker": self.tracker,
@@ -216,7 +263,19 @@ class SequenceReport:
         }
 
     def to_json(self) -> str:
-        """One JSON document (sorted keys, no NaN)."""
+        """One JSON document (sorted keys, no NaN).
+
+        Returns
+        -------
+        str
+            :meth:`to_dict` serialised on one line by ``json.dumps``, keys sorted.
+
+        Raises
+        ------
+        ValueError
+            If ``visibility_threshold`` is NaN or infinite (the one float written as
+            stored; :func:`scenegen.evaluation.evaluate` only makes it in [0, 1)).
+        """
         return json.dumps(self.to_dict(), sort_keys=True, allow_nan=False)
 
 

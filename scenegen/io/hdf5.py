@@ -572,6 +572,7 @@ class LazyArray:
 
     @property
     def ndim(self) -> int:
+        """Number of dimensions, an int (``len(shape)``)."""
         return len(self.shape)
 
     def _get(self, key: Any) -> NDArray[Any]:
@@ -611,6 +612,11 @@ class LazyArray:
             yield self[t]
 
     def close(self) -> None:
+        """Close this array's handle on the file, if open (no-op otherwise).
+
+        The array stays usable: the next access reopens the file, checking that it is
+        still the version first read.
+        """
         if self._file is not None:
             self._file.close()
             self._file = None

@@ -167,12 +167,29 @@ class Hasher:
         self._h = hashlib.sha256()
 
     def update(self, block: NDArray[Any]) -> None:
-        """Add the next values (rows in storage order)."""
+        """Add the next values (rows in storage order).
+
+        Only the raw bytes are hashed (C order), not the dtype or shape: feeding a
+        dataset block by block gives the same digest as feeding it whole.
+
+        Parameters
+        ----------
+        block : ndarray, any shape and dtype
+            The next values, e.g. frames of shape (t, H, W, 3), uint8; an empty one adds
+            nothing.
+        """
         arr = np.ascontiguousarray(block)
         if arr.size:  # hashed in place: no copy of a block of frames
             self._h.update(memoryview(arr.reshape(-1).view(np.uint8)))
 
     def hexdigest(self) -> str:
+        """SHA-256 of the values fed so far (more may still be added).
+
+        Returns
+        -------
+        str
+            64 lowercase hex digits.
+        """
         return self._h.hexdigest()
 
 

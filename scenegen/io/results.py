@@ -74,7 +74,17 @@ class TrackerResult:
         (T, M, 4) with M distinct ``target_ids``; ``orderings`` (L, M) of positions 0..M-1 and
         ``order_prob`` (T, L), both or neither) and box rows that are neither finite with
         w, h >= 0 nor all NaN.
-        Empty if none."""
+        Empty if none.
+
+        Returns
+        -------
+        list of str
+            One sentence per problem, also for repeated ``target_ids`` and ``order_prob``
+            values that are not probabilities in [0, 1]. A shape problem of
+            ``target_ids``, ``boxes`` or ``orderings``, or ``orderings`` without
+            ``order_prob`` (or the reverse), is the only one given (the later checks
+            need those shapes).
+        """
         out: list[str] = []
         ids, boxes = np.asarray(self.target_ids), np.asarray(self.boxes)
         if ids.ndim != 1:

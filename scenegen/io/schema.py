@@ -109,6 +109,18 @@ class Field:
     def shape_for(self, **sizes: int) -> tuple[int, ...]:
         """The concrete shape given the symbol sizes, e.g. ``shape_for(T=8, K=3)``.
 
+        Parameters
+        ----------
+        **sizes : int
+            Size of each symbol of :attr:`shape` (``T``, ``K``, ``H``, ...); extra ones are
+            ignored.
+
+        Returns
+        -------
+        tuple of int
+            One size per axis: the given size of a symbol, a fixed size as is
+            (``("T", "K", 4)`` with T=8, K=3 gives ``(8, 3, 4)``).
+
         Raises
         ------
         KeyError

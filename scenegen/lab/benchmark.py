@@ -123,13 +123,40 @@ class BenchTask:
     sequence_params: str = "{}"
 
     def tracker_seed(self) -> int:
+        """Seed of the tracker's random stream on this sequence.
+
+        Derived (:func:`scenegen.lab.experiments.runner.derive_seed`) from ``"benchmark"``,
+        the tracker, its parameters as sorted JSON and the sequence's seed: the same for
+        every run of the pair, whatever the dataset folder or the sequence's position.
+
+        Returns
+        -------
+        int
+            A seed in [0, 2**63).
+        """
         return derive_seed("benchmark", self.tracker, json.dumps(dict(self.params),
                            sort_keys=True), self.seed)  # fmt: skip
 
     def filename(self) -> str:
+        """The pair's record file, relative to the output folder (:func:`run_file`).
+
+        Returns
+        -------
+        str
+            ``"runs/TRACKER/NNNNN.json"``, ``NNNNN`` the sequence's index.
+        """
         return run_file(self.tracker, self.index)
 
     def key(self) -> dict[str, Any]:
+        """What identifies the pair's record: a stored record of another key is stale.
+
+        Returns
+        -------
+        dict of str to object
+            ``index``, ``name``, ``file``, ``seed``, ``frames_digest``, ``tracker`` and
+            ``params`` (a dict), as JSON types with floats rounded to 6 decimals (NaN and
+            infinities as None); without ``root`` and ``sequence_params``.
+        """
         d = asdict(self)
         del d["root"], d["sequence_params"]
         d["params"] = dict(self.params)

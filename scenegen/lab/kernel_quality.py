@@ -73,11 +73,13 @@ class Row:
 
     @property
     def inside(self) -> bool:
+        """Whether ``other`` lies in ``base_ci``, bounds included, a bool (False for NaN)."""
         lo, hi = self.base_ci
         return bool(lo <= self.other <= hi)
 
     @property
     def metric(self) -> str:
+        """The metric's name, a str: the last part of ``path`` (e.g. ``"success"``)."""
         return self.path.rsplit("/", 1)[-1]
 
 

@@ -221,13 +221,23 @@ class Scenario:
 
     @property
     def n_frames(self) -> int:
+        """Number of frames T, an int (``config.n_frames``)."""
         return self.config.n_frames
 
     @property
     def n_entities(self) -> int:
+        """Number of entities K, an int (clutter items included)."""
         return len(self.names)
 
     def entities(self) -> Entities:
+        """The K entities, with ids 1..K in ``names`` order.
+
+        Returns
+        -------
+        Entities
+            ``id`` (K,) int32 ``1..K``; ``role`` and ``name`` (K,) str arrays of
+            :attr:`roles` and :attr:`names`.
+        """
         k = self.n_entities
         return Entities(
             id=np.arange(1, k + 1, dtype=np.int32),
@@ -252,15 +262,30 @@ class Scenario:
 
     @property
     def moving_camera(self) -> bool:
+        """Whether the background moves under the frame, a bool (``view_x`` or
+        ``view_y`` nonzero at some frame)."""
         return bool(np.any(self.view_x != 0) or np.any(self.view_y != 0))
 
     @property
     def zoomed(self) -> bool:
+        """Whether the camera zooms, a bool (``zoom`` differs from 1 at some frame)."""
         return bool(np.any(self.zoom != 1.0))
 
     def background_frame(self, t: int) -> NDArray[np.uint8]:
         """The background as seen in frame ``t`` (H, W, 3): the window at the camera
-        offset, resampled about the frame centre when the camera zooms."""
+        offset, resampled about the frame centre when the camera zooms.
+
+        Parameters
+        ----------
+        t : int
+            Frame index, ``0 <= t < T`` (negative counts from the end).
+
+        Returns
+        -------
+        ndarray of shape (H, W, 3), uint8
+            A new array (a copy of the window; bilinear resampling, borders reflected,
+            when ``zoom[t] != 1``), without entities, illumination or noise.
+        """
         h, w = self.config.height, self.config.width
         px, py = self.pad
         xs, ys = px + int(self.view_x[t]), py + int(self.view_y[t])
@@ -309,9 +334,26 @@ class Scenario:
     def render(self, start: int = 0, stop: int | None = None) -> Chunk:
         """Render frames ``start:stop`` with their ground truth.
 
+        The first call draws the static layer and keeps it; any split of the frames into
+        ranges gives the same bytes as one call.
+
+        Parameters
+        ----------
+        start : int, default 0
+            First frame (``0 <= start < stop``).
+        stop : int, optional
+            End frame, exclusive (``<= T``); None: T.
+
         Returns
         -------
         Chunk
+            The F = stop - start frames (F, H, W, 3) uint8, labels (F, H, W) uint16 and
+            ground-truth arrays (F, K, ...) of the range.
+
+        Raises
+        ------
+        ValueError
+            If the range is empty or outside ``0:T``.
         """
         t_n = self.n_frames
         stop = t_n if stop is None else stop
@@ -435,7 +477,16 @@ class Scenario:
 
     def image_velocity(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Velocity (T, K) of every entity in frame coordinates, pixels per frame (the
-        backward difference; frame 0 takes frame 1's)."""
+        backward difference; frame 0 takes frame 1's).
+
+        Computed from the drawn centres ``cx``, ``cy`` (position noise included) minus
+        the camera offset.
+
+        Returns
+        -------
+        vx, vy : ndarray of shape (T, K), float64
+            Horizontal and vertical velocity (px/frame); zeros when T = 1.
+        """
         x = self.cx - self.cam_x[:, None]
         y = self.cy - self.cam_y[:, None]
         vx, vy = np.zeros_like(x), np.zeros_like(y)
@@ -445,12 +496,38 @@ class Scenario:
         return vx, vy
 
     def chunks(self, size: int = 64) -> Iterator[Chunk]:
-        """Render the whole scenario in chunks of ``size`` frames (bounded memory)."""
-        for start in range(0, self.n_frames, size):
-            yield self.render(start, min(start + size, self.n_frames))
+        """Render the whole scenario in chunks of ``size`` frames (bounded memory).
+
+        Parameters
+        ----------
+        size : int, default 64
+            Frames per chunk, >= 1 (the last chunk may be shorter).
+
+        Returns
+        -------
+        iterator of Chunk
+            ``render(start, min(start + size, T))`` for ``start = 0, size, 2 size, ...``,
+            each rendered when the iterator reaches it.
+
+        Raises
+        ------
+        ValueError
+            If ``size`` is not an integer >= 1 (at the call, not at the first chunk).
+        """
+        if isinstance(size, bool) or not isinstance(size, (int, np.integer)) or size < 1:
+            raise ValueError(f"size must be an integer >= 1, got {size!r}")
+        step = int(size)
+        return (self.render(start, min(start + step, self.n_frames))
+                for start in range(0, self.n_frames, step))
 
     def template_images(self) -> dict[int, NDArray[np.uint8]]:
-        """Each entity's base template (RGBA), keyed by id."""
+        """Each entity's base template (RGBA), keyed by id.
+
+        Returns
+        -------
+        dict of int to ndarray of shape (h, w, 4), uint8
+            :attr:`templates` (not copies) keyed by ids 1..K.
+        """
         return {k + 1: tpl for k, tpl in enumerate(self.templates)}
 
 

@@ -133,16 +133,47 @@ class ConformanceReport:
         return [r.name for r in self.results if r.status == "failed"]
 
     def status(self, name: str) -> str:
-        """The status of check ``name`` (KeyError if it was not run)."""
+        """The status of check ``name`` (KeyError if it was not run).
+
+        Parameters
+        ----------
+        name : str
+            The check's name (a key of :data:`CHECKS`).
+
+        Returns
+        -------
+        {"passed", "failed", "skipped"}
+            Its outcome.
+
+        Raises
+        ------
+        KeyError
+            If no check ``name`` was run.
+        """
         for r in self.results:
             if r.name == name:
                 return r.status
         raise KeyError(f"check {name!r} was not run; ran: {', '.join(self.names())}")
 
     def names(self) -> list[str]:
+        """Names of the checks run, in the order run.
+
+        Returns
+        -------
+        list of str
+            One name per result.
+        """
         return [r.name for r in self.results]
 
     def as_dict(self) -> dict[str, Any]:
+        """The report as plain data (for JSON).
+
+        Returns
+        -------
+        dict
+            ``{"tracker": str, "passed": bool, "checks": {name: {"status": str,
+            "message": str}}}``, the checks in the order run.
+        """
         return {
             "tracker": self.tracker,
             "passed": self.passed,

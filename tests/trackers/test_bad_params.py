@@ -252,3 +252,26 @@ def test_an_opencv_init_refused_on_a_later_box_leaves_it_uninitialised(monkeypat
         t.init(frame, [[30, 20, 20, 20], [5, 5, 20, 20]])
     with pytest.raises(ValueError, match=r"call init\(\) before step\(\)"):
         t.step(frame)
+
+
+def test_an_opencv_init_refused_by_the_box_check_leaves_it_uninitialised(monkeypatch):
+    # A box outside the frame was refused before the adapter unset its trackers: step
+    # went on with the previous init's.
+    from trackers.adapters import opencv
+
+    class Still:
+        def init(self, frame, box):
+            pass
+
+        def update(self, frame):
+            return True, (1, 1, 8, 8)
+
+    t = opencv("MIL", rng=0)
+    monkeypatch.setattr(t, "_make", Still)
+    frame = np.zeros((60, 80, 3), np.uint8)
+    t.init(frame, [[30, 20, 20, 20]])
+    assert t.step(frame).boxes.shape == (1, 4)
+    with pytest.raises(ValueError):
+        t.init(frame, [[500, 500, 20, 20]])
+    with pytest.raises(ValueError, match=r"call init\(\) before step\(\)"):
+        t.step(frame)

@@ -105,6 +105,10 @@ _FIVE = [[i * 5.0, 2.0, 4.0, 4.0] for i in range(5)]
         ("shm-fast", {}, _FIVE),
         ("dps", {"n_particles": 3}, _FIVE),  # one group per target > n_particles
         ("ps", {"ordering": (1, 0)}, [[2.0, 3.0, 5.0, 6.0]]),  # not a permutation of 1
+        # Refused by the box check before _init: the previous init's state was kept.
+        ("condensation", {}, [[500.0, 500.0, 5.0, 5.0]]),  # outside the frame
+        ("kalman", {}, [[2.0, 3.0, -5.0, 6.0]]),  # a negative width
+        ("meanshift", {}, [[2.0, float("nan"), 5.0, 6.0]]),
     ],
 )
 def test_an_init_that_fails_leaves_the_tracker_uninitialised(name, params, refused):

@@ -160,18 +160,38 @@ class OpenCVTracker:
         return " with params " + ", ".join(f"{k}={v!r}" for k, v in self.params.items())
 
     def init(self, frame: Any, boxes: Any) -> None:
-        """Start one cv2 tracker per box on ``frame`` (H, W, 3) RGB; ``boxes`` (K, 4)."""
+        """Start one cv2 tracker per box on ``frame`` (H, W, 3) RGB; ``boxes`` (K, 4).
+
+        Seeds OpenCV's global random state first when ``rng`` was given. Each box is
+        rounded outward to whole pixels, clipped to the frame and grown to at least
+        ``MIN_SIDE`` px a side before it goes to OpenCV.
+
+        Parameters
+        ----------
+        frame : array_like of uint8, shape (H, W, 3)
+            The first frame, RGB (converted to BGR for OpenCV).
+        boxes : array_like of float, shape (K, 4) or (4,)
+            Initial box [x, y, w, h] per target, in px, K >= 1.
+
+        Raises
+        ------
+        ValueError
+            For a bad frame or bad boxes (``trackers.base.check_frame``,
+            ``trackers.base.check_boxes``), or a box a cv2 tracker refuses to start on.
+            The tracker is then left uninitialised: ``step`` refuses to run.
+        """
         import cv2
 
+        # Unset until every box has started: a box refused had left step tracking only
+        # the boxes before it (fewer rows than init's boxes), and a box outside the frame
+        # the previous init's trackers.
+        self._shape = None
+        self._trackers, self._sizes = [], []
         rgb = check_frame(frame)
         boxes = check_boxes(boxes, rgb.shape)
         if self.rng is not None:
             cv2.setRNGSeed(int(self.rng))
         bgr = np.ascontiguousarray(rgb[:, :, ::-1])
-        # Unset until every box has started: a box refused had left step tracking only
-        # the boxes before it (fewer rows than init's boxes).
-        self._shape = None
-        self._trackers, self._sizes = [], []
         for box in boxes:
             t = self._make()
             px = _pixel_box(box, rgb.shape)
@@ -188,7 +208,27 @@ class OpenCVTracker:
         self._shape = rgb.shape
 
     def step(self, frame: Any) -> Estimate:
-        """Update every cv2 tracker on ``frame``; NaN boxes where one reports failure."""
+        """Update every cv2 tracker on ``frame``; NaN boxes where one reports failure.
+
+        Parameters
+        ----------
+        frame : array_like of uint8, shape (H, W, 3)
+            The next frame, RGB, of the shape of the ``init`` frame.
+
+        Returns
+        -------
+        Estimate
+            ``boxes`` of shape (K, 4), [x, y, w, h] in px as OpenCV reports them (whole
+            pixels; a box grown at ``init`` keeps its initial size about OpenCV's
+            centre), NaN rows for the targets whose tracker failed; ``extras["ok"]``,
+            bool of shape (K,), True where it succeeded.
+
+        Raises
+        ------
+        ValueError
+            If ``init`` has not succeeded yet, or for a bad frame or one whose shape
+            differs from the ``init`` frame's.
+        """
         if self._shape is None:
             raise ValueError(f"cv2.Tracker{self.name}: call init() before step()")
         rgb = check_frame(frame, self._shape)

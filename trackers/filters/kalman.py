@@ -75,6 +75,26 @@ class MotionModel:
         (px/frame²) per coordinate, FilterPy's ``Q_discrete_white_noise(2, 1, var)``:
         ``Q = var [[1/4, 1/2], [1/2, 1]]`` per (position, velocity) pair.
         ``position_std`` (px) and ``velocity_std`` (px/frame) set ``P0``.
+
+        Parameters
+        ----------
+        accel_std : float
+            Acceleration noise std, px/frame², finite and >= 0 (keyword only).
+        position_std : float, default 1.0
+            Initial position std, px, finite and > 0.
+        velocity_std : float, default 5.0
+            Initial velocity std, px/frame, finite and > 0.
+
+        Returns
+        -------
+        MotionModel
+            ``kind="cv"``, n = 4: ``F``, ``Q``, ``P0`` of shape (4, 4), ``H`` (2, 4), and
+            ``P0 = diag(position_std², position_std², velocity_std², velocity_std²)``.
+
+        Raises
+        ------
+        ValueError
+            For a std that is not finite or out of its range, naming it.
         """
         _check_positive("accel_std", accel_std, allow_zero=True)
         _check_positive("position_std", position_std)
@@ -111,6 +131,28 @@ class MotionModel:
         velocity of std ``velocity_std``. Explosive coefficients (a root of
         z² − a1 z − a2 outside the unit circle) are refused, as by every tracker with AR2
         dynamics (``trackers.models.dynamics.check_ar2_coefficients``).
+
+        Parameters
+        ----------
+        a1, a2 : float
+            AR2 coefficients (keyword only), finite and not explosive.
+        noise_std : float
+            Std of the AR2 noise, px, finite and >= 0 (keyword only).
+        position_std : float, default 1.0
+            Initial position std, px, finite and > 0.
+        velocity_std : float, default 5.0
+            Initial velocity std, px/frame, finite and > 0.
+
+        Returns
+        -------
+        MotionModel
+            ``kind="ar2"``, n = 4: ``F``, ``Q``, ``P0`` of shape (4, 4), ``H`` (2, 4).
+
+        Raises
+        ------
+        ValueError
+            For a std that is not finite or out of its range, or for coefficients that
+            are not finite or explosive, naming the parameter.
         """
         _check_positive("noise_std", noise_std, allow_zero=True)
         _check_positive("position_std", position_std)
@@ -136,6 +178,23 @@ class MotionModel:
 
         The joint state stacks the objects' states (object-major, dimension
         ``n_objects * n``); the joint measurement stacks their (x, y).
+
+        Parameters
+        ----------
+        n_objects : int
+            Number of objects K, >= 1.
+
+        Returns
+        -------
+        MotionModel
+            Of the same ``kind``: ``F``, ``Q``, ``P0`` of shape (K n, K n), ``H`` of shape
+            (2 K, K n), each block-diagonal with K copies of this model's matrix
+            (``numpy.kron``).
+
+        Raises
+        ------
+        ValueError
+            If ``n_objects < 1``.
         """
         if n_objects < 1:
             raise ValueError(f"n_objects must be >= 1, got {n_objects}")
@@ -243,6 +302,25 @@ class KalmanFilter:
         stays the prior. ``R`` of shape (m', m') or (B, m', m') and ``H`` of shape (m', n)
         override ``self.R``/``self.H`` for this call only (a sub-block of the measurement
         may be processed this way, as in sequential updates of independent objects).
+
+        Sets ``x``, ``P`` (and their copies ``x_post``, ``P_post``), ``y``, ``S``, ``K``
+        and ``log_likelihood`` (0 for a missed measurement).
+
+        Parameters
+        ----------
+        z : array_like of shape (B, m') or None
+            One measurement per filter; a row with a NaN (or inf) is a missed measurement
+            for that filter, and None misses them all.
+        R : array_like of shape (m', m') or (B, m', m'), optional
+            Measurement noise covariance for this call; None (the default): ``self.R``.
+        H : array_like of shape (m', n), optional
+            Measurement matrix for this call; None (the default): ``self.H``.
+
+        Raises
+        ------
+        ValueError
+            If ``H``, ``R`` or ``z`` has the wrong shape (for ``R``: not (m', m') for the
+            ``H`` used, ``self.R`` included).
         """
         b, n = self.x.shape
         h = self.H if H is None else np.asarray(H, dtype=np.float64)

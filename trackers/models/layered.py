@@ -228,13 +228,23 @@ class LayeredMatcher:
         Parameters
         ----------
         frame : ndarray of shape (H, W, 3), uint8
+            The current frame, of the shape of the one the templates were cut from
+            (blurred here if ``blur`` > 0).
         centres : array_like of shape (M, 2)
-            Predicted centre (x, y) of each object: the middle of its search window.
+            Predicted centre (x, y) of each object: the middle of its search window, in px
+            (rounded to whole pixels; a NaN centre searches around the object's position
+            in the template frame).
         order : ndarray of shape (L, M)
             Orderings, nearest first (``orderings(M)``, or one row for plain matching).
-        masking : bool
+        masking : bool, default True
             Mask the pixels of the objects matched in front (False: every object is
             matched on the unmasked frame).
+
+        Returns
+        -------
+        LayeredMeasurement
+            ``centres`` (L, M, 2) in px, ``mse`` (L, M), ``counts`` (L, M) and
+            ``n_searches``: one row per row of ``order``.
         """
         c = np.asarray(centres, dtype=np.float64).reshape(self.n_objects, 2)
         h, w = self._frame_hw

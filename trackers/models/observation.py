@@ -106,7 +106,22 @@ class FrameLikelihood(Protocol):
 
     def log_likelihoods(self, boxes: NDArray[np.floating], objects: NDArray[np.integer]
                         ) -> NDArray[np.float64]:
-        """log p(Z | X) (P,) of boxes (P, 4) [x, y, w, h] for their objects (P,)."""
+        """log p(Z | X) (P,) of boxes (P, 4) [x, y, w, h] for their objects (P,).
+
+        Parameters
+        ----------
+        boxes : ndarray of float64, shape (P, 4)
+            Candidate boxes [x, y, w, h] in px (any position, possibly outside the frame;
+            w, h > 0).
+        objects : ndarray of int64, shape (P,)
+            The object index k of each box (row k of the ``set_references`` boxes).
+
+        Returns
+        -------
+        ndarray of float64, shape (P,)
+            log p(Z | X_k = box), natural log, finite; only differences between boxes of
+            one object matter.
+        """
         ...
 
 
@@ -122,11 +137,30 @@ class ObservationModel(Protocol):
     """
 
     def set_references(self, frame: NDArray[np.uint8], boxes: NDArray[np.floating]) -> None:
-        """Initialise on the first frame (H, W, 3) with the objects' boxes (K, 4)."""
+        """Initialise on the first frame (H, W, 3) with the objects' boxes (K, 4).
+
+        Parameters
+        ----------
+        frame : ndarray of uint8, shape (H, W, 3)
+            The first frame, RGB.
+        boxes : ndarray of float64, shape (K, 4)
+            Initial box [x, y, w, h] of each object, in px, in the tracker's object order.
+        """
         ...
 
     def observe(self, frame: NDArray[np.uint8]) -> FrameLikelihood:
-        """See frame (H, W, 3) of the current step; score its boxes with the result."""
+        """See frame (H, W, 3) of the current step; score its boxes with the result.
+
+        Parameters
+        ----------
+        frame : ndarray of uint8, shape (H, W, 3)
+            The frame of the current step, RGB; called once per step, in frame order.
+
+        Returns
+        -------
+        FrameLikelihood
+            Whose ``log_likelihoods(boxes, objects)`` scores that frame's boxes.
+        """
         ...
 
 #: Observation model names and their default (n_parts, kernel).
@@ -222,14 +256,53 @@ class ColourModel:
         self._prepared: PreparedReferences | None = None
 
     def quantize(self, frame: NDArray[np.uint8]) -> NDArray[np.int32]:
-        """Bin-index image (H, W) int32 of an RGB frame (H, W, 3) uint8."""
+        """Bin-index image (H, W) int32 of an RGB frame (H, W, 3) uint8.
+
+        Parameters
+        ----------
+        frame : ndarray of uint8, shape (H, W, 3)
+            RGB frame.
+
+        Returns
+        -------
+        ndarray of int32, shape (H, W)
+            Bin index of every pixel, in [0, ``n_bins``): ``quantize_hsv`` with ``bins``
+            bins of hue, saturation and value and thresholds ``s_min``, ``v_min`` for
+            "hsv", ``quantize_rgb`` with ``bins`` per channel for "rgb"
+            (``trackers.kernels.quantize``).
+
+        Raises
+        ------
+        ValueError
+            If ``frame`` is not uint8 of shape (H, W, 3).
+        """
         if self.kind == "hsv":
             return quantize_hsv(frame, self.bins, self.bins, self.bins, self.s_min, self.v_min)
         return quantize_rgb(frame, self.bins)
 
     def histograms(self, frame: NDArray[np.uint8], boxes: NDArray[np.floating]
                    ) -> NDArray[np.float64]:
-        """Histograms (P, dim) of ``boxes`` (P, 4) in ``frame`` (H, W, 3)."""
+        """Histograms (P, dim) of ``boxes`` (P, 4) in ``frame`` (H, W, 3).
+
+        Parameters
+        ----------
+        frame : ndarray of uint8, shape (H, W, 3)
+            RGB frame (quantised by :meth:`quantize`).
+        boxes : ndarray of float, shape (P, 4)
+            Boxes [x, y, w, h] in px, finite, w, h > 0; they may leave the frame.
+
+        Returns
+        -------
+        ndarray of float64, shape (P, dim)
+            One kernel-weighted histogram per box, its ``n_parts`` bands of ``n_bins``
+            concatenated top to bottom; each row sums to 1
+            (``trackers.kernels.histogram.region_histograms``).
+
+        Raises
+        ------
+        ValueError
+            For a bad frame, or boxes of a bad shape, not finite or of non-positive size.
+        """
         return region_histograms(self.quantize(frame), boxes, self.n_bins,
                                  KERNELS[self.kernel], self.n_parts,
                                  box_levels=self.box_levels)
@@ -247,16 +320,42 @@ class ColourModel:
         self._prepared = prepare_references(refs, self.n_parts)
 
     def set_references(self, frame: NDArray[np.uint8], boxes: NDArray[np.floating]) -> None:
-        """Take the histograms of ``boxes`` (K, 4) in ``frame`` as the objects' templates."""
+        """Take the histograms of ``boxes`` (K, 4) in ``frame`` as the objects' templates.
+
+        Sets ``references`` (K, dim), replacing any earlier ones.
+
+        Parameters
+        ----------
+        frame : ndarray of uint8, shape (H, W, 3)
+            The first frame, RGB.
+        boxes : ndarray of float, shape (K, 4)
+            Box [x, y, w, h] of each object, in px, finite, w, h > 0.
+
+        Raises
+        ------
+        ValueError
+            As :meth:`histograms`.
+        """
         self.references = self.histograms(frame, boxes)
 
     def observe(self, frame: NDArray[np.uint8]) -> FrameObservation:
         """Quantise ``frame`` (H, W, 3) once; score candidates with the result.
 
+        Parameters
+        ----------
+        frame : ndarray of uint8, shape (H, W, 3)
+            RGB frame of the current step.
+
+        Returns
+        -------
+        FrameObservation
+            This model and the frame's bin-index image (H, W) (:meth:`quantize`).
+
         Raises
         ------
         ValueError
-            If ``set_references`` was not called.
+            If ``set_references`` was not called, or for a frame that is not uint8 of
+            shape (H, W, 3).
         """
         if self._prepared is None:
             raise ValueError("ColourModel.observe: call set_references() first")
@@ -301,7 +400,26 @@ class FrameObservation:
 
     def log_likelihoods(self, boxes: NDArray[np.floating], objects: NDArray[np.integer]
                         ) -> NDArray[np.float64]:
-        """log p(Z | X) = −λ d² of each box (P, 4) for its object (P,); shape (P,)."""
+        """log p(Z | X) = −λ d² of each box (P, 4) for its object (P,); shape (P,).
+
+        Parameters
+        ----------
+        boxes : ndarray of shape (P, 4)
+            Candidate boxes [x, y, w, h] in px (any position; w, h > 0).
+        objects : ndarray of shape (P,), integer
+            Object index (row of ``model.references``) of each box.
+
+        Returns
+        -------
+        ndarray of float64, shape (P,)
+            −λ d², in [−λ, 0], with d the Bhattacharyya distance of :meth:`distances`.
+
+        Raises
+        ------
+        ValueError
+            As :meth:`distances`: boxes not (P, 4), finite and of positive size, or an
+            object index out of range.
+        """
         d = self.distances(boxes, objects)
         return -self.model.lam * d * d
 
@@ -394,7 +512,20 @@ class PositionModel:
         self._t = 0
 
     def set_references(self, frame: NDArray[np.uint8], boxes: NDArray[np.floating]) -> None:
-        """Reset to frame 0; ``boxes`` (K, 4) must match the measurements' K."""
+        """Reset to frame 0; ``boxes`` (K, 4) must match the measurements' K.
+
+        Parameters
+        ----------
+        frame : ndarray of uint8, shape (H, W, 3)
+            The first frame; not looked at.
+        boxes : ndarray of float, shape (K, 4)
+            Initial boxes [x, y, w, h]; only their number K is used.
+
+        Raises
+        ------
+        ValueError
+            If K differs from the measurements' (``measurements.shape[1]``).
+        """
         k = np.shape(boxes)[0]
         if k != self.measurements.shape[1]:
             raise ValueError(f"PositionModel has measurements of {self.measurements.shape[1]} "
@@ -402,7 +533,27 @@ class PositionModel:
         self._t = 0
 
     def observe(self, frame: NDArray[np.uint8]) -> _PositionFrame:
-        """The next frame's measurements."""
+        """The next frame's measurements.
+
+        Advances the frame counter t by one (also when it raises).
+
+        Parameters
+        ----------
+        frame : ndarray of uint8, shape (H, W, 3)
+            The frame of the current step; not looked at.
+
+        Returns
+        -------
+        FrameLikelihood
+            Whose ``log_likelihoods(boxes, objects)`` (P,) is log N(c(box); z_{t,k}, R)
+            with ``measurements[t]`` (K, 2); a constant, log N at its mean, for a box whose
+            object has a NaN measurement.
+
+        Raises
+        ------
+        ValueError
+            Once t reaches T (more than T − 1 frames observed since ``set_references``).
+        """
         self._t += 1
         if self._t >= self.measurements.shape[0]:
             raise ValueError(f"PositionModel: frame {self._t} observed, but measurements "

@@ -54,6 +54,14 @@ class BenchRow:
     params: dict[str, object] = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, object]:
+        """The row as a dict (``dataclasses.asdict``).
+
+        Returns
+        -------
+        dict of str to object
+            One key per attribute, in field order (``group`` ... ``params``); ``params``
+            is a copy of the row's dict.
+        """
         return asdict(self)
 
 

@@ -42,6 +42,14 @@ class Method:
     group: str = ""
 
     def param_dict(self) -> dict[str, Any]:
+        """The method's tracker parameters as keyword arguments.
+
+        Returns
+        -------
+        dict of str to object
+            Parameter name -> value, in the order of ``params``; tuple values become
+            lists (one level: e.g. a PS ``ordering``).
+        """
         return {k: (list(v) if isinstance(v, tuple) else v) for k, v in self.params}
 
 
@@ -94,6 +102,16 @@ class Experiment:
     def method(self, slug_or_label: str) -> Method:
         """The method with this slug or label.
 
+        Parameters
+        ----------
+        slug_or_label : str
+            A method's ``slug`` (e.g. ``"ps-123"``) or ``label`` (e.g. ``"PS(1,2,3)"``).
+
+        Returns
+        -------
+        Method
+            The first of ``methods`` whose slug or label it is.
+
         Raises
         ------
         ConfigError
@@ -108,7 +126,19 @@ class Experiment:
         )
 
     def sweep_values(self, quick: bool = False) -> list[tuple[str, Any]]:
-        """``(parameter, value)`` pairs to run; ``[("", None)]`` without a sweep."""
+        """``(parameter, value)`` pairs to run; ``[("", None)]`` without a sweep.
+
+        Parameters
+        ----------
+        quick : bool, default False
+            Quick mode: keep only the values in ``quick_sweep`` (all of them when
+            ``quick_sweep`` is empty).
+
+        Returns
+        -------
+        list of (str, object)
+            The swept parameter's name with each of its values, in the order of ``sweep``.
+        """
         if not self.sweep:
             return [("", None)]
         key, values = self.sweep[0]

@@ -131,6 +131,8 @@ class Task:
 
     @property
     def sweep_label(self) -> str:
+        """The swept value as ``"param=value"`` (value in ``:g`` format), a str; "" without a
+        sweep."""
         return f"{self.param}={self.value:g}" if self.param else ""
 
     @property
@@ -139,23 +141,58 @@ class Task:
         return (self.preset, self.scene, self.run)
 
     def scene_seed(self) -> int:
-        """Seed of the run's sequence: shared by every method and run on scene s."""
+        """Seed of the run's sequence: shared by every method and run on scene s.
+
+        Derived from the base seed, the experiment, the preset and the scene index only
+        (not the method, swept value, run or overrides).
+
+        Returns
+        -------
+        int
+            A seed in [0, 2**63).
+        """
         return scene_seed(self.seed, self.experiment, self.preset, self.scene)
 
     def tracker_seed(self) -> int:
-        """Seed of the tracker's random stream for this run."""
+        """Seed of the tracker's random stream for this run.
+
+        Derived from the base seed, the experiment, the method, the preset,
+        :attr:`sweep_label`, the scene and the run (not ``quick`` nor the overrides).
+
+        Returns
+        -------
+        int
+            A seed in [0, 2**63).
+        """
         return derive_seed(
             self.seed, self.experiment, self.method, self.preset, self.sweep_label,
             self.scene, self.run,
         )
 
     def filename(self) -> str:
+        """The run's record file name, in the experiment's ``runs/`` folder.
+
+        Returns
+        -------
+        str
+            ``METHOD__PRESET[__PARAMVALUE][__NAME-VALUE...]__sSSS__rRRR.json``: the swept
+            value in ``:g`` format, one ``__NAME-VALUE`` per override, scene and run
+            zero-padded to three digits (e.g. ``"dps__dps-occlusion__s000__r001.json"``).
+        """
         sweep = f"__{self.param}{self.value:g}" if self.param else ""
         over = "".join(f"__{k}-{v}" for k, v in self.overrides)
         return (f"{self.method}__{self.preset}{sweep}{over}__s{self.scene:03d}"
                 f"__r{self.run:03d}.json")
 
     def key(self) -> dict[str, Any]:
+        """What identifies the run's record: a stored record of another key is stale.
+
+        Returns
+        -------
+        dict of str to object
+            The attributes by name (``dataclasses.asdict``), without ``overrides`` when
+            there are none (so records stored before overrides existed stay valid).
+        """
         key = asdict(self)
         if not self.overrides:
             # Records of runs without overrides keep the key they had before overrides existed.
@@ -745,7 +782,21 @@ class Workers:
         self._pending: dict[tuple[Path, Task], tuple[Any, int | None]] = {}
 
     def serves(self, jobs: int | None, scheduler: str | None) -> bool:
-        """Whether :func:`execute` with these settings runs on these workers."""
+        """Whether :func:`execute` with these settings runs on these workers.
+
+        Parameters
+        ----------
+        jobs : int or None
+            :func:`execute`'s local worker processes.
+        scheduler : str or None
+            :func:`execute`'s Dask scheduler address.
+
+        Returns
+        -------
+        bool
+            True when both equal those the workers were made with (``jobs`` None and an
+            explicit count are different settings).
+        """
         return (jobs, scheduler) == (self.jobs, self.scheduler)
 
     def __enter__(self) -> Workers:
@@ -770,13 +821,35 @@ class Workers:
             self._client = None
 
     def started(self, runs_dir: Path, task: Task) -> bool:
-        """Whether ``task`` (stored under ``runs_dir``) was started and not yet collected."""
+        """Whether ``task`` (stored under ``runs_dir``) was started and not yet collected.
+
+        Parameters
+        ----------
+        runs_dir : pathlib.Path
+            The experiment's ``runs/`` folder the task's record goes to.
+        task : Task
+            The run.
+
+        Returns
+        -------
+        bool
+            True while it is pending on these workers.
+        """
         return (runs_dir, task) in self._pending
 
     def start(self, tasks: list[Task], runs_dir: Path) -> None:
         """Start the tasks not yet stored under ``runs_dir`` (nor started); their records
         are stored by the :func:`execute` that collects them. In this process (``jobs``
-        1) nothing starts early: the tasks run when collected."""
+        1) nothing starts early: the tasks run when collected.
+
+        Parameters
+        ----------
+        tasks : list of Task
+            The runs to start; those with a sound stored record (:func:`load_record`) or
+            already started are skipped.
+        runs_dir : pathlib.Path
+            The experiment's ``runs/`` folder their records go to.
+        """
         todo = [t for t in tasks if not self.started(runs_dir, t)
                 and load_record(runs_dir / t.filename(), t) is None]
         if self._client is not None or self._n > 1:
@@ -807,7 +880,28 @@ class Workers:
         self, todo: list[Task], runs_dir: Path, store: Callable[[Task, dict[str, Any]], None]
     ) -> None:
         """Run (or wait for) every task of ``todo`` and ``store`` each record as it
-        arrives."""
+        arrives.
+
+        With no pool or client started and one worker (or fewer than two tasks), the
+        tasks run here, in order; otherwise those not yet started are started first.
+
+        Parameters
+        ----------
+        todo : list of Task
+            The runs to collect (stored records are not looked for: see :meth:`start`).
+        runs_dir : pathlib.Path
+            The experiment's ``runs/`` folder their records go to.
+        store : callable
+            Called as ``store(task, record)`` with each task and its record
+            (:func:`run_task`), in order of completion.
+
+        Raises
+        ------
+        ConfigError
+            A local worker process died (out of memory, a crash), saying how and, when
+            known, in which task; tasks still pending are cancelled. A task's own error is
+            raised as is, after cancelling the pending tasks likewise.
+        """
         if self._client is None and self._pool is None and (self._n == 1 or len(todo) < 2):
             for t in todo:
                 store(t, run_task(t))

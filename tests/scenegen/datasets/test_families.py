@@ -90,6 +90,14 @@ def test_a_draw_depends_on_family_seed_and_index_only(seed, index):
     assert fam.draw(index, seed + 1).seed != alone.seed
 
 
+@pytest.mark.parametrize("index", [-1, 1.5, True, "3", None])
+def test_a_draw_of_a_bad_index_is_one_config_error_naming_it(index):
+    # -1 was numpy's bare "expected non-negative integer"; 1.5 a TypeError of its own.
+    with pytest.raises(ConfigError, match=r"^index must be an integer >= 0, got "):
+        family_from_dict(FAMILY).draw(index)
+    assert family_from_dict(FAMILY).draw(np.int64(2)) == family_from_dict(FAMILY).draw(2)
+
+
 def test_family_file(tmp_path):
     p = tmp_path / "f.json"
     p.write_text(json.dumps(FAMILY))

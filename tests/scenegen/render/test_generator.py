@@ -142,6 +142,14 @@ def test_chunked_rendering_equals_whole(p, seed, size):
         np.testing.assert_array_equal(np.concatenate([c.gt[key] for c in parts]), arr)
 
 
+@pytest.mark.parametrize("size", [0, -3, 2.5, True])
+def test_chunks_of_a_bad_size_are_refused_at_the_call(size):
+    # size 0 raised numpy's range error at the first chunk; a negative size gave no chunk.
+    scn = plan(scenegen.presets.get("kams-a"), 0)
+    with pytest.raises(ValueError, match=r"^size must be an integer >= 1, got "):
+        scn.chunks(size)
+
+
 def test_sensor_noise_is_keyed_per_frame():
     cfg = build_config(
         {"width": 40, "height": 30, "n_frames": 6, "n_entities": 2, "n_clutter": 0,
