@@ -23,6 +23,7 @@ from scenegen.config import (
     SceneConfig,
     Variation,
 )
+from scenegen.config.messages import _short
 from scenegen.errors import ConfigError
 
 __all__ = ["all_names", "describe", "get", "names", "realistic_names"]
@@ -110,6 +111,8 @@ def get(name: str) -> SceneConfig:
     >>> config.width, config.height, config.n_frames
     (320, 240, 140)
     """
+    if not isinstance(name, str):  # a list was a TypeError (unhashable)
+        raise ConfigError(f"unknown preset {_short(name)}; valid presets: {', '.join(all_names())}")
     if name in _REALISTIC:
         return _REALISTIC[name]()
     if name not in _PRESETS:

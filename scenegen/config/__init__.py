@@ -12,6 +12,9 @@ One module per concept, each re-exported here:
 - ``fields``: which fields each pattern, background kind, clutter pattern and AR2 boundary
   uses (``PATTERN_FIELDS``, ...), and fields added after the first release;
 - ``checks``: value checks that several classes share (colours, names, keyframes);
+- ``coerce``: a value read as its field's type, by :func:`from_dict` and by every class on
+  construction (a bad type or choice is a ConfigError naming the field; numpy numbers
+  become Python numbers and lists tuples);
 - ``sources``: image sources (``SKIMAGE_NAMES``, ``check_source``) and ``relative_to``;
 - ``motion`` (``AR2``, ``Motion``), ``appearance`` (``Appearance``, ``Variation``),
   ``background`` (``Background``), ``entities`` (``EntitySpec``, ``ClutterSpec``),

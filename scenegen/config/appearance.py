@@ -7,6 +7,7 @@ from dataclasses import dataclass
 from typing import Literal
 
 from scenegen.config.checks import _check_color
+from scenegen.config.coerce import _coerce_fields
 from scenegen.config.fields import PATTERN_FIELDS, _check_unused, _new
 from scenegen.config.limits import MAX_SIDE
 from scenegen.config.messages import _fail, _short
@@ -94,6 +95,7 @@ class Appearance:
     noise_scale: float = _new(8.0)
 
     def __post_init__(self) -> None:
+        _coerce_fields(self)
         if self.pattern == "image" and self.source is None:
             _fail("source", "is required by the image pattern")
         self._check_image()
@@ -156,6 +158,7 @@ class Variation:
     phase: float = 0.0
 
     def __post_init__(self) -> None:
+        _coerce_fields(self)
         if self.period <= 0:
             _fail("period", f"must be > 0, got {_short(self.period)}")
         if not 0 <= self.shading < 1:

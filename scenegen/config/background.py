@@ -7,6 +7,7 @@ from typing import Literal
 
 from scenegen.config.appearance import Color, Fit
 from scenegen.config.checks import _check_color
+from scenegen.config.coerce import _coerce_fields
 from scenegen.config.fields import BACKGROUND_FIELDS, _check_unused, _new
 from scenegen.config.limits import MAX_BLUR
 from scenegen.config.messages import _fail, _short
@@ -66,6 +67,7 @@ class Background:
     fit: Fit = _new("crop")
 
     def __post_init__(self) -> None:
+        _coerce_fields(self)
         if self.kind == "image" and self.source is None:
             _fail("source", "is required by kind: image")
         if self.source is not None:

@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from scenegen.config.checks import _check_keyframes
+from scenegen.config.coerce import _coerce_fields
 from scenegen.config.fields import _new, _unused
 from scenegen.config.limits import MAX_SIDE
 from scenegen.config.messages import _fail, _short
@@ -74,6 +75,7 @@ class Camera:
     zoom: AR2 | None = _new(None)
 
     def __post_init__(self) -> None:
+        _coerce_fields(self)
         if not (0 <= self.extent[0] <= MAX_SIDE and 0 <= self.extent[1] <= MAX_SIDE):
             _fail("extent", f"must be in 0..{MAX_SIDE}, got {_short(list(self.extent))}")
         for axis in ("x", "y", "zoom"):

@@ -9,6 +9,7 @@ from typing import Literal
 
 from scenegen.config.appearance import Appearance, Color, Variation
 from scenegen.config.checks import _check_color, _check_name
+from scenegen.config.coerce import _coerce_fields
 from scenegen.config.fields import _MIMIC_FIELDS, CLUTTER_FIELDS, _check_unused, _unused
 from scenegen.config.limits import MAX_COLORS
 from scenegen.config.messages import _fail, _short
@@ -86,6 +87,7 @@ class EntitySpec:
     variation: Variation | None = None
 
     def __post_init__(self) -> None:
+        _coerce_fields(self)
         _check_name("name", self.name)
         if self.position_noise < 0:
             _fail("position_noise", f"must be >= 0, got {_short(self.position_noise)}")
@@ -196,6 +198,7 @@ class ClutterSpec:
     name: str = "clutter"
 
     def __post_init__(self) -> None:
+        _coerce_fields(self)
         _check_name("name", self.name)
         if self.count < 0:
             _fail("count", f"must be >= 0, got {_short(self.count)}")

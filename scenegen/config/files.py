@@ -306,15 +306,15 @@ def load_data(path: str | Path, what: str = "config") -> Any:
     -------
     Any
         The file's data as parsed: dicts, lists, strings, numbers, booleans and None
-        (never None itself: an empty YAML document is refused).
+        (never None itself: an empty YAML document or a bare ``null`` is refused).
 
     Raises
     ------
     ConfigError
         One line naming the file: not a regular file (a FIFO, a device), unreadable, too
-        big, not UTF-8, another extension, empty, not valid YAML/JSON (the parser's problem
-        and its line and column), more than :data:`MAX_VALUES` values, an alias bomb or a
-        duplicate key.
+        big, not UTF-8, another extension, empty (or a bare ``null``), not valid YAML/JSON
+        (the parser's problem and its line and column), more than :data:`MAX_VALUES`
+        values, an alias bomb or a duplicate key.
     """
     from scenegen.io.atomic import describe_special_file
 
@@ -340,6 +340,8 @@ def load_data(path: str | Path, what: str = "config") -> Any:
             return data
         if p.suffix.lower() == ".json":
             data = json.loads(text, object_pairs_hook=json_object)
+            if data is None:  # a bare null, as in YAML
+                raise ConfigError(f"{what} is empty (a JSON object of fields is expected)")
             _count_values(data)
             return data
         raise ConfigError(f"{p}: {what} must be .yaml, .yml or .json, got {_short(p.suffix)}")

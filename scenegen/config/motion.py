@@ -6,6 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Literal
 
+from scenegen.config.coerce import _coerce_fields
 from scenegen.config.fields import AR2_FIELDS, _check_unused
 from scenegen.config.messages import _fail, _short
 
@@ -78,6 +79,7 @@ class AR2:
     margin: float = 0.0
 
     def __post_init__(self) -> None:
+        _coerce_fields(self)
         if self.sigma < 0:
             _fail("sigma", f"must be >= 0, got {_short(self.sigma)}")
         if self.margin < 0:
@@ -107,3 +109,6 @@ class Motion:
     y: AR2
     scale: AR2 | None = None
     velocity: tuple[float, float] = (0.0, 0.0)
+
+    def __post_init__(self) -> None:
+        _coerce_fields(self)

@@ -6,6 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from scenegen.config.checks import _check_keyframes
+from scenegen.config.coerce import _coerce_fields
 from scenegen.config.limits import MAX_MOTION_BLUR
 from scenegen.config.messages import _fail, _short
 from scenegen.config.motion import AR2
@@ -48,6 +49,7 @@ class Photometric:
     jpeg_quality: int | None = None
 
     def __post_init__(self) -> None:
+        _coerce_fields(self)
         if self.keyframes and (self.gain is not None or self.offset is not None):
             _fail("keyframes", "cannot be combined with gain or offset motion")
         _check_keyframes("keyframes", self.keyframes)

@@ -5,16 +5,13 @@ path (``entities[1].motion.x.boundary``) and the bad value."""
 from __future__ import annotations
 
 import dataclasses
-import functools
-import math
-import types
-import typing
 from pathlib import Path
-from typing import Any, Literal, get_args, get_origin
+from typing import Any
 
+from scenegen.config import coerce
 from scenegen.config.entities import EntitySpec
 from scenegen.config.fields import _STORED
-from scenegen.config.limits import _MAX_ENTITIES, MAX_MAGNITUDE
+from scenegen.config.limits import _MAX_ENTITIES
 from scenegen.config.messages import _fail, _key, _short
 from scenegen.config.scene import SceneConfig
 from scenegen.config.sources import _sources_relative_to
@@ -23,78 +20,8 @@ from scenegen.errors import ConfigError
 __all__ = ["from_dict", "from_stored", "to_dict"]
 
 
-def _type_name(tp: Any) -> str:
-    return getattr(tp, "__name__", str(tp))
-
-
-def _is_integer(value: Any) -> bool:
-    """An int or a numpy integer scalar, not a bool."""
-    import numpy as np
-
-    return isinstance(value, (int, np.integer)) and not isinstance(value, bool)
-
-
-def _is_number(value: Any) -> bool:
-    """An int or float, or a numpy integer or floating scalar; not a bool."""
-    import numpy as np
-
-    return _is_integer(value) or isinstance(value, (float, np.floating))
-
-
 def _convert(value: Any, tp: Any, path: str) -> Any:
-    origin = get_origin(tp)
-    if origin is typing.Union or origin is types.UnionType:
-        args = get_args(tp)
-        if value is None:
-            if type(None) in args:
-                return None
-            _fail(path, "must not be null")
-        inner = [a for a in args if a is not type(None)]
-        return _convert(value, inner[0], path)
-    if origin is Literal:
-        choices = get_args(tp)
-        if value not in choices:
-            _fail(path, f"must be one of {', '.join(map(str, choices))}; got {_short(value)}")
-        return value
-    if dataclasses.is_dataclass(tp):
-        if isinstance(value, tp):
-            return value
-        return _build(tp, value, path)
-    if origin is tuple:
-        args = get_args(tp)
-        if isinstance(value, (str, bytes, dict)) or not hasattr(value, "__iter__"):
-            _fail(path, f"must be a list, got {_short(value)}")
-        items = list(value)
-        if len(args) == 2 and args[1] is Ellipsis:
-            return tuple(_convert(v, args[0], f"{path}[{i}]") for i, v in enumerate(items))
-        if len(items) != len(args):
-            _fail(path, f"must have {len(args)} items, got {_short(items)}")
-        return tuple(
-            _convert(v, a, f"{path}[{i}]") for i, (v, a) in enumerate(zip(items, args, strict=True))
-        )
-    if tp is bool:
-        if not isinstance(value, bool):
-            _fail(path, f"must be true or false, got {_short(value)}")
-        return value
-    if tp is int:
-        if not _is_number(value):
-            _fail(path, f"must be an integer, got {_short(value)}")
-        if not _is_integer(value) and not float(value).is_integer():
-            _fail(path, f"must be an integer, got {_short(value)}")
-        return int(value)
-    if tp is float:
-        if not _is_number(value):
-            _fail(path, f"must be a number, got {_short(value)}")
-        if _is_integer(value) and abs(int(value)) > MAX_MAGNITUDE:
-            _fail(path, f"must be at most {MAX_MAGNITUDE:g} in magnitude, got {_short(value)}")
-        if not math.isfinite(value):
-            _fail(path, f"must be finite, got {_short(value)}")
-        return float(value)
-    if tp is str:
-        if not isinstance(value, str):
-            _fail(path, f"must be a string, got {_short(value)}")
-        return value
-    _fail(path, f"cannot read a value of type {_type_name(tp)}")
+    return coerce._convert(value, tp, path, _build)
 
 
 def _check_count(path: str, value: Any) -> None:
@@ -110,21 +37,15 @@ def _check_count(path: str, value: Any) -> None:
 
 def _normalise_depth(value: Any) -> Any:
     # A single number is shorthand for a constant depth from frame 0.
-    if _is_number(value):
+    if coerce._is_number(value):
         return [[0, value]]
     return value
-
-
-@functools.cache
-def _hints(cls: type) -> dict[str, Any]:
-    """The field types of a config dataclass (resolving them costs more than a field)."""
-    return typing.get_type_hints(cls)
 
 
 def _build(cls: type, data: Any, path: str) -> Any:
     if not isinstance(data, dict):
         _fail(path, f"must be a mapping, got {_short(data)}")
-    hints = _hints(cls)
+    hints = coerce._hints(cls)
     fields = {f.name: f for f in dataclasses.fields(cls)}
     for key in data:
         if key not in fields:

@@ -11,6 +11,7 @@ from typing import Any
 from scenegen.config.background import Background
 from scenegen.config.camera import Camera
 from scenegen.config.checks import _check_name
+from scenegen.config.coerce import _coerce_fields
 from scenegen.config.entities import ClutterSpec, EntitySpec
 from scenegen.config.fields import PATTERN_FIELDS, _new, _unused
 from scenegen.config.limits import (
@@ -64,6 +65,7 @@ class SceneConfig:
     photometric: Photometric | None = _new(None)
 
     def __post_init__(self) -> None:
+        _coerce_fields(self)
         for f in ("width", "height", "n_frames"):
             v = getattr(self, f)
             if v < 1:

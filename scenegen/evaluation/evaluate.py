@@ -148,10 +148,17 @@ def _finite(x: float) -> float | None:
 
 
 def check_options(
-    gt_mode: str, visibility_threshold: float, otb_average: str, iou_threshold: float = 0.5
+    gt_mode: str,
+    visibility_threshold: float,
+    otb_average: str,
+    iou_threshold: float = 0.5,
+    *,
+    recover_frames: int = DEFAULT_RECOVER_FRAMES,
+    persist: int = 10,
 ) -> None:
-    """Raise ConfigError naming an unknown ``gt_mode`` / ``otb_average`` or a bad threshold
-    (:func:`scenegen.io.mot.check_gt_mode`: one definition with the exports).
+    """Raise ConfigError naming an unknown ``gt_mode`` / ``otb_average``, a bad threshold
+    (:func:`scenegen.io.mot.check_gt_mode`: one definition with the exports) or a bad
+    frame count.
 
     Parameters
     ----------
@@ -163,16 +170,25 @@ def check_options(
         Overall OTB average, one of :data:`OTB_AVERAGES`.
     iou_threshold : float
         IoU of a match, in (0, 1].
+    recover_frames : int
+        Final frames that must be tracked for ``recovered``, an integer >= 1.
+    persist : int
+        Frames the error must stay above the threshold for a failure, an integer >= 1.
 
     Raises
     ------
     ConfigError
         If ``iou_threshold`` is not in (0, 1], ``gt_mode`` or ``otb_average`` is unknown,
         ``visibility_threshold`` is not in [0, 1), or it is not 0 with ``gt_mode``
-        ``"amodal"``.
+        ``"amodal"``, or ``recover_frames`` or ``persist`` is not an integer >= 1.
     """
     if not 0.0 < iou_threshold <= 1.0:
         raise ConfigError(f"iou_threshold must be in (0, 1], got {iou_threshold}")
+    for name, value in (("recover_frames", recover_frames), ("persist", persist)):
+        try:
+            metrics._count(value, name)
+        except ValueError as err:
+            raise ConfigError(str(err)) from None
     check_gt_mode(gt_mode, visibility_threshold)
     if otb_average not in OTB_AVERAGES:
         raise ConfigError(
@@ -244,7 +260,8 @@ def evaluate(
     ConfigError
         If an option is out of range.
     """
-    check_options(gt_mode, visibility_threshold, otb_average, iou_threshold)
+    check_options(gt_mode, visibility_threshold, otb_average, iou_threshold,
+                  recover_frames=recover_frames, persist=persist)  # fmt: skip
     est = np.asarray(boxes, dtype=np.float64)
     ids = _int_ids(target_ids, "target_ids")
     name = str(getattr(sequence, "name", ""))
@@ -407,7 +424,8 @@ def evaluate_target(
     >>> boxes = read_benchmark_result("otb.txt", seq.n_frames, "otb")  # doctest: +SKIP
     >>> print(format_table(evaluate_target(seq, boxes, 1)))            # doctest: +SKIP
     """
-    check_options(gt_mode, visibility_threshold, otb_average, iou_threshold)
+    check_options(gt_mode, visibility_threshold, otb_average, iou_threshold,
+                  recover_frames=recover_frames, persist=persist)  # fmt: skip
     est = np.asarray(boxes, dtype=np.float64)
     name = str(getattr(sequence, "name", ""))
     t_n = int(np.asarray(sequence.gt.box).shape[0])
@@ -544,7 +562,8 @@ def evaluate_tracks(
     ConfigError
         If an option is out of range.
     """
-    check_options(gt_mode, visibility_threshold, otb_average, iou_threshold)
+    check_options(gt_mode, visibility_threshold, otb_average, iou_threshold,
+                  recover_frames=recover_frames, persist=persist)  # fmt: skip
     est = np.asarray(boxes, dtype=np.float64)
     ids = _int_ids(track_ids, "track_ids")
     name = str(getattr(sequence, "name", ""))

@@ -22,6 +22,7 @@ Examples
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -231,6 +232,14 @@ def precision_recall(est: ArrayLike, gt: ArrayLike) -> tuple[FloatArray, FloatAr
     return p, r
 
 
+def _count(value: Any, name: str) -> int:
+    """``value`` as an int >= 1 (an int or numpy integer, not a bool); else ValueError
+    naming ``name`` (a fractional count was compared with an int count and never met)."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
+        raise ValueError(f"{name} must be an integer >= 1, got {value!r}")
+    return int(value)
+
+
 def _state(state: ArrayLike) -> NDArray[np.bool_]:
     s = np.asarray(state, dtype=bool)
     if s.ndim != 2 or s.shape[1] < 1:
@@ -287,11 +296,10 @@ def recovery_rate(state: ArrayLike, *, last_k: int = 5) -> float:
     Raises
     ------
     ValueError
-        If ``state`` is not of shape (R, T) with T ≥ 1, or ``last_k`` < 1.
+        If ``state`` is not of shape (R, T) with T ≥ 1, or ``last_k`` is not an integer ≥ 1.
     """
     s = _state(state)
-    if last_k < 1:
-        raise ValueError(f"last_k must be >= 1, got {last_k}")
+    last_k = _count(last_k, "last_k")
     if s.shape[0] == 0:
         return float("nan")
     k = min(last_k, s.shape[1])
@@ -523,13 +531,12 @@ def failure_frame(error: ArrayLike, threshold: float, *, persist: int = 10) -> i
     Raises
     ------
     ValueError
-        If ``error`` is not 1-D or ``persist`` < 1.
+        If ``error`` is not 1-D or ``persist`` is not an integer ≥ 1.
     """
     e = np.asarray(error, dtype=np.float64)
     if e.ndim != 1:
         raise ValueError(f"error must have shape (T,), got {e.shape}")
-    if persist < 1:
-        raise ValueError(f"persist must be >= 1, got {persist}")
+    persist = _count(persist, "persist")
     above = ~(e <= threshold)
     run = 0
     for t, a in enumerate(above):
@@ -561,7 +568,7 @@ def tracked_fraction(error: ArrayLike, threshold: float, *, persist: int = 10) -
     Raises
     ------
     ValueError
-        If ``error`` is not 1-D or ``persist`` < 1.
+        If ``error`` is not 1-D or ``persist`` is not an integer ≥ 1.
     """
     e = np.asarray(error, dtype=np.float64)
     f = failure_frame(e, threshold, persist=persist)

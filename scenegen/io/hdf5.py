@@ -330,10 +330,14 @@ def write(path: str | Path, *sequences: Sequence, compression: str = "gzip") -> 
     Raises
     ------
     ConfigError
-        No sequence, duplicate names, a bad compression or a missing folder.
+        No sequence, an argument that is not a :class:`Sequence` (``write(path, [seq])``),
+        duplicate names, a bad compression or a missing folder.
     """
     if not sequences:
         raise ConfigError("write needs at least one sequence")
+    for seq in sequences:
+        if not isinstance(seq, Sequence):  # a preset name, a list of sequences, ...
+            raise ConfigError(f"write takes Sequence objects, got a {type(seq).__name__}")
     filter_options(compression)
     with atomic_path(path) as tmp, h5py.File(tmp, "w", **_WRITE_OPTIONS) as f:
         _write_header(f)

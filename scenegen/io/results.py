@@ -79,26 +79,33 @@ class TrackerResult:
         Returns
         -------
         list of str
-            One sentence per problem, also for repeated ``target_ids`` and ``order_prob``
-            values that are not probabilities in [0, 1]. A shape problem of
-            ``target_ids``, ``boxes`` or ``orderings``, or ``orderings`` without
-            ``order_prob`` (or the reverse), is the only one given (the later checks
-            need those shapes).
+            One sentence per problem, also for a ``tracker`` that cannot name an HDF5
+            group (not a string, empty, holding ``/``: :func:`scenegen.config.checks.
+            _check_name`), a ``seed`` that is not an integer in [0, 2**64 - 1], target ids
+            that are not integers within int32, repeated ``target_ids``, box values beyond
+            float32 and ``order_prob`` values that are not probabilities in [0, 1]. A shape
+            problem of ``target_ids``, ``boxes`` or ``orderings``, or ``orderings`` without
+            ``order_prob`` (or the reverse), is the only one given (the later checks need
+            those shapes).
         """
-        out: list[str] = []
+        out = _header_problems(self.tracker, self.seed)
         ids, boxes = np.asarray(self.target_ids), np.asarray(self.boxes)
         if ids.ndim != 1:
             return [f"target_ids has shape {ids.shape}, expected (M,)"]
         m = ids.shape[0]
         if boxes.ndim != 3 or boxes.shape[1:] != (m, 4):
             return [f"boxes has shape {boxes.shape}, expected (T, {m}, 4)"]
-        if rep := repeated_ids(ids):
+        if bad := _bad_ids(ids):
+            out.append(bad)
+        elif rep := repeated_ids(ids):
             out.append(rep)
         if bad_box_rows(boxes).any():
             out.append(
                 "boxes has rows that are neither finite with w, h >= 0 nor all NaN "
                 "(a lost target)"
             )
+        elif boxes.size and np.nanmax(np.abs(boxes.astype(np.float64))) > _FLOAT32_MAX:
+            out.append(f"boxes has values beyond float32's range (|value| > {_FLOAT32_MAX:.3g})")
         if (self.orderings is None) != (self.order_prob is None):
             return ["orderings and order_prob must come together"]
         if self.orderings is None:
@@ -116,6 +123,47 @@ class TrackerResult:
         if bad := bad_probabilities(prob):
             out.append(bad)
         return out
+
+
+_FLOAT32_MAX = float(np.finfo(np.float32).max)
+
+
+def _header_problems(tracker: Any, seed: Any) -> list[str]:
+    """The problems with a result's ``tracker`` name (it names the HDF5 group
+    ``/results/<tracker>``: a ``/`` made nested groups that read back as damaged) and its
+    ``seed`` (an integer in [0, 2**64 - 1], as ``--seed`` and sequence files take)."""
+    from scenegen.config.checks import _check_name
+    from scenegen.config.messages import _short
+
+    out = []
+    if not isinstance(tracker, str):
+        out.append(f"tracker must be a string, got {_short(tracker)}")
+    else:
+        try:
+            _check_name("tracker", tracker)
+        except ConfigError as err:
+            out.append(str(err))
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not (
+            0 <= seed <= 2**64 - 1):  # fmt: skip
+        out.append(f"seed must be an integer in [0, 2**64 - 1], got {_short(seed)}")
+    return out
+
+
+def _bad_ids(ids: NDArray[Any]) -> str:
+    """The problem with target ids (M,) that are not integers within int32 ("" if none):
+    they were cast to int32, so 7.6 was stored as 7 and 2**32 + 1 as 1."""
+    info = np.iinfo(np.int32)
+    try:
+        num = ids.astype(np.float64)
+    except (TypeError, ValueError):
+        return f"target_ids must be integers, got {ids[:5].tolist()}"
+    bad = ~np.isfinite(num) | (num != np.round(num)) | (num < info.min) | (num > info.max)
+    if ids.dtype.kind in "iu":  # exact, whatever float64 rounds
+        bad = (ids < info.min) | (ids > info.max)
+    if ids.dtype.kind == "b" or bad.any():
+        first = ids[bad][0].item() if bad.any() else ids[0].item()
+        return f"target_ids must be integers within int32, got {first!r}"
+    return ""
 
 
 def bad_probabilities(prob: ArrayLike) -> str:
@@ -155,14 +203,18 @@ def write_result(path: str | Path, *results: TrackerResult) -> None:
     Raises
     ------
     ConfigError
-        No result, two results of one tracker, a result whose shapes disagree
-        (:meth:`TrackerResult.problems`, which also refuses repeated target ids, box rows
-        neither finite with w, h >= 0 nor all NaN, and ``order_prob`` values outside
-        [0, 1]), or a missing folder.
+        No result, an argument that is not a :class:`TrackerResult`, two results of one
+        tracker, a result whose shapes disagree (:meth:`TrackerResult.problems`, which
+        also refuses a tracker name that cannot name a group, a seed outside [0, 2**64 -
+        1], target ids that are not int32 integers or repeat, box rows neither finite
+        with w, h >= 0 nor all NaN, and ``order_prob`` values outside [0, 1]), or a
+        missing folder.
     """
     if not results:
         raise ConfigError("write_result needs at least one result")
     for r in results:
+        if not isinstance(r, TrackerResult):
+            raise ConfigError(f"write_result takes TrackerResult objects, got a {type(r).__name__}")
         if bad := r.problems():
             raise ConfigError(f"result of tracker {r.tracker!r}: {bad[0]}")
     with atomic_path(path) as tmp, h5py.File(tmp, "w", **_WRITE_OPTIONS) as f:

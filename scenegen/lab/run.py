@@ -380,7 +380,7 @@ def _result(
         order_prob=order_prob,
     )
     if bad := result.problems():
-        raise TrackerError(f"tracker {label!r}: its depth-order output cannot be stored: {bad[0]}")
+        raise TrackerError(f"tracker {label!r}: its output cannot be stored: {bad[0]}")
     return result
 
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import copy
 import json
+import re
 
 import numpy as np
 import pytest
@@ -431,3 +432,44 @@ def test_a_byte_order_mark_is_allowed_in_json_as_in_yaml(tmp_path):
         path = tmp_path / f"c{suffix}"
         path.write_bytes(b"\xef\xbb\xbf" + text.encode())
         assert load_config(path) == from_dict(base())
+
+
+def test_config_classes_check_their_field_types_on_construction(tmp_path):
+    """A config built in Python is read as from_dict reads plain data: a bad choice or type
+    is a ConfigError naming the field (role 'zz' and boundary 'x' were accepted, the
+    first written to files; width 32.5 was a TypeError at generation), and numpy numbers
+    and lists are stored as Python numbers and tuples (np.int64 made write fail: JSON has
+    no int64)."""
+    from scenegen.config import AR2, Appearance, Background, EntitySpec, Motion, SceneConfig
+
+    def ent(**kw):
+        base = dict(name="a", role="target", position=(10.0, 10.0),
+                    appearance=Appearance(shape="ellipse", size=(5, 5)))  # fmt: skip
+        return EntitySpec(**(base | kw))
+
+    for build, message in (
+        (lambda: AR2(boundary="x"), "boundary: must be one of reflect, clamp, free; got 'x'"),
+        (lambda: ent(role="zz"), "role: must be one of target, distractor, occluder, clutter"),
+        (lambda: Background(kind="zz"), "kind: must be one of uniform, noise, texture"),
+        (lambda: SceneConfig(width=32.5, height=24, n_frames=3),
+         "width: must be an integer, got 32.5"),
+        (lambda: SceneConfig(width=None, height=24, n_frames=3),
+         "width: must be an integer, got None"),
+        (lambda: SceneConfig(width=3, height=3, n_frames=1, entities=({"name": "a"},)),
+         "entities[0]: must be of type EntitySpec, got {'name': 'a'}"),
+        (lambda: AR2(boundary="free", sigma="1"), "sigma: must be a number, got '1'"),
+        (lambda: Motion(x=AR2(boundary="free"), y=None), "y: must be of type AR2, got None"),
+        (lambda: ent(position="ab"), "position: must be a list, got 'ab'"),
+    ):  # fmt: skip
+        with pytest.raises(ConfigError, match=f"^{re.escape(message)}"):
+            build()
+    cfg = SceneConfig(width=np.int64(32), height=24, n_frames=np.uint8(3),
+                      sensor_noise=np.float32(0.5), entities=[ent()])  # fmt: skip
+    assert type(cfg.width) is int and type(cfg.sensor_noise) is float
+    assert isinstance(cfg.entities, tuple) and from_dict(to_dict(cfg)) == cfg
+    path = tmp_path / "s.h5"
+    scenegen.write(path, scenegen.generate(cfg, seed=0))
+    assert scenegen.read(path).config == cfg
+    # A Python int given for a float is kept as given (configs built in Python, such as
+    # the presets, store what they hold).
+    assert AR2(boundary="free", sigma=1).sigma.__class__ is int

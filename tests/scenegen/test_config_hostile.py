@@ -11,6 +11,7 @@ import contextlib
 import copy
 import io
 import json
+import re
 import time
 
 import pytest
@@ -376,3 +377,23 @@ def test_an_empty_file_or_a_list_is_one_line(tmp_path, text, message):
     with pytest.raises(ConfigError) as err:
         load_config(path)
     assert str(err.value) == f"{path}: {message}"
+
+
+def test_load_data_never_returns_none(tmp_path):
+    """A JSON file holding ``null`` is refused as an empty YAML file is: load_data
+    documents that it never returns None (it did for JSON)."""
+    from scenegen.config import load_data
+
+    for name in ("c.json", "c.yaml"):
+        path = tmp_path / name
+        path.write_text("null\n")
+        with pytest.raises(ConfigError, match=rf"^{re.escape(str(path))}: config is empty \("):
+            load_data(path)
+
+
+def test_an_unhashable_preset_name_is_a_config_error():
+    # presets.get(["kams-a"]) was a TypeError (unhashable type: 'list').
+    from scenegen import presets
+
+    with pytest.raises(ConfigError, match=r"^unknown preset \['kams-a'\]; valid presets: "):
+        presets.get(["kams-a"])

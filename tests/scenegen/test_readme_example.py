@@ -15,7 +15,7 @@ HEADING = "Testing your own tracker with scenegen"
 def _example() -> tuple[Path, str]:
     source = ROOT / "README.md"
     text = source.read_text(encoding="utf-8")
-    section = text[text.index(HEADING) :]
+    section = text[text.index(f"## {HEADING}\n") :]  # not the contents line
     match = re.search(r"```python\n(.*?)```", section, flags=re.DOTALL)
     assert match is not None, f"{source}: no python code block after {HEADING!r}"
     return source, match.group(1)

@@ -61,6 +61,8 @@ def test_failure_is_nan():
         ("MIL", {"rng": 1.5}, "rng of an OpenCV tracker must be a Generator, an int seed or "
                               "None, not 1.5"),
         ("MIL", {"rng": -(2**31) - 1}, "rng of an OpenCV tracker must be >= -2**31"),
+        # The message was three lines: a SeedSequence's repr.
+        ("MIL", {"rng": np.random.SeedSequence(0)}, "int seed or None, not SeedSequence"),
     ],
 )
 def test_bad_construction_names_the_problem(name, kw, needle):

@@ -50,6 +50,14 @@ import trackers
         ("dps", {"lam": "30"}, "lam must be finite and > 0, got '30'"),
         ("kalman", {"process_std": "1"}, "process_std must be in [0, 1e+06], got '1'"),
         ("annealed", {"alpha": b"0.5"}, "alpha must be in (0, 1), got b'0.5'"),
+        # ... and so were the AR2 dynamics and the annealing noise, read with float():
+        # a1="2" tracked as 2 (AR2(a1="2") kept the text and failed at its first step).
+        ("dps", {"sigma": ("2", "2", "0.001")}, "sigma must be 3 finite non-negative"),
+        ("condensation", {"a1": "2"}, "a1 must be finite, got '2'"),
+        ("ps", {"a2": b"-1"}, "a2 must be finite, got b'-1'"),
+        ("kalman", {"motion": "ar2", "a1": "1.5"}, "a1 must be finite, got '1.5'"),
+        ("annealed", {"sigma": "12"}, "sigma must be a number or 3 numbers"),
+        ("kams", {"sigma": ("30", "15", "7.5")}, "sigma must be a number or 3 numbers"),
     ],
 )
 def test_bad_values_name_the_parameter(name, params, needle):

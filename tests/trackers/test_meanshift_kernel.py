@@ -137,6 +137,12 @@ def test_window_outside_the_frame_stays_put():
         ({"bin_img": np.full((5, 5), 7, dtype=np.int32)}, "bin_img"),
         ({"bin_img": np.zeros((5, 5))}, "bin_img"),
         ({"models": np.zeros(4)}, "models"),
+        # Not numbers: int()'s "cannot convert float NaN to integer", TypeErrors of None
+        # and of text compared with a float.
+        ({"max_iter": float("nan")}, "max_iter must be an integer >= 0, got nan"),
+        ({"max_iter": None}, "max_iter must be an integer >= 0, got None"),
+        ({"eps": "0.5"}, "eps must be >= 0, got '0.5'"),
+        ({"min_distance": None}, "min_distance must be >= 0, got None"),
     ],
 )
 def test_bad_input_raises_value_error_naming_it(kwargs, message):

@@ -229,6 +229,17 @@ def test_dynamics_on_the_boundary_are_accepted_and_stay_finite(name, params):
         assert np.all(np.isfinite(est.extras["effective_dynamics"]))
 
 
+@pytest.mark.parametrize("rng", [0, None, np.random.RandomState(0)])
+def test_dynamics_draw_from_a_generator_only(rng):
+    # A seed was "'int' object has no attribute 'standard_normal'" (AttributeError); a
+    # seed turned into a Generator at every call would repeat the same draws.
+    from trackers.models.dynamics import AR2 as Dynamics
+
+    x = np.zeros((4, 2, 3))
+    with pytest.raises(ValueError, match="rng must be a numpy Generator"):
+        Dynamics().propagate(x, x, np.zeros(3), rng=rng)
+
+
 def test_effective_dynamics_without_noise_is_one():
     frames, boxes = _scene(2)
     tracker = trackers.make("ps", n_particles=30, sigma=(0.0, 2.0, 0.0), rng=0)

@@ -211,7 +211,7 @@ def test_a_users_tracker_that_raises_is_one_line_naming_it(user_dir, monkeypatch
         # A factory failing for its own reasons was "internal error: RuntimeError".
         ("usertrk:wrong_bug", "failed while being built: RuntimeError: model file not found"),
         # Depth-order outputs a result file cannot hold were written, then called invalid.
-        ("usertrk:BadOrderings", "its depth-order output cannot be stored: orderings name "
+        ("usertrk:BadOrderings", "its output cannot be stored: orderings name "
                                  "positions outside 0..0"),
         # A box beyond float32 warned of an overflow, then blamed the depth-order output.
         ("usertrk:Huge", "its box at frame 1 for target 1 is [1e+39, "),

@@ -213,6 +213,26 @@ def test_fractional_ids_and_broken_boxes_are_refused_from_python(seq):
             call(seq, broken, ids)
 
 
+def test_frame_count_options_are_config_errors(seq):
+    # persist=2.5 scored every run as never failing; persist=0 and recover_frames=0 were
+    # metrics' ValueError, recover_frames=1.5 numpy's TypeError.
+    from scenegen.evaluation.evaluate import evaluate_target, evaluate_tracks
+
+    est = np.asarray(seq.gt.box[:, seq.target_indices()], dtype=np.float64)
+    ids = seq.target_ids()
+    calls = (
+        lambda **kw: evaluate(seq, est, ids, **kw),
+        lambda **kw: evaluate_tracks(seq, est, ids, **kw),
+        lambda **kw: evaluate_target(seq, est[:, 0], int(ids[0]), **kw),
+    )
+    for call in calls:
+        for option in ("persist", "recover_frames"):
+            for bad in (0, 2.5, True):
+                with pytest.raises(scenegen.errors.ConfigError,
+                                   match=rf"^{option} must be an integer >= 1, got {bad!r}$"):
+                    call(**{option: bad})
+
+
 def test_failure_frame_is_a_frame_of_the_sequence():
     from scenegen.evaluation import evaluate_tracks
 

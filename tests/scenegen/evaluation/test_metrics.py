@@ -145,6 +145,13 @@ def test_failure_frame_and_tracked_fraction():
     assert m.tracked_fraction(err, 10.0, persist=4) == 1.0
     with pytest.raises(ValueError, match="persist"):
         m.failure_frame(err, 10.0, persist=0)
+    # A fractional count never equalled the run length: the run never failed.
+    for bad in (2.5, True, "3"):
+        with pytest.raises(ValueError, match="^persist must be an integer >= 1, got "):
+            m.failure_frame(err, 10.0, persist=bad)
+        with pytest.raises(ValueError, match="^last_k must be an integer >= 1, got "):
+            m.recovery_rate(np.ones((2, 4), bool), last_k=bad)
+    assert m.failure_frame(err, 10.0, persist=np.int64(3)) == 4
 
 
 def test_mcnemar_hand_worked():

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import re
 
 import h5py
 import numpy as np
@@ -120,6 +121,49 @@ def test_result_round_trip(tmp_path):
         g = f["results/shm"]
         assert g["boxes"].dtype == np.float32 and g["orderings"].dtype == np.int16
         assert g["order_prob"].shape == (4, 2)
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        ({"tracker": "a/b"}, "tracker: must not contain '/', got 'a/b'"),  # nested groups
+        ({"tracker": ""}, "tracker: must not be empty"),  # h5py's ValueError
+        ({"tracker": 3}, "tracker must be a string, got 3"),  # h5py's TypeError
+        ({"seed": 2**64}, "seed must be an integer in [0, 2**64 - 1], got 18446744073709551616"),
+        ({"seed": "7"}, "seed must be an integer in [0, 2**64 - 1], got '7'"),
+        ({"target_ids": np.array([1, 2**32 + 2])}, "target_ids must be integers within int32, "
+                                                   "got 4294967298"),  # stored as 2
+        ({"target_ids": np.array([1, 2.5])}, "target_ids must be integers within int32, "
+                                             "got 2.5"),  # stored as 2
+        ({"boxes": np.full((4, 2, 4), 1e39)}, "boxes has values beyond float32's range"),
+    ],
+)
+def test_write_result_refuses_what_it_cannot_store(tmp_path, change, message):
+    """A result whose tracker name, seed, ids or boxes cannot be stored as given is refused
+    with one line naming the value: it was a raw h5py/numpy error, or stored changed (a
+    tracker 'a/b' as nested groups, read back as damaged; ids cast to int32)."""
+    res = TrackerResult(
+        tracker="shm", params={}, seed=7, sequence="x",
+        target_ids=np.array([1, 2], np.int32), boxes=np.ones((4, 2, 4), np.float32),
+    )  # fmt: skip
+    path = tmp_path / "r.h5"
+    with pytest.raises(scenegen.ConfigError, match=re.escape(message)):
+        write_result(path, dataclasses.replace(res, **change))
+    assert not path.exists()
+    with pytest.raises(scenegen.ConfigError,
+                       match="^write_result takes TrackerResult objects, got a str$"):
+        write_result(path, "shm")
+    write_result(path, dataclasses.replace(res, seed=2**64 - 1, target_ids=np.array([1.0, 2.0])))
+    assert read_result(path).seed == 2**64 - 1
+
+
+def test_write_refuses_what_is_not_a_sequence(tmp_path, seq):
+    # write(path, [seq]) and write(path, "kams-a") were AttributeErrors from inside write.
+    for bad, kind in (([seq], "list"), ("kams-a", "str"), (None, "NoneType")):
+        with pytest.raises(scenegen.ConfigError,
+                           match=f"^write takes Sequence objects, got a {kind}$"):
+            write(tmp_path / "s.h5", seq, bad)
+    assert list(tmp_path.iterdir()) == []
 
 
 @pytest.mark.parametrize("value", ["", "plain", "é ∑ 漢字", "x" * 5000])

@@ -157,11 +157,34 @@ def test_bad_measurement_shape_raises():
     [
         (dict(accel_std=-1.0), "accel_std"),
         (dict(accel_std=1.0, velocity_std=0.0), "velocity_std"),
+        # Not numbers: "1" and None were numpy's TypeError from isfinite, True was 1.
+        (dict(accel_std="1"), "accel_std must be finite and >= 0, got '1'"),
+        (dict(accel_std=None), "accel_std must be finite and >= 0, got None"),
+        (dict(accel_std=1.0, position_std=True), "position_std must be finite and > 0"),
     ],
 )
 def test_bad_model_parameters_raise(kwargs, match):
     with pytest.raises(ValueError, match=match):
         MotionModel.constant_velocity(**kwargs)
+
+
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        (dict(a1=1.0, a2=0.0, noise_std="2"), "noise_std must be finite and >= 0, got '2'"),
+        (dict(a1=1.0, a2=0.0, noise_std=1.0, velocity_std=[5.0]), "velocity_std must be"),
+    ],
+)
+def test_bad_ar2_model_parameters_raise(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        MotionModel.ar2(**kwargs)
+
+
+@pytest.mark.parametrize("n", [1.5, True, "2"])
+def test_the_joint_model_needs_an_integer_count(n):
+    # 1.5 was numpy's "'float' object cannot be interpreted as an integer" (TypeError).
+    with pytest.raises(ValueError, match="n_objects must be an integer, got"):
+        MotionModel.constant_velocity(accel_std=1.0).joint(n)
 
 
 # --- the plain Kalman tracker ------------------------------------------------------------

@@ -113,6 +113,18 @@ def test_same_seed_same_draw():
     (lambda rng: resample_groups(np.ones(4), [2, 3], rng=rng), "sum to 4"),
     (lambda rng: weighted_resample(np.ones(3), np.ones(2), rng=rng), "shape"),
     (lambda rng: weighted_resample(np.ones(3), np.zeros(3), rng=rng), "positive sum"),
+    # Weights of another shape named the group sizes ("must ... sum to -1", "to 0").
+    (lambda rng: resample(np.ones((3, 2)), rng=rng),
+     r"weights must have shape \(N,\) with N >= 1, got \(3, 2\)"),
+    (lambda rng: resample(np.ones(0), rng=rng),
+     r"weights must have shape \(N,\) with N >= 1, got \(0,\)"),
+    (lambda rng: weighted_resample(np.ones((2, 2)), np.ones((2, 2)), rng=rng),
+     r"weights must have shape \(N,\)"),
+    # A seed for rng was "'int' object has no attribute 'random'" (AttributeError).
+    (lambda rng: resample(np.ones(3), rng=0), "rng must be a numpy Generator .*got int"),
+    (lambda rng: resample_groups(np.ones(3), rng=None), "rng must be a numpy Generator"),
+    (lambda rng: weighted_resample(np.ones(3), np.ones(3), rng=1),
+     "rng must be a numpy Generator"),
 ])
 def test_bad_input_raises(call, match):
     with pytest.raises(ValueError, match=match):

@@ -183,6 +183,9 @@ def test_coarse_to_fine_finds_smooth_texture_exactly():
         (dict(min_visible=1.5), "min_visible"),
         (dict(support="disc"), "unknown support 'disc'"),
         (dict(blur=np.inf), "blur"),
+        # Booleans are refused, as documented (True was a radius, a stride of 1).
+        (dict(search_radius=True), "search_radius must be an int in \\[1, 200\\], got True"),
+        (dict(step=True), "step must be an int in \\[1, 8\\], got True"),
     ],
 )
 def test_bad_matcher_parameters(kwargs, match):

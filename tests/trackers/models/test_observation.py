@@ -286,6 +286,17 @@ def test_model_scores_template_at_zero_and_shifted_worse(kind):
     ({"lam": 0.0}, "lam"),
     ({"bins": 0}, "bins"),
     ({"n_parts": 0}, "n_parts"),
+    # Not numbers: numpy's or int()'s own TypeError/ValueError, naming nothing; True was
+    # one bin.
+    ({"bins": None}, "bins must be an integer in \\[1, 256\\], got None"),
+    ({"bins": float("nan")}, "bins must be an integer in \\[1, 256\\], got nan"),
+    ({"bins": True}, "bins must be an integer in \\[1, 256\\], got True"),
+    ({"n_parts": "2"}, "n_parts must be a positive integer, got '2'"),
+    ({"lam": "20"}, "lam must be a positive number, got '20'"),
+    ({"lam": None}, "lam must be a positive number, got None"),
+    ({"s_min": "0.1"}, "s_min must lie in \\[0, 1\\], got '0.1'"),
+    ({"kernel": ["cone"]}, "unknown kernel \\['cone'\\]"),
+    ({"kind": ["hsv"]}, "unknown observation model \\['hsv'\\]"),
 ])
 def test_model_rejects_bad_parameters(kwargs, match):
     with pytest.raises(ValueError, match=match):
@@ -308,6 +319,29 @@ def test_kernel_rejects_bad_input():
                          np.array([0]), KERNEL_UNIFORM, method="fast")
     with pytest.raises(ValueError, match="observe"):
         ColourModel("rgb").observe(np.zeros((4, 4, 3), dtype=np.uint8))
+
+
+@pytest.mark.parametrize("call, match", [
+    # Counts and thresholds that are not numbers: int()'s TypeError for None, its "cannot
+    # convert float NaN to integer" naming no argument, a TypeError comparing text; True
+    # was one bin.
+    (lambda b, f: region_histograms(b, np.ones((1, 4)), None, KERNEL_UNIFORM),
+     "n_bins must be a positive integer, got None"),
+    (lambda b, f: region_histograms(b, np.ones((1, 4)), float("nan"), KERNEL_UNIFORM),
+     "n_bins must be a positive integer, got nan"),
+    (lambda b, f: region_histograms(b, np.ones((1, 4)), 4, KERNEL_UNIFORM, None),
+     "n_parts must be a positive integer, got None"),
+    (lambda b, f: prepare_references(np.full((1, 4), 0.25), None),
+     "n_parts must be a positive divisor of refs.shape"),
+    (lambda b, f: quantize_rgb(f, None), "bins must be an integer in \\[1, 256\\], got None"),
+    (lambda b, f: quantize_rgb(f, True), "bins must be an integer in \\[1, 256\\], got True"),
+    (lambda b, f: quantize_hsv(f, s_bins=float("nan")), "s_bins must be an integer in"),
+    (lambda b, f: quantize_hsv(f, s_min="0.1"), "s_min must lie in \\[0, 1\\], got '0.1'"),
+    (lambda b, f: ColourModel(kernel="box", box_levels=None), "box_levels must be an integer"),
+])
+def test_kernel_entry_points_name_a_bad_number(call, match):
+    with pytest.raises(ValueError, match=match):
+        call(np.zeros((10, 10), dtype=np.int32), np.zeros((4, 4, 3), dtype=np.uint8))
 
 
 _DETERMINISM_SCRIPT = """
