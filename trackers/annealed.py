@@ -465,7 +465,8 @@ def _layer_sigmas(sigma: float | Sequence[float], decay: float,
                   n_layers: int) -> NDArray[np.float64]:
     """Noise standard deviation (n_layers,) of each layer, first layer first."""
     try:
-        if np.asarray(sigma).dtype.kind == "b":  # True was read as 1 px
+        # True was read as 1 px, and "12" (or ("12", "6", "3")) as 12 px: numbers only.
+        if np.asarray(sigma).dtype.kind in "bUS":
             raise TypeError(sigma)
         if np.ndim(sigma) == 0:
             sigmas = float(sigma) * decay ** np.arange(n_layers)  # type: ignore[arg-type]

@@ -111,6 +111,7 @@ __all__ = [
     "Tracker",
     "as_generator",
     "box_array",
+    "check_generator",
     "check_boxes",
     "check_frame",
 ]
@@ -149,6 +150,29 @@ def as_generator(rng: RngLike) -> np.random.Generator:
     # True was seed 1; a SeedSequence's repr took three lines.
     what = repr(rng) if isinstance(rng, (int, np.integer, float, str)) else type(rng).__name__
     raise ValueError(f"rng must be a numpy Generator, a non-negative int or None, not {what}")
+
+
+def check_generator(rng: Any) -> None:
+    """Refuse an ``rng`` that is not a ``numpy.random.Generator``, in one line.
+
+    For the functions that draw from a Generator they are given (resamplers, dynamics):
+    unlike a tracker's ``rng`` (:func:`as_generator`), a seed there would restart the
+    same draws at every call, so it is refused rather than turned into a Generator.
+
+    Parameters
+    ----------
+    rng : Any
+        The argument to check.
+
+    Raises
+    ------
+    ValueError
+        If ``rng`` is not a Generator (a seed, None, a ``RandomState``), naming its type.
+    """
+    if not isinstance(rng, np.random.Generator):
+        # An int was "'int' object has no attribute 'random'" (AttributeError).
+        raise ValueError(f"rng must be a numpy Generator (numpy.random.default_rng(seed)), "
+                         f"got {type(rng).__name__}")
 
 
 @dataclass

@@ -315,8 +315,10 @@ def cv2_seed(rng: np.random.Generator | int | None) -> int | None:
     if isinstance(rng, np.random.Generator):
         return int(rng.integers(2**31))
     if isinstance(rng, bool) or not isinstance(rng, (int, np.integer)):
+        # A SeedSequence's repr took three lines: name the type of what is not a number.
+        what = repr(rng) if isinstance(rng, (bool, float, str)) else type(rng).__name__
         raise ValueError(f"rng of an OpenCV tracker must be a Generator, an int seed or None, "
-                         f"not {rng!r}")  # fmt: skip
+                         f"not {what}")  # fmt: skip
     seed = int(rng)
     if -(2**31) <= seed < 2**31:
         return seed

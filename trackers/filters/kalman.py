@@ -194,8 +194,10 @@ class MotionModel:
         Raises
         ------
         ValueError
-            If ``n_objects < 1``.
+            If ``n_objects`` is not an integer >= 1.
         """
+        if isinstance(n_objects, (bool, np.bool_)) or not isinstance(n_objects, (int, np.integer)):
+            raise ValueError(f"n_objects must be an integer, got {n_objects!r}")
         if n_objects < 1:
             raise ValueError(f"n_objects must be >= 1, got {n_objects}")
         eye = np.eye(n_objects)
@@ -209,7 +211,11 @@ class MotionModel:
 
 
 def _check_positive(name: str, value: float, *, allow_zero: bool = False) -> None:
-    ok = np.isfinite(value) and (value >= 0 if allow_zero else value > 0)
+    # Only numbers: "1" and None failed in np.isfinite with numpy's own TypeError, and
+    # True was read as 1.
+    number = (not isinstance(value, (bool, np.bool_))
+              and isinstance(value, (int, float, np.integer, np.floating)))
+    ok = number and np.isfinite(value) and (value >= 0 if allow_zero else value > 0)
     if not ok:
         bound = ">= 0" if allow_zero else "> 0"
         raise ValueError(f"{name} must be finite and {bound}, got {value!r}")

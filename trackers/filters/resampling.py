@@ -27,6 +27,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from trackers.base import check_generator
 from trackers.kernels.sampling import MULTINOMIAL, STRATIFIED, SYSTEMATIC, inverse_cdf_groups
 from trackers.kernels.stages import normalise_groups_checked
 
@@ -155,13 +156,25 @@ def resample_groups(
     Raises
     ------
     ValueError
-        For an unknown method, negative or non-finite weights, a group of zero total
-        weight, or sizes that do not sum to N.
+        For an unknown method, weights not of shape (N,) with N >= 1, negative or
+        non-finite weights, a group of zero total weight, sizes that do not sum to N, or
+        an ``rng`` that is not a Generator (a seed is refused:
+        ``trackers.base.check_generator``).
     """
     _check_method(method)
-    w = np.asarray(weights)
-    sizes = _check_sizes(sizes, w.shape[0] if w.ndim == 1 else -1)
+    check_generator(rng)
+    w = _weights_shape(weights, "weights")
+    sizes = _check_sizes(sizes, w.shape[0])
     return _resample_normalised(_normalise_groups(w, sizes, "weights"), sizes, method, rng)
+
+
+def _weights_shape(weights, name):
+    """``weights`` as an array, checked (N,) with N >= 1 (a (N, 1) or an empty array was
+    "group sizes must be positive and sum to -1" or "to 0", naming no argument)."""
+    w = np.asarray(weights)
+    if w.ndim != 1 or w.size < 1:
+        raise ValueError(f"{name} must have shape (N,) with N >= 1, got {w.shape}")
+    return w
 
 
 def _check_method(method):
@@ -264,17 +277,18 @@ def weighted_resample_groups(
     Raises
     ------
     ValueError
-        For weights or ``g`` that are negative or not finite, a group where π g sums to
-        zero, or the cases of ``resample_groups``.
+        For weights or ``g`` that are negative or not finite, ``g`` not of the shape of
+        the weights, a group where π g sums to zero, or the cases of ``resample_groups``.
     """
     _check_method(method)
-    w = np.asarray(weights, dtype=np.float64)
+    check_generator(rng)
+    w = _weights_shape(weights, "weights")
     gv = np.asarray(g, dtype=np.float64)
     if gv.shape != w.shape:
         raise ValueError(f"g must have the shape of weights {w.shape}, got {gv.shape}")
-    if gv.size and not _finite_non_negative(gv):
+    if not _finite_non_negative(gv):
         raise ValueError("g must be finite and non-negative")
-    sizes = _check_sizes(sizes, w.shape[0] if w.ndim == 1 else -1)
+    sizes = _check_sizes(sizes, w.shape[0])
     # ρ ∝ π g per group; the new weight π_k / ρ_k = (Σ_c π g) / g_k is 1 / g_k up to the
     # group's constant, which the final normalisation removes. Drawn ancestors have
     # ρ_k > 0, hence g_k > 0.

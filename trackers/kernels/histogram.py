@@ -76,7 +76,7 @@ from trackers.kernels.profiles import (
     _pixel_range,
     box_kernel_levels,
 )
-from trackers.kernels.quantize import hsv_n_bins, quantize_hsv, quantize_rgb
+from trackers.kernels.quantize import _is_integer, hsv_n_bins, quantize_hsv, quantize_rgb
 
 __all__ = [
     "DEFAULT_BOX_LEVELS",
@@ -270,7 +270,7 @@ def _check_region_args(bin_img, boxes, n_bins, kernel, n_parts, check_bins=True)
     if img.ndim != 2 or not np.issubdtype(img.dtype, np.integer):
         raise ValueError(f"bin_img must be an integer array of shape (H, W), got "
                          f"{img.dtype} {img.shape}")
-    if int(n_bins) != n_bins or n_bins < 1:
+    if not _is_integer(n_bins) or n_bins < 1:
         raise ValueError(f"n_bins must be a positive integer, got {n_bins!r}")
     if check_bins and img.size and (img.min() < 0 or img.max() >= n_bins):
         raise ValueError(f"bin_img values must lie in [0, {n_bins}), got "
@@ -278,7 +278,7 @@ def _check_region_args(bin_img, boxes, n_bins, kernel, n_parts, check_bins=True)
     if kernel not in KERNELS.values():
         raise ValueError(f"kernel must be one of {sorted(KERNELS.values())} "
                          f"({', '.join(KERNELS)}), got {kernel!r}")
-    if int(n_parts) != n_parts or n_parts < 1:
+    if not _is_integer(n_parts) or n_parts < 1:
         raise ValueError(f"n_parts must be a positive integer, got {n_parts!r}")
     bx = np.ascontiguousarray(boxes, dtype=np.float64)
     if bx.ndim != 2 or bx.shape[1] != 4:
@@ -487,7 +487,7 @@ def prepare_references(refs: NDArray[np.floating], n_parts: int = 1) -> Prepared
     q = np.ascontiguousarray(refs, dtype=np.float64)
     if q.ndim != 2 or q.shape[0] < 1 or q.shape[1] < 1:
         raise ValueError(f"refs must have shape (R, n_parts * n_bins), got {q.shape}")
-    if int(n_parts) != n_parts or n_parts < 1 or q.shape[1] % n_parts:
+    if not _is_integer(n_parts) or n_parts < 1 or q.shape[1] % n_parts:
         raise ValueError(f"n_parts must be a positive divisor of refs.shape[1] = "
                          f"{q.shape[1]}, got {n_parts!r}")
     n_parts = int(n_parts)

@@ -45,6 +45,7 @@ from numba import njit
 from numpy.typing import NDArray
 
 from trackers.kernels.histogram import KERNEL_CONE, KERNEL_EPANECHNIKOV
+from trackers.kernels.quantize import _is_integer, _is_number
 
 __all__ = ["MEAN_SHIFT_KERNELS", "MeanShiftResult", "mean_shift"]
 
@@ -401,10 +402,10 @@ def _checked_inputs(bin_img, models, model_index, centres, sizes, *, kernel, max
     if kernel not in MEAN_SHIFT_KERNELS.values():
         raise ValueError(f"kernel must be KERNEL_EPANECHNIKOV ({KERNEL_EPANECHNIKOV}) or "
                          f"KERNEL_CONE ({KERNEL_CONE}), got {kernel!r}")
-    if int(max_iter) != max_iter or max_iter < 0:
+    if not _is_integer(max_iter) or max_iter < 0:
         raise ValueError(f"max_iter must be an integer >= 0, got {max_iter!r}")
-    if not (eps >= 0.0):
+    if not (_is_number(eps) and eps >= 0.0):
         raise ValueError(f"eps must be >= 0, got {eps!r}")
-    if not (min_distance >= 0.0):
+    if not (_is_number(min_distance) and min_distance >= 0.0):
         raise ValueError(f"min_distance must be >= 0, got {min_distance!r}")
     return img, q, idx, y, hw

@@ -14,6 +14,8 @@ import numpy as np
 from numba import njit
 from numpy.typing import NDArray
 
+from trackers.kernels.quantize import _is_integer
+
 __all__ = [
     "DEFAULT_BOX_LEVELS",
     "KERNEL_BOX",
@@ -72,7 +74,7 @@ def box_kernel_levels(levels: int = DEFAULT_BOX_LEVELS) -> tuple[NDArray[np.floa
     ValueError
         If ``levels`` is not an integer in [1, 16].
     """
-    if isinstance(levels, bool) or int(levels) != levels or not 1 <= levels <= _MAX_BOX_LEVELS:
+    if not _is_integer(levels) or not 1 <= levels <= _MAX_BOX_LEVELS:
         raise ValueError(f"box_levels must be an integer in [1, {_MAX_BOX_LEVELS}], got "
                          f"{levels!r}")
     n = int(levels)

@@ -21,8 +21,24 @@ def _check_frame(frame: NDArray[np.uint8]) -> NDArray[np.uint8]:
     return np.ascontiguousarray(arr)
 
 
+def _is_number(value: object) -> bool:
+    """Whether ``value`` is a real number (int or float, numpy's too), not a bool or text.
+
+    The one test of the kernels' and the colour model's numeric arguments: None and text
+    failed in ``int()`` or a comparison with their own TypeError, and True was 1.
+    """
+    return (not isinstance(value, (bool, np.bool_))
+            and isinstance(value, (int, float, np.integer, np.floating)))
+
+
+def _is_integer(value: object) -> bool:
+    """Whether ``value`` is an integer or an integral finite float (not a bool): NaN failed
+    in ``int()`` with "cannot convert float NaN to integer", naming no argument."""
+    return _is_number(value) and bool(np.isfinite(value)) and int(value) == value
+
+
 def _check_bin_count(name: str, value: int) -> int:
-    if int(value) != value or not 1 <= value <= 256:
+    if not _is_integer(value) or not 1 <= value <= 256:
         raise ValueError(f"{name} must be an integer in [1, 256], got {value!r}")
     return int(value)
 
@@ -192,7 +208,7 @@ def quantize_hsv(
     s_bins = _check_bin_count("s_bins", s_bins)
     v_bins = _check_bin_count("v_bins", v_bins)
     for name, val in (("s_min", s_min), ("v_min", v_min)):
-        if not 0.0 <= val <= 1.0:
+        if not (_is_number(val) and 0.0 <= val <= 1.0):
             raise ValueError(f"{name} must lie in [0, 1], got {val!r}")
     s_thr = int(np.floor(s_min * 2**20))
     v_thr = int(np.ceil(v_min * 255 - 1e-9))

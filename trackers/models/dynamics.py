@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from trackers.base import MAX_BOX_VALUE
+from trackers.base import MAX_BOX_VALUE, check_generator
 
 __all__ = ["AR2", "MAX_SIGMA_A", "MAX_SIGMA_UV", "boxes_from_states", "check_ar2",
            "check_ar2_coefficients", "states_from_boxes"]
@@ -79,8 +79,9 @@ def check_ar2(sigma: object, a1: object, a2: object
     """
     try:
         items = [] if isinstance(sigma, (str, bytes)) else list(sigma)  # type: ignore[call-overload]
-        # True was read as 1 px.
-        sig = tuple(math.nan if isinstance(v, bool) else float(v) for v in items)
+        # True was read as 1 px, and "2" as 2 px: a number field takes numbers only.
+        sig = tuple(math.nan if isinstance(v, (bool, str, bytes)) else float(v)
+                    for v in items)
     except (TypeError, ValueError):
         sig = ()
     if len(sig) != 3 or not all(math.isfinite(v) and v >= 0 for v in sig):
@@ -104,7 +105,7 @@ def check_ar2_coefficients(a1: object, a2: object) -> tuple[float, float]:
     Parameters
     ----------
     a1, a2 : float
-        AR coefficients A1, A2 (booleans are refused).
+        AR coefficients A1, A2 (booleans and numbers written as text are refused).
 
     Returns
     -------
@@ -132,7 +133,8 @@ def check_ar2_coefficients(a1: object, a2: object) -> tuple[float, float]:
             x = float(val)  # type: ignore[arg-type]
         except (TypeError, ValueError):
             x = math.nan
-        if isinstance(val, bool) or not math.isfinite(x):
+        # Text ("2") was read as a number; booleans too (True as 1).
+        if isinstance(val, (bool, str, bytes)) or not math.isfinite(x):
             raise ValueError(f"{name} must be finite, got {val!r}")
         coef.append(x)
     c1, c2 = coef
@@ -257,6 +259,12 @@ class AR2:
         Returns
         -------
         ndarray of shape (..., 3)
+
+        Raises
+        ------
+        ValueError
+            If ``rng`` is not a Generator (``trackers.base.check_generator``).
         """
+        check_generator(rng)
         noise = rng.standard_normal(np.shape(x)) * self._sigma
         return mean + self.a1 * (x - mean) + self.a2 * (x_prev - mean) + noise

@@ -347,9 +347,9 @@ def check_matcher_params(
         Naming the first bad value (``search_radius`` and ``step`` must be ints, not
         integral floats; booleans and non-finite numbers are refused).
     """
-    if not isinstance(search_radius, (int, np.integer)) or not 1 <= search_radius <= 200:
+    if not _is_int(search_radius) or not 1 <= search_radius <= 200:
         raise ValueError(f"search_radius must be an int in [1, 200], got {search_radius!r}")
-    if not isinstance(step, (int, np.integer)) or not 1 <= step <= 8:
+    if not _is_int(step) or not 1 <= step <= 8:
         raise ValueError(f"step must be an int in [1, 8], got {step!r}")
     if not 0 < _real(min_visible) <= 1:
         raise ValueError(f"min_visible must be in (0, 1], got {min_visible!r}")
@@ -357,6 +357,11 @@ def check_matcher_params(
         raise ValueError(f"unknown support {support!r}; valid: {', '.join(SUPPORTS)}")
     if not 0 <= _real(blur) <= 20:
         raise ValueError(f"blur must be in [0, 20] pixels, got {blur!r}")
+
+
+def _is_int(value: object) -> bool:
+    """Whether ``value`` is an int (numpy's too) and not a bool (True was a radius of 1)."""
+    return isinstance(value, (int, np.integer)) and not isinstance(value, bool)
 
 
 def _real(value: object) -> float:

@@ -82,6 +82,7 @@ from trackers.kernels.histogram import (
     region_histograms,
 )
 from trackers.kernels.meanshift import MEAN_SHIFT_KERNELS, MeanShiftResult, mean_shift
+from trackers.kernels.quantize import _is_integer, _is_number
 
 __all__ = [
     "MODELS",
@@ -225,21 +226,23 @@ class ColourModel:
         v_min: float = 0.2,
         box_levels: int = DEFAULT_BOX_LEVELS,
     ) -> None:
-        if kind not in MODELS:
+        if not isinstance(kind, str) or kind not in MODELS:
             raise ValueError(f"unknown observation model {kind!r}; valid: {', '.join(MODELS)}")
         default_parts, default_kernel = MODELS[kind]
         n_parts = default_parts if n_parts is None else n_parts
         kernel = default_kernel if kernel is None else kernel
-        if int(bins) != bins or not 1 <= bins <= 256:
+        # Numbers only, checked without converting: None, text and NaN were TypeErrors or
+        # int()'s own message, and True was one bin.
+        if not (_is_integer(bins) and 1 <= bins <= 256):
             raise ValueError(f"bins must be an integer in [1, 256], got {bins!r}")
-        if int(n_parts) != n_parts or n_parts < 1:
+        if not (_is_integer(n_parts) and n_parts >= 1):
             raise ValueError(f"n_parts must be a positive integer, got {n_parts!r}")
-        if kernel not in KERNELS:
+        if not isinstance(kernel, str) or kernel not in KERNELS:
             raise ValueError(f"unknown kernel {kernel!r}; valid: {', '.join(KERNELS)}")
-        if not (np.isfinite(lam) and lam > 0):
+        if not (_is_number(lam) and np.isfinite(lam) and lam > 0):
             raise ValueError(f"lam must be a positive number, got {lam!r}")
         for name, val in (("s_min", s_min), ("v_min", v_min)):
-            if not 0.0 <= val <= 1.0:
+            if not (_is_number(val) and 0.0 <= val <= 1.0):
                 raise ValueError(f"{name} must lie in [0, 1], got {val!r}")
         self.kind = kind
         self.bins = int(bins)
