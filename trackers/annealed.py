@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -28,11 +29,15 @@ from trackers.meanshift import (
 )
 from trackers.models.observation import FrameObservation
 from trackers.params import (
+    RNG_RANDOM,
+    FieldDoc,
     TrackerParams,
     check_choice,
     check_integer,
     check_number,
     check_particle_count,
+    choices,
+    documented,
 )
 
 __all__ = [
@@ -225,45 +230,71 @@ def check_particles(params: TrackerParams) -> None:
     check_choice(params, "resampler", RESAMPLERS)
 
 
+@documented()
 @dataclass(frozen=True)
 class AnnealedParams(ColourParams):
-    """Parameters of the annealed particle filter (documented on ``AnnealedPF``).
+    """Parameters of the annealed particle filter.
 
     ``sigma`` is stored as a float, or as a tuple of ``n_layers`` floats.
 
     Parameters
     ----------
-    kernel : {"cone", "epanechnikov"}, default "cone"
-        Histogram kernel (``ColourParams``).
-    bins : int, default 10
-        Bins per RGB channel, in [1, 32].
-    n_particles : int, default 100
-        Particles per target N, in [1, ``trackers.params.MAX_PARTICLES``].
-    n_layers : int, default 3
-        Annealing layers per frame, in [1, ``MAX_LAYERS``].
-    lam : float, default 1000.0
-        λ of the weighting function exp(−λ d²), finite and > 0.
-    sigma : float or sequence of float, default 12.0
-        Noise standard deviation in px: the first layer's (a number), or one per layer
-        (``n_layers`` numbers); finite and >= 0.
-    sigma_decay : float, default 0.5
-        Ratio between successive layers' noise when ``sigma`` is a number, in (0, 1].
-    schedule : {"adaptive", "geometric"}, default "adaptive"
-        How β is chosen for the layers before the last.
-    alpha : float, default 0.5
-        Survival rate of the adaptive schedule, in (0, 1).
-    beta_ratio : float, default 0.5
-        Ratio of the geometric schedule, in (0, 1].
-    estimate : {"mean", "mode"}, default "mean"
-        Weighted mean of all the last layer's particles, or of its main mode.
-    resampler : {"systematic", "multinomial", "stratified", "residual"}, default "systematic"
-        Resampling method (``trackers.filters.resampling``).
+    {parameters}
 
     Raises
     ------
     ValueError
         For a bad value, naming the parameter.
     """
+
+    FIELD_DOCS: ClassVar[dict[str, FieldDoc]] = {
+        "n_particles": ("int", "Particles per target, N, in [1, "
+                              "``trackers.params.MAX_PARTICLES``]."),
+        "n_layers": ("int", "Annealing layers per frame, M + 1 (each one weighting), in "
+                            "[1, ``trackers.annealed.MAX_LAYERS``]."),
+        "lam": ("float", "λ of the weighting function exp(−λ d²), finite and > 0. **(open)** "
+                         "The KAMS paper gives none; we default to 1000, not the DPS value "
+                         "20: on the kams presets the target's window matches its model to "
+                         "d ≈ 0–0.02 and the nearest clutter discs to d ≈ 0.03–0.2, so "
+                         "λ = 20 weights them within a factor of 2 and the weighted mean "
+                         "straddles modes (kams-a, seeds 0–9, runs tracked: annealed 1/10 at "
+                         "λ = 20, 7/10 at λ = 1000; kams 6/10 at λ = 20, 10/10 at λ = 400 and "
+                         "1000; hybrid 7/10 at λ = 200, 9/10 at λ = 1000)."),
+        "sigma": ("float or tuple of float",
+                  "**(open)** Noise per layer, in px, finite and >= 0. A sequence gives each "
+                  "layer's standard deviation, first layer first (``n_layers`` numbers); a "
+                  "number is the first layer's, each later layer multiplying it by "
+                  "``sigma_decay`` (noise shrinks as the weighting sharpens, as Deutscher et "
+                  "al.'s P_m does). The default 12 px suits the kams presets, whose target "
+                  "jumps by about 6–12 px a frame on kams-a (annealed on kams-a, seeds 0–9, "
+                  "λ = 1000: 7/10 runs tracked at 12 px, 6/10 at 8 px)."),
+        "sigma_decay": ("float", "Ratio between successive layers' noise when ``sigma`` is a "
+                                 "number, in (0, 1]."),
+        "schedule": (choices(SCHEDULES),
+                     "**(open)** How β_m is chosen for the layers m > 0 (β_0 = 1 always): "
+                     '"adaptive": per layer and target, the largest β in (0, 1] keeping the '
+                     "survival rate (Σ w)² / (N Σ w²) at least ``alpha`` (the PARSEC "
+                     "bodytrack rule), but never below the previous layer's β; "
+                     '"geometric": fixed β_m = ``beta_ratio`` ** m. **(open, decided)** The '
+                     "survival rule alone can lower β from one layer to the next (the new "
+                     "layer's particles, moved by noise or mean shift, may be spread over "
+                     "worse likelihoods than the last layer's were): on kams-a/b/d, seeds "
+                     "0–2, 40 frames, β fell between consecutive adaptive layers in 0–8 % of "
+                     'cases for "annealed" and 7–27 % for "kams". An annealing schedule '
+                     "sharpens the weighting monotonically (Deutscher et al.: β_M < … < β_0), "
+                     "so such a layer keeps the previous β instead; its survival rate is then "
+                     'below ``alpha`` (``Estimate.extras["survival"]`` reports it), every '
+                     "other adaptive layer's is ``alpha`` to the search's precision (0.5 %)."),
+        "alpha": ("float", "Survival rate of the adaptive schedule, in (0, 1)."),
+        "beta_ratio": ("float", "Ratio of the geometric schedule, in (0, 1]."),
+        "estimate": (choices(ESTIMATES),
+                     '**(open)** "mean" (KAMS): the weighted mean of the last layer; "mode": '
+                     "the weighted mean of the particles within half the target's smaller "
+                     "box side of the heaviest particle, which does not average a set split "
+                     "between the target and a distractor (kams on kams-b, seeds 0–9: 4/10 "
+                     'runs tracked to the end with "mean", 6/10 with "mode").'),
+        "resampler": (choices(RESAMPLERS), "Resampling method (``trackers.filters.resampling``)."),
+    }
 
     n_particles: int = 100
     n_layers: int = 3
@@ -301,6 +332,7 @@ class AnnealedParams(ColourParams):
         return _layer_sigmas(self.sigma, self.sigma_decay, self.n_layers)
 
 
+@documented(extra=RNG_RANDOM)
 class AnnealedPF(Tracker):
     """Annealed particle filter on colour histograms, one particle set per target.
 
@@ -323,58 +355,7 @@ class AnnealedPF(Tracker):
 
     Parameters
     ----------
-    n_particles : int, optional
-        Particles per target, N.
-    n_layers : int, optional
-        Annealing layers per frame, M + 1 (each one weighting).
-    lam : float, optional
-        λ of the weighting function exp(−λ d²). **(open)** The KAMS paper gives none; we
-        default to 1000, not the DPS value 20: on the kams presets the target's window
-        matches its model to d ≈ 0–0.02 and the nearest clutter discs to d ≈ 0.03–0.2, so
-        λ = 20 weights them within a factor of 2 and the weighted mean straddles modes
-        (kams-a, seeds 0–9, runs tracked: annealed 1/10 at λ = 20, 7/10 at λ = 1000; kams
-        6/10 at λ = 20, 10/10 at λ = 400 and 1000).
-    sigma : float or sequence of float, optional
-        **(open)** Noise per layer, in pixels. A sequence gives each layer's standard
-        deviation, first layer first; a number is the first layer's, each later layer
-        multiplying it by ``sigma_decay`` (noise shrinks as the weighting sharpens, as
-        Deutscher et al.'s P_m does). The default 12 px suits the kams presets, whose
-        target jumps by about 6–12 px a frame on kams-a (annealed on kams-a, seeds 0–9,
-        λ = 1000: 7/10 runs tracked at 12 px, 6/10 at 8 px).
-    sigma_decay : float, optional
-        Ratio between successive layers' noise when ``sigma`` is a number, in (0, 1].
-    schedule : str, optional
-        **(open)** How β_m is chosen for the layers m > 0 (β_0 = 1 always):
-        ``"adaptive"`` (default): per layer and target, the largest β in (0, 1] keeping the
-        survival rate (Σ w)² / (N Σ w²) at least ``alpha`` (the PARSEC bodytrack rule),
-        but never below the previous layer's β; ``"geometric"``: fixed
-        β_m = ``beta_ratio`` ** m. **(open, decided)** The survival rule alone can lower
-        β from one layer to the next (the new layer's particles, moved by noise or mean
-        shift, may be spread over worse likelihoods than the last layer's were): on
-        kams-a/b/d, seeds 0–2, 40 frames, β fell between consecutive adaptive layers in
-        0–8 % of cases for "annealed" and 7–27 % for "kams". An annealing schedule
-        sharpens the weighting monotonically (Deutscher et al.: β_M < … < β_0), so such
-        a layer keeps the previous β instead; its survival rate is then below ``alpha``
-        (``Estimate.extras["survival"]`` reports it), every other adaptive layer's is
-        ``alpha`` to the search's precision (0.5 %).
-    alpha : float, optional
-        Survival rate of the adaptive schedule, in (0, 1).
-    beta_ratio : float, optional
-        Ratio of the geometric schedule, in (0, 1].
-    estimate : str, optional
-        **(open)** ``"mean"`` (default; KAMS): the weighted mean of the last layer;
-        ``"mode"``: the weighted mean of the particles within half the target's smaller
-        box side of the heaviest particle, which does not average a set split between the
-        target and a distractor (kams on kams-b, seeds 0–9: 4/10 runs tracked to the end
-        with "mean", 6/10 with "mode").
-    resampler : str, optional
-        Resampling method, by name (``trackers.filters.resampling``).
-    kernel : str, optional
-        Histogram kernel: ``"cone"`` (KAMS) or ``"epanechnikov"``.
-    bins : int, optional
-        Bins per RGB channel.
-    rng : Generator, int or None, optional
-        Source of all randomness.
+    {parameters}
 
     Attributes
     ----------

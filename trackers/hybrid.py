@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
 
-from trackers.annealed import check_particles, resample_targets, weighted_estimate
+from trackers.annealed import AnnealedParams, check_particles, resample_targets, weighted_estimate
 from trackers.base import Estimate, Tracker
 from trackers.filters.weights import normalised_weights
 from trackers.meanshift import (
@@ -18,40 +19,38 @@ from trackers.meanshift import (
     set_mean_shift,
     window_boxes,
 )
-from trackers.params import check_number
+from trackers.params import RNG_RANDOM, FieldDoc, check_number, documented
 
 __all__ = ["HybridPF", "HybridParams"]
 
 
+@documented()
 @dataclass(frozen=True)
 class HybridParams(MeanShiftParams):
     """Parameters of the hybrid filter: ``MeanShiftParams`` (10 iterations by default) and
-    the particle set's (documented on ``HybridPF``).
+    the particle set's.
 
     Parameters
     ----------
-    kernel : {"cone", "epanechnikov"}, default "cone"
-        Histogram kernel (``ColourParams``).
-    bins : int, default 10
-        Bins per RGB channel, in [1, 32].
-    max_iter : int, default 10
-        Mean-shift iterations per particle and frame, in [0, ``MAX_ITER``].
-    eps : float, default 0.5
-        Mean-shift stopping shift in px, >= 0.
-    n_particles : int, default 100
-        Particles per target N, in [1, ``trackers.params.MAX_PARTICLES``].
-    lam : float, default 1000.0
-        λ of the likelihood exp(−λ d²), finite and > 0.
-    sigma : float, default 8.0
-        Position noise after the constant-velocity prediction, in px, finite and >= 0.
-    resampler : {"systematic", "multinomial", "stratified", "residual"}, default "systematic"
-        Resampling method (``trackers.filters.resampling``).
+    {parameters}
 
     Raises
     ------
     ValueError
         For a bad value, naming the parameter.
     """
+
+    FIELD_DOCS: ClassVar[dict[str, FieldDoc]] = {
+        "max_iter": ("int", "Mean-shift iterations per particle and frame, in [0, "
+                            "``trackers.meanshift.MAX_ITER``]. Measured on kams-a, seeds "
+                            "0–9, λ = 1000: with ``sigma`` 8 px and 10 iterations 9/10 runs "
+                            "tracked to the end; 7/10 with 5 iterations, 4/10 with 4 px."),
+        "n_particles": AnnealedParams.FIELD_DOCS["n_particles"],
+        "lam": AnnealedParams.FIELD_DOCS["lam"],
+        "sigma": ("float", "Position noise added after the constant-velocity prediction, in "
+                           "px; finite and >= 0."),
+        "resampler": AnnealedParams.FIELD_DOCS["resampler"],
+    }
 
     max_iter: int = 10
     n_particles: int = 100
@@ -65,6 +64,7 @@ class HybridParams(MeanShiftParams):
         check_number(self, "sigma", low=0.0)
 
 
+@documented(extra=RNG_RANDOM)
 class HybridPF(Tracker):
     """Condensation with a constant-velocity model whose particles each run mean shift.
 
@@ -81,30 +81,7 @@ class HybridPF(Tracker):
 
     Parameters
     ----------
-    n_particles : int, optional
-        Particles per target (the KAMS paper's experiment: 100).
-    lam : float, optional
-        λ of the likelihood exp(−λ d²). **(open)** The KAMS paper gives none; we
-        default to 1000, not the DPS value 20: on the kams presets the target's window
-        matches its model to d ≈ 0–0.02 and the nearest clutter discs to d ≈ 0.03–0.2, so
-        λ = 20 weights them within a factor of 2 and the weighted mean straddles modes
-        (hybrid on kams-a, seeds 0–9: 7/10 runs tracked at λ = 200, 9/10 at λ = 1000).
-    sigma : float, optional
-        Position noise added after the constant-velocity prediction, in pixels (>= 0).
-    max_iter : int, optional
-        Mean-shift iterations per particle and frame. The defaults (8 px, 10 iterations)
-        are measured on kams-a, seeds 0–9, λ = 1000: 9/10 runs tracked to the end; 7/10
-        with 5 iterations, 4/10 with 4 px.
-    eps : float, optional
-        Mean-shift stopping shift, in pixels.
-    resampler : str, optional
-        Resampling method, by name (``trackers.filters.resampling``).
-    kernel : str, optional
-        ``"cone"`` (KAMS) or ``"epanechnikov"``.
-    bins : int, optional
-        Bins per RGB channel.
-    rng : Generator, int or None, optional
-        Source of all randomness.
+    {parameters}
 
     Attributes
     ----------

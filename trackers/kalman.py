@@ -20,7 +20,7 @@ Shared with the SHM trackers (``trackers.shm``):
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -28,8 +28,17 @@ from numpy.typing import NDArray
 from trackers.base import Estimate, Tracker
 from trackers.filters.kalman import KalmanFilter, MotionModel
 from trackers.models.dynamics import check_ar2_coefficients
-from trackers.models.layered import LayeredMatcher, check_matcher_params
-from trackers.params import TrackerParams, check_choice, check_integer, check_number
+from trackers.models.layered import SUPPORTS, LayeredMatcher, check_matcher_params
+from trackers.params import (
+    RNG_UNUSED,
+    FieldDoc,
+    TrackerParams,
+    check_choice,
+    check_integer,
+    check_number,
+    choices,
+    documented,
+)
 
 __all__ = ["MOTIONS", "KalmanParams", "KalmanTracker"]
 
@@ -82,42 +91,55 @@ def boxes_at(centres: NDArray[np.float64], sizes: NDArray[np.float64]) -> NDArra
     return np.concatenate([centres - sizes / 2, sizes], axis=1)
 
 
+@documented()
 @dataclass(frozen=True)
 class KalmanParams(TrackerParams):
     """Motion, measurement noise and matching: the parameters of the Kalman tracker and of
-    the SHM trackers (``trackers.shm``), documented on ``KalmanTracker``.
+    the SHM trackers (``trackers.shm``).
 
     Parameters
     ----------
-    motion : {"cv", "ar2"}, default "cv"
-        Motion model: constant velocity or AR2.
-    process_std : float, default 1.5
-        Process noise std, px/frame², in [0, ``MAX_STD``].
-    a1, a2 : float, default 2.0 and -1.0
-        AR2 coefficients, finite and not explosive (checked whatever the motion).
-    velocity_std : float, default 5.0
-        Initial velocity std, px/frame, in (0, ``MAX_STD``].
-    r_gain : float, default 0.01
-        Measurement variance per unit of mean squared difference, px²/intensity², in
-        [0, ``MAX_R``].
-    r_floor : float, default 0.5
-        Smallest measurement variance, px², in [``MIN_R_FLOOR``, ``MAX_R``].
-    search_radius : int, default 12
-        Search window half-size, px, in [1, 200].
-    step : int, default 2
-        Coarse-to-fine search stride, in [1, 8].
-    min_visible : float, default 0.25
-        Fraction of the template that must be compared for a match to count, in (0, 1].
-    support : {"box", "ellipse"}, default "ellipse"
-        Template support (``trackers.models.layered``).
-    blur : float, default 2.0
-        Gaussian pre-smoothing std, px, in [0, 20].
+    {parameters}
 
     Raises
     ------
     ValueError
         For a bad value, naming the parameter.
     """
+
+    FIELD_DOCS: ClassVar[dict[str, FieldDoc]] = {
+        "motion": (choices(MOTIONS),
+                   'Motion model: "cv" constant velocity, "ar2" AR2 (``a1``, ``a2``); see '
+                   "the ``trackers.kalman`` module docstring."),
+        "process_std": ("float", "Process noise std: acceleration (cv) or AR2 noise, "
+                                 "px/frame², in [0, ``trackers.kalman.MAX_STD``]."),
+        "a1": ("float", "AR2 coefficient A1 (used by ``motion=\"ar2\"`` only, checked "
+                        "whatever the motion); with ``a2``, not explosive: |a2| <= 1 and "
+                        "|a1| <= 1 − a2 (``trackers.models.dynamics.check_ar2_coefficients``, "
+                        "as for the particle trackers)."),
+        "a2": ("float", "AR2 coefficient A2 (see ``a1``)."),
+        "velocity_std": ("float", "Initial velocity std, px/frame (objects start at rest), "
+                                  "in (0, ``trackers.kalman.MAX_STD``]."),
+        "r_gain": ("float", "Measurement variance per unit of mean squared difference, "
+                            "px²/intensity², in [0, ``trackers.kalman.MAX_R``]."),
+        "r_floor": ("float", "Smallest measurement variance, px², in "
+                             "[``trackers.kalman.MIN_R_FLOOR``, ``trackers.kalman.MAX_R``]."),
+        "search_radius": ("int", "Search window half-size around the predicted position, px, "
+                                 "in [1, 200]."),
+        "step": ("int", "Coarse-to-fine search stride, in [1, 8]; 1 is exhaustive. The coarse "
+                        "grid of the default 2 is safe because of the blur (σ = 2 px smooths "
+                        "textures below the grid's Nyquist limit; measured on "
+                        "``shm-crossing``: the same errors as exhaustive search, about 2.5x "
+                        "faster); with ``blur=0`` on fine textures use 1."),
+        "min_visible": ("float", "Fraction of the template that must be compared for a match "
+                                 "to count, in (0, 1]."),
+        "support": (choices(SUPPORTS),
+                    "Template support (``trackers.models.layered``); the ellipse inscribed in "
+                    "the box fits round objects and keeps the background corners out of the "
+                    "match."),
+        "blur": ("float", "Gaussian pre-smoothing of frames and templates, std in px, in "
+                          "[0, 20] (0 = none)."),
+    }
 
     motion: str = "cv"
     process_std: float = 1.5
@@ -174,6 +196,7 @@ class KalmanParams(TrackerParams):
                     min_visible=self.min_visible, support=self.support, blur=self.blur)
 
 
+@documented(extra=RNG_UNUSED)
 class KalmanTracker(Tracker):
     """One Kalman filter per object on plain (unmasked) template-matching measurements.
 
@@ -181,37 +204,7 @@ class KalmanTracker(Tracker):
 
     Parameters
     ----------
-    motion : {"cv", "ar2"}, default "cv"
-        Motion model (see the module docstring).
-    process_std : float, default 1.5
-        Process noise std: acceleration (cv) or AR2 noise, px/frame², in [0, 1e6].
-    a1, a2 : float, default 2.0 and -1.0
-        AR2 coefficients (used by ``motion="ar2"`` only, checked whatever the motion),
-        not explosive: |a2| <= 1 and |a1| <= 1 − a2
-        (``trackers.models.dynamics.check_ar2_coefficients``, as for the particle trackers).
-    velocity_std : float, default 5.0
-        Initial velocity std, px/frame (objects start at rest), in (0, 1e6].
-    r_gain : float, default 0.01
-        Measurement variance per unit of mean squared difference, px²/intensity², in
-        [0, 1e12].
-    r_floor : float, default 0.5
-        Smallest measurement variance, px², in [1e-6, 1e12].
-    search_radius : int, default 12
-        Search window half-size around the predicted position, px, in [1, 200].
-    step : int, default 2
-        Coarse-to-fine search stride, in [1, 8]; 1 is exhaustive. The coarse grid of the
-        default 2 is safe because of the blur (σ = 2 px smooths textures below the grid's
-        Nyquist limit; measured on ``shm-crossing``: the same errors as exhaustive search,
-        about 2.5x faster); with ``blur=0`` on fine textures use 1.
-    min_visible : float, default 0.25
-        Fraction of the template that must be compared for a match to count, in (0, 1].
-    support : {"box", "ellipse"}, default "ellipse"
-        Template support (``trackers.models.layered``); the ellipse inscribed in the box fits
-        round objects and keeps the background corners out of the match.
-    blur : float, default 2.0
-        Gaussian pre-smoothing of frames and templates, std in px, in [0, 20] (0 = none).
-    rng : Generator, int or None, optional
-        Unused by this deterministic tracker; accepted like every tracker's.
+    {parameters}
 
     Notes
     -----

@@ -3,60 +3,62 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
 
 from trackers.annealed import AnnealedParams, AnnealedPF
-from trackers.meanshift import check_mean_shift, set_mean_shift
+from trackers.meanshift import MeanShiftParams, check_mean_shift, set_mean_shift
 from trackers.models.observation import FrameObservation
+from trackers.params import RNG_RANDOM, FieldDoc, documented
 
 __all__ = ["KAMS", "KamsParams"]
 
 
+@documented()
 @dataclass(frozen=True)
 class KamsParams(AnnealedParams):
     """Parameters of KAMS: ``AnnealedParams`` with KAMS defaults, and the mean-shift loop.
 
-    Documented on ``KAMS``.
-
     Parameters
     ----------
-    kernel : {"cone", "epanechnikov"}, default "cone"
-        Histogram kernel (``ColourParams``).
-    bins : int, default 10
-        Bins per RGB channel, in [1, 32].
-    n_particles : int, default 40
-        Particles per target N, in [1, ``trackers.params.MAX_PARTICLES``].
-    n_layers : int, default 3
-        Annealing layers per frame, in [1, ``trackers.annealed.MAX_LAYERS``].
-    lam : float, default 1000.0
-        λ of the weighting function exp(−λ d²), finite and > 0.
-    sigma : float or sequence of float, default 30.0
-        Noise standard deviation in px: the first layer's (a number), or one per layer
-        (``n_layers`` numbers); finite and >= 0.
-    sigma_decay : float, default 0.5
-        Ratio between successive layers' noise when ``sigma`` is a number, in (0, 1].
-    schedule : {"adaptive", "geometric"}, default "adaptive"
-        How β is chosen for the layers before the last.
-    alpha : float, default 0.8
-        Survival rate of the adaptive schedule, in (0, 1).
-    beta_ratio : float, default 0.5
-        Ratio of the geometric schedule, in (0, 1].
-    estimate : {"mean", "mode"}, default "mean"
-        Weighted mean of all the last layer's particles, or of its main mode.
-    resampler : {"systematic", "multinomial", "stratified", "residual"}, default "systematic"
-        Resampling method (``trackers.filters.resampling``).
-    max_iter : int, default 20
-        Mean-shift iterations per particle and layer, in [0, ``MAX_ITER``].
-    eps : float, default 0.5
-        Mean-shift stopping shift in px, >= 0.
+    {parameters}
 
     Raises
     ------
     ValueError
         For a bad value, naming the parameter.
     """
+
+    FIELD_DOCS: ClassVar[dict[str, FieldDoc]] = {
+        "n_particles": ("int", "Particles per target, N, in [1, "
+                               "``trackers.params.MAX_PARTICLES``] (the paper: 40)."),
+        "sigma": ("float or tuple of float",
+                  "Noise of the first layer, in px, multiplied by ``sigma_decay`` at each "
+                  "further layer, or one value per layer (``n_layers`` numbers); finite and "
+                  ">= 0. **(open)** Default 30 (30, 15, 7.5 px): there is no motion model, "
+                  "so the first layer must reach the target's jump between frames, about "
+                  "σ·√2 per axis under the kams presets' position noise σ (20 px on kams-d, "
+                  "with jumps beyond 50 px in most sequences). Measured on kams-d, seeds "
+                  "0–19, runs tracked to the end with 40 particles and max_iter 20: 16/20 at "
+                  "30, 11/20 at 40, 13/20 at 30 with 4 layers, 3/20 at 12 (the annealed "
+                  "filter's default)."),
+        "alpha": ("float", "Survival rate of the adaptive β schedule, in (0, 1). **(open)** "
+                           "Default 0.8, not 0.5: mean shift already concentrates the "
+                           "particles, so a flatter weighting keeps more of the alternatives "
+                           "alive (kams-d, seeds 0–19: 16/20 runs tracked to the end at 0.8, "
+                           "15/20 at 0.5; kams-b 20/20 at both)."),
+        "max_iter": ("int", "Mean-shift iterations per particle and layer, in [0, "
+                            "``trackers.meanshift.MAX_ITER``]. The paper runs mean shift "
+                            "until the distance is stable (\"usually within five "
+                            "iterations\") and allows a cap; **(open)** default 20: in dense "
+                            "clutter the steps shrink, and 5 iterations converge from 12 px "
+                            "of the target in 81% of starts against 97% with 20 (kams-d); "
+                            "kams-d, seeds 0–19, runs tracked to the end: 6/20 at 5, 16/20 "
+                            "at 20."),
+        "eps": MeanShiftParams.FIELD_DOCS["eps"],
+    }
 
     n_particles: int = 40
     sigma: float | tuple[float, ...] = 30.0
@@ -71,6 +73,7 @@ class KamsParams(AnnealedParams):
         self._set("eps", float(self.eps))
 
 
+@documented(extra=RNG_RANDOM)
 class KAMS(AnnealedPF):
     """The annealed particle filter with a kernel mean-shift step after each layer's noise.
 
@@ -84,49 +87,7 @@ class KAMS(AnnealedPF):
 
     Parameters
     ----------
-    n_particles : int, optional
-        Particles per target (the paper: 40).
-    max_iter : int, optional
-        Mean-shift iterations per particle and layer. The paper runs mean shift until the
-        distance is stable ("usually within five iterations") and allows a cap; **(open)**
-        default 20: in dense clutter the steps shrink, and 5 iterations converge from
-        12 px of the target in 81% of starts against 97% with 20 (kams-d); kams-d, seeds
-        0–19, runs tracked to the end: 6/20 at 5, 16/20 at 20.
-    eps : float, optional
-        Mean-shift stopping shift, in pixels.
-    alpha : float, optional
-        Survival rate of the adaptive β schedule, as for ``AnnealedPF``. **(open)** Default
-        0.8, not 0.5: mean shift already concentrates the particles, so a flatter weighting
-        keeps more of the alternatives alive (kams-d, seeds 0–19: 16/20 runs tracked to the
-        end at 0.8, 15/20 at 0.5; kams-b 20/20 at both).
-    sigma : float or sequence of float, optional
-        Noise of the first layer, in pixels, halved at each further layer
-        (``sigma_decay``), or one value per layer. **(open)** Default 30 (30, 15, 7.5 px):
-        there is no motion model, so the first layer must reach the target's jump between
-        frames, about σ·√2 per axis under the kams presets' position noise σ (20 px on
-        kams-d, with jumps beyond 50 px in most sequences). Measured on kams-d, seeds
-        0–19, runs tracked to the end with 40 particles and max_iter 20: 16/20 at 30, 11/20
-        at 40, 13/20 at 30 with 4 layers, 3/20 at 12 (the annealed filter's default).
-    n_layers : int, default 3
-        As for ``AnnealedPF``.
-    lam : float, default 1000.0
-        As for ``AnnealedPF``.
-    sigma_decay : float, default 0.5
-        As for ``AnnealedPF``.
-    schedule : {"adaptive", "geometric"}, default "adaptive"
-        As for ``AnnealedPF``.
-    beta_ratio : float, default 0.5
-        As for ``AnnealedPF``.
-    estimate : {"mean", "mode"}, default "mean"
-        As for ``AnnealedPF``.
-    resampler : str, default "systematic"
-        As for ``AnnealedPF``.
-    kernel : {"cone", "epanechnikov"}, default "cone"
-        As for ``AnnealedPF``.
-    bins : int, default 10
-        As for ``AnnealedPF``.
-    rng : Generator, int or None, optional
-        As for ``AnnealedPF``.
+    {parameters}
 
     Notes
     -----

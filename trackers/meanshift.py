@@ -20,6 +20,7 @@ row).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -27,7 +28,7 @@ from numpy.typing import NDArray
 from trackers.base import Estimate, Tracker
 from trackers.kernels.meanshift import MEAN_SHIFT_KERNELS, MeanShiftResult
 from trackers.models.observation import ColourModel, FrameObservation
-from trackers.params import TrackerParams
+from trackers.params import RNG_UNUSED, FieldDoc, TrackerParams, choices, documented
 
 __all__ = [
     "ColourParams",
@@ -260,17 +261,22 @@ def keep_inside(centres: NDArray[np.float64], frame_shape: tuple[int, ...]) -> N
     np.clip(centres[..., 1], 0.0, frame_shape[0], out=centres[..., 1])
 
 
+@documented()
 @dataclass(frozen=True)
 class ColourParams(TrackerParams):
     """The colour model's parameters, shared by every tracker of the KAMS family.
 
     Parameters
     ----------
-    kernel : {"cone", "epanechnikov"}, optional
-        Histogram kernel: ``"cone"`` (KAMS linear kernel) or ``"epanechnikov"``.
-    bins : int, optional
-        Bins per RGB channel, in [1, 32] (KAMS: 10).
+    {parameters}
     """
+
+    FIELD_DOCS: ClassVar[dict[str, FieldDoc]] = {
+        "kernel": (choices(MEAN_SHIFT_KERNELS),
+                   'Histogram kernel of the target\'s colour model: "cone" (the KAMS paper\'s '
+                   'linear kernel over the inscribed ellipse) or "epanechnikov".'),
+        "bins": ("int", "Bins per RGB channel, in [1, 32] (KAMS: 10)."),
+    }
 
     kernel: str = "cone"
     bins: int = 10
@@ -280,26 +286,27 @@ class ColourParams(TrackerParams):
         self._set("bins", int(self.bins))
 
 
+@documented()
 @dataclass(frozen=True)
 class MeanShiftParams(ColourParams):
     """Parameters of the mean-shift tracker: ``ColourParams`` and the mean-shift loop.
 
     Parameters
     ----------
-    kernel : {"cone", "epanechnikov"}, default "cone"
-        Histogram kernel (``ColourParams``).
-    bins : int, default 10
-        Bins per RGB channel, in [1, 32] (``ColourParams``).
-    max_iter : int, optional
-        Maximum mean-shift iterations per start point and frame (Comaniciu et al. use 20).
-    eps : float, optional
-        Stop when a shift moves the window by less than ``eps`` pixels (>= 0).
+    {parameters}
 
     Raises
     ------
     ValueError
         For a bad value, naming the parameter.
     """
+
+    FIELD_DOCS: ClassVar[dict[str, FieldDoc]] = {
+        "max_iter": ("int", "Maximum mean-shift iterations per start point and frame, in "
+                            "[0, ``trackers.meanshift.MAX_ITER``] (Comaniciu et al. use 20)."),
+        "eps": ("float", "Stop when a shift moves the window by less than ``eps`` px; finite "
+                         "and >= 0."),
+    }
 
     max_iter: int = 20
     eps: float = 0.5
@@ -311,6 +318,7 @@ class MeanShiftParams(ColourParams):
         self._set("eps", float(self.eps))
 
 
+@documented(extra=RNG_UNUSED)
 class MeanShiftTracker(Tracker):
     """Kernel mean-shift tracker: one window per target climbs the Bhattacharyya coefficient.
 
@@ -323,16 +331,7 @@ class MeanShiftTracker(Tracker):
 
     Parameters
     ----------
-    kernel : {"cone", "epanechnikov"}, default "cone"
-        Histogram kernel.
-    bins : int, default 10
-        Bins per RGB channel, in [1, 32].
-    max_iter : int, default 20
-        Maximum mean-shift iterations per target and frame, in [0, ``MAX_ITER``].
-    eps : float, default 0.5
-        Stop when a shift moves the window by less than ``eps`` px (>= 0).
-    rng : Generator, int or None, optional
-        Unused (the tracker is deterministic).
+    {parameters}
 
     Attributes
     ----------

@@ -50,6 +50,7 @@ from __future__ import annotations
 from abc import abstractmethod
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -87,11 +88,15 @@ from trackers.models.observation import (
 )
 from trackers.params import (
     MAX_PARTICLES,
+    RNG_RANDOM,
+    FieldDoc,
     TrackerParams,
     check_choice,
     check_integer,
     check_number,
     check_particle_count,
+    choices,
+    documented,
 )
 
 __all__ = [
@@ -147,40 +152,60 @@ def circular_shift(n_objects: int, k: int) -> NDArray[np.int64]:
     return (np.arange(n_objects) + k) % n_objects
 
 
+@documented()
 @dataclass(frozen=True)
 class ParticleParams(TrackerParams):
     """Parameters of the four particle filters (condensation, joint-pf; PS and DPS add theirs).
 
     Parameters
     ----------
-    n_particles : int, optional
-        N, particles of the whole set (DPS: 300 synthetic, 200 real).
-    lam : float, optional
-        λ of the likelihood exp(−λ d²), > 0.
-    model : {"hsv", "rgb"}, optional
-        Colour-histogram observation model (``trackers.models.observation``).
-    bins : int, optional
-        Histogram bins per colour channel, in [1, 256].
-    n_parts : int or None, optional
-        Spatial components (horizontal bands) of a region; None: the model's default.
-    kernel : {"uniform", "epanechnikov", "cone", "box"} or None, optional
-        Kernel weighting the pixels of a region; None: the model's default.
-    box_levels : int, optional
-        Levels of the "box" kernel (nested rectangles), in [1, 16].
-    sigma : tuple of 3 floats, optional
-        (σ_u, σ_v, σ_a) of the AR2 tracking dynamics (DPS: 2, 2, 0.001); σ_u, σ_v in
-        [0, 1e9] px, σ_a in [0, 20.7] (``trackers.models.dynamics.check_ar2``).
-    a1, a2 : float, optional
-        AR2 coefficients (2, −1: constant velocity), not explosive: |a2| <= 1 and
-        |a1| <= 1 − a2 (``check_ar2``).
-    resampler : {"systematic", "multinomial", "stratified", "residual"}, optional
-        Resampling scheme of every (weighted) resampling step.
-    observation : ObservationModel or None, optional
-        The observation model, replacing the colour-histogram model built from ``lam``,
-        ``model``, ``bins``, ``n_parts`` and ``kernel`` (which are then unused): any object
-        with ``set_references(frame, boxes)`` and ``observe(frame)`` returning per-box
-        log-likelihoods (the protocol ``trackers.models.observation.ObservationModel``).
+    {parameters}
+
+    Raises
+    ------
+    ValueError
+        For a bad value, naming the parameter.
     """
+
+    FIELD_DOCS: ClassVar[dict[str, FieldDoc]] = {
+        "n_particles": ("int", "N, particles of the whole joint set (``joint-pf``, ``ps``, "
+                               "``dps``) or of each target's filter (``condensation``), in "
+                               "[1, ``trackers.params.MAX_PARTICLES``] (DPS: 300 synthetic, "
+                               "200 real)."),
+        "lam": ("float", "λ of the likelihood exp(−λ d²), finite and > 0."),
+        "model": (choices(MODELS), "Colour-histogram observation model "
+                                   "(``trackers.models.observation``)."),
+        "bins": ("int", "Histogram bins per colour channel, in [1, 256]."),
+        "n_parts": ("int or None", "Spatial components (horizontal bands) of a region, in "
+                                   "[1, ``trackers.params.MAX_PARTICLES``]; None: the "
+                                   "model's default ("
+                                   + ", ".join(f'{n} for "{m}"' for m, (n, _) in MODELS.items())
+                                   + ")."),
+        "kernel": (choices(KERNELS) + " or None",
+                   "Kernel weighting the pixels of a region; None: the model's default ("
+                   + ", ".join(f'"{k}" for "{m}"' for m, (_, k) in MODELS.items()) + ")."),
+        "box_levels": ("int", 'Levels of the "box" kernel (nested rectangles), in [1, 16].'),
+        "sigma": ("tuple of 3 float",
+                  "(σ_u, σ_v, σ_a) of the AR2 tracking dynamics: px, px and log scale per "
+                  "frame (DPS: 2, 2, 0.001); σ_u, σ_v in [0, "
+                  "``trackers.models.dynamics.MAX_SIGMA_UV``], σ_a in [0, "
+                  "``trackers.models.dynamics.MAX_SIGMA_A``] (about 20.7) "
+                  "(``trackers.models.dynamics.check_ar2``)."),
+        "a1": ("float", "AR2 coefficient A1 (A1 = 2, A2 = −1: constant velocity); with "
+                        "``a2``, not explosive: |a2| <= 1 and |a1| <= 1 − a2 "
+                        "(``trackers.models.dynamics.check_ar2``)."),
+        "a2": ("float", "AR2 coefficient A2 (see ``a1``)."),
+        "resampler": (choices(RESAMPLERS), "Resampling scheme of every (weighted) resampling "
+                                           "step (``trackers.filters.resampling``)."),
+        "observation": ("ObservationModel or None",
+                        "The observation model, replacing the colour-histogram model built "
+                        "from ``lam``, ``model``, ``bins``, ``n_parts``, ``kernel`` and "
+                        "``box_levels`` (which are then unused): any object with "
+                        "``set_references(frame, boxes)`` and ``observe(frame)`` returning "
+                        "per-box log-likelihoods (the protocol "
+                        "``trackers.models.observation.ObservationModel``); None: the colour "
+                        "model."),
+    }
 
     n_particles: int = 300
     lam: float = 20.0
@@ -212,64 +237,49 @@ class ParticleParams(TrackerParams):
         check_observation(self, "observation")
 
 
+@documented()
 @dataclass(frozen=True)
 class PartitionedParams(ParticleParams):
-    """Parameters shared by PS and DPS: ``ParticleParams`` and ``weighting``.
+    """Parameters shared by PS and DPS: ``ParticleParams``, ``weighting`` and
+    ``resample_scope``.
 
     Parameters
     ----------
-    n_particles : int, default 300
-        N, particles of the whole set, in [1, ``trackers.params.MAX_PARTICLES``].
-    lam : float, default 20.0
-        λ of the likelihood exp(−λ d²), finite and > 0.
-    model : {"hsv", "rgb"}, default "hsv"
-        Colour-histogram observation model (``trackers.models.observation``).
-    bins : int, default 10
-        Histogram bins per colour channel, in [1, 256].
-    n_parts : int or None, default None
-        Spatial components (horizontal bands) of a region; None: the model's default.
-    kernel : {"uniform", "epanechnikov", "cone", "box"} or None, default None
-        Kernel weighting the pixels of a region; None: the model's default.
-    box_levels : int, default 3
-        Levels of the "box" kernel (nested rectangles), in [1, 16].
-    sigma : tuple of 3 float, default (2.0, 2.0, 0.001)
-        (σ_u, σ_v, σ_a) of the AR2 tracking dynamics: px, px and log scale per frame.
-    a1, a2 : float, default 2.0 and -1.0
-        AR2 coefficients, not explosive (``trackers.models.dynamics.check_ar2``).
-    resampler : {"systematic", "multinomial", "stratified", "residual"}, default "systematic"
-        Resampling scheme of every (weighted) resampling step.
-    observation : ObservationModel or None, default None
-        Replaces the colour-histogram model built from ``lam``, ``model``, ``bins``,
-        ``n_parts``, ``kernel`` and ``box_levels`` (then unused).
-    weighting : {"stage", "placed", "g-only"}, optional
-        **(open)** The weighting function g_j of stage j's weighted resampling, which
-        draws ancestors ∝ π g_j with π the weights carried from stage j − 1 (∝ 1 / g_{j−1})
-        and gives them the weight π / ρ. "stage" (default): g_j = p(Z | X_{o_j}), the
-        stage's object alone, as DPS §3 and MacCormick & Blake write it; ancestors are then
-        drawn ∝ p(Z | X_{o_j}) / p(Z | X_{o_{j−1}}), which thins the previous object's good
-        hypotheses, and the final weights keep p(Z | X_{o_i}) of every object but
-        o_{M−1}, so the ordering decides how many distinct hypotheses an object moves from.
-        "placed": g_j = Π_{i<=j} p(Z | X_{o_i}), the objects placed so far, so ancestors
-        are drawn ∝ p(Z | X_{o_j}) and every object gets the same selections per step
-        whatever its place. "g-only": ρ ∝ g_j = Π_{i<=j} p(Z | X_{o_i}) without π (the
-        first object is selected at every stage, then penalised by the final weights).
-        All three keep the set a correct weighted sample of the same posterior
-        (docs/algorithms.md §2.5).
-    resample_scope : {"joint", "placed"}, optional
-        **(open)** What a stage's weighted resampling copies from the drawn ancestor.
-        "joint" (default): the whole joint state, so the objects not yet placed in the
-        step are thinned by the placed objects' selections. "placed": only the
-        sub-states of the objects placed so far in the particle's ordering (o_1 … o_j at
-        stage j, "weighted resampling in each partition", DPS §3); the others keep
-        their own. Valid because the objects are independent a priori and in the
-        likelihood, and every step starts from an equally weighted set; then the object
-        sampled last is resampled once per step and the first M times.
+    {parameters}
 
     Raises
     ------
     ValueError
         For a bad value, naming the parameter.
     """
+
+    FIELD_DOCS: ClassVar[dict[str, FieldDoc]] = {
+        "weighting": (
+            choices(WEIGHTINGS),
+            "**(open)** The weighting function g_j of stage j's weighted resampling, which "
+            "draws ancestors ∝ π g_j with π the weights carried from stage j − 1 "
+            "(∝ 1 / g_{j−1}) and gives them the weight π / ρ. \"stage\": g_j = p(Z | X_{o_j}), "
+            "the stage's object alone, as DPS §3 and MacCormick & Blake write it; ancestors "
+            "are then drawn ∝ p(Z | X_{o_j}) / p(Z | X_{o_{j−1}}), which thins the previous "
+            "object's good hypotheses, and the final weights keep p(Z | X_{o_i}) of every "
+            "object but o_{M−1}, so the ordering decides how many distinct hypotheses an "
+            "object moves from. \"placed\": g_j = Π_{i<=j} p(Z | X_{o_i}), the objects placed "
+            "so far, so ancestors are drawn ∝ p(Z | X_{o_j}) and every object gets the same "
+            "selections per step whatever its place. \"g-only\": ρ ∝ g_j = "
+            "Π_{i<=j} p(Z | X_{o_i}) without π (the first object is selected at every stage, "
+            "then penalised by the final weights). All three keep the set a correct "
+            "weighted sample of the same posterior (docs/algorithms.md §2.5)."),
+        "resample_scope": (
+            choices(RESAMPLE_SCOPES),
+            "**(open)** What a stage's weighted resampling copies from the drawn ancestor. "
+            "\"joint\": the whole joint state, so the objects not yet placed in the step are "
+            "thinned by the placed objects' selections. \"placed\": only the sub-states of "
+            "the objects placed so far in the particle's ordering (o_1 … o_j at stage j, "
+            "\"weighted resampling in each partition\", DPS §3); the others keep their own. "
+            "Valid because the objects are independent a priori and in the likelihood, and "
+            "every step starts from an equally weighted set; then the object sampled last "
+            "is resampled once per step and the first M times."),
+    }
 
     weighting: str = "stage"
     resample_scope: str = "joint"
@@ -280,51 +290,28 @@ class PartitionedParams(ParticleParams):
         check_choice(self, "resample_scope", RESAMPLE_SCOPES)
 
 
+@documented()
 @dataclass(frozen=True)
 class PSParams(PartitionedParams):
     """Parameters of partitioned sampling: ``PartitionedParams`` and ``ordering``.
 
     Parameters
     ----------
-    n_particles : int, default 300
-        N, particles of the whole set, in [1, ``trackers.params.MAX_PARTICLES``].
-    lam : float, default 20.0
-        λ of the likelihood exp(−λ d²), finite and > 0.
-    model : {"hsv", "rgb"}, default "hsv"
-        Colour-histogram observation model (``trackers.models.observation``).
-    bins : int, default 10
-        Histogram bins per colour channel, in [1, 256].
-    n_parts : int or None, default None
-        Spatial components (horizontal bands) of a region; None: the model's default.
-    kernel : {"uniform", "epanechnikov", "cone", "box"} or None, default None
-        Kernel weighting the pixels of a region; None: the model's default.
-    box_levels : int, default 3
-        Levels of the "box" kernel (nested rectangles), in [1, 16].
-    sigma : tuple of 3 float, default (2.0, 2.0, 0.001)
-        (σ_u, σ_v, σ_a) of the AR2 tracking dynamics: px, px and log scale per frame.
-    a1, a2 : float, default 2.0 and -1.0
-        AR2 coefficients, not explosive (``trackers.models.dynamics.check_ar2``).
-    resampler : {"systematic", "multinomial", "stratified", "residual"}, default "systematic"
-        Resampling scheme of every (weighted) resampling step.
-    observation : ObservationModel or None, default None
-        Replaces the colour-histogram model built from ``lam``, ``model``, ``bins``,
-        ``n_parts``, ``kernel`` and ``box_levels`` (then unused).
-    weighting : {"stage", "placed", "g-only"}, default "stage"
-        The weighting function of the weighted resampling stages (``PartitionedParams``).
-    resample_scope : {"joint", "placed"}, default "joint"
-        What a stage's weighted resampling copies from the drawn ancestor
-        (``PartitionedParams``).
-    ordering : int or tuple of int, optional
-        The order in which objects are sampled: an int k is the k-th circular shift
-        (k, k+1, …, K−1, 0, …, k−1) of the targets (0 ≤ k < K; the paper's orderings),
-        a sequence is an explicit permutation of 0…K−1 (stored as a tuple). Checked
-        against K at ``init``.
+    {parameters}
 
     Raises
     ------
     ValueError
         For a bad value, naming the parameter.
     """
+
+    FIELD_DOCS: ClassVar[dict[str, FieldDoc]] = {
+        "ordering": ("int or tuple of int",
+                     "The order in which objects are sampled: an int k is the k-th circular "
+                     "shift (k, k+1, …, K−1, 0, …, k−1) of the targets (0 ≤ k < K; the "
+                     "paper's orderings), a sequence is an explicit permutation of 0…K−1 "
+                     "(stored as a tuple). Checked against K at ``init``."),
+    }
 
     ordering: int | tuple[int, ...] = 0
 
@@ -352,55 +339,45 @@ class PSParams(PartitionedParams):
         self._set("ordering", tuple(int(o) for o in items))
 
 
+@documented()
 @dataclass(frozen=True)
 class DPSParams(PartitionedParams):
     """Parameters of distributed partitioned sampling: ``PartitionedParams`` and the groups.
 
     Parameters
     ----------
-    n_particles : int, default 300
-        N, particles of the whole set, in [1, ``trackers.params.MAX_PARTICLES``].
-    lam : float, default 20.0
-        λ of the likelihood exp(−λ d²), finite and > 0.
-    model : {"hsv", "rgb"}, default "hsv"
-        Colour-histogram observation model (``trackers.models.observation``).
-    bins : int, default 10
-        Histogram bins per colour channel, in [1, 256].
-    n_parts : int or None, default None
-        Spatial components (horizontal bands) of a region; None: the model's default.
-    kernel : {"uniform", "epanechnikov", "cone", "box"} or None, default None
-        Kernel weighting the pixels of a region; None: the model's default.
-    box_levels : int, default 3
-        Levels of the "box" kernel (nested rectangles), in [1, 16].
-    sigma : tuple of 3 float, default (2.0, 2.0, 0.001)
-        (σ_u, σ_v, σ_a) of the AR2 tracking dynamics: px, px and log scale per frame.
-    a1, a2 : float, default 2.0 and -1.0
-        AR2 coefficients, not explosive (``trackers.models.dynamics.check_ar2``).
-    resampler : {"systematic", "multinomial", "stratified", "residual"}, default "systematic"
-        Resampling scheme of every (weighted) resampling step.
-    observation : ObservationModel or None, default None
-        Replaces the colour-histogram model built from ``lam``, ``model``, ``bins``,
-        ``n_parts``, ``kernel`` and ``box_levels`` (then unused).
-    weighting : {"stage", "placed", "g-only"}, default "stage"
-        The weighting function of the weighted resampling stages (``PartitionedParams``).
-    resample_scope : {"joint", "placed"}, default "joint"
-        What a stage's weighted resampling copies from the drawn ancestor
-        (``PartitionedParams``).
-    n_groups : int or None, optional
-        C, the number of mixture components, in [1, n_particles]; None: one per target
-        (the paper's C = M).
-    assignment : {"random", "interleaved", "persistent"}, optional
-        How particles are assigned to components (``DistributedPartitionedSampling``).
-    mixture : {"evidence", "prior"}, optional
-        The components' mixture weights at reassembly: "evidence" (π_c,t ∝ π_c,t−1 times
-        the component's evidence, Vermaak et al.) or "prior" (π_c,t = π_c,t−1, each
-        component keeps its share; ``DistributedPartitionedSampling``).
+    {parameters}
 
     Raises
     ------
     ValueError
         For a bad value, naming the parameter.
     """
+
+    FIELD_DOCS: ClassVar[dict[str, FieldDoc]] = {
+        "n_groups": ("int or None", "C, the number of mixture components, in [1, "
+                                    "n_particles]; None: one per target (the paper's C = M)."),
+        "assignment": (
+            choices(ASSIGNMENTS),
+            "**(open)** How particles are assigned to the components. \"random\" (the paper) "
+            "draws a uniformly random partition each step; \"interleaved\" sends particle n "
+            "of the resampled set to component n mod C: systematic resampling leaves copies "
+            "of one ancestor next to each other, so this spreads them over the components "
+            "(stratified assignment) and uses no randomness. \"persistent\" keeps the "
+            "components: each is resampled within itself by its own weights, and its mixture "
+            "weight is carried from step to step (π_c,t ∝ π_c,t−1 Σ_{n∈c} w̃_n with the "
+            "previous π_c,t−1, the general form of the paper's Eq. 3, as in Vermaak, Doucet "
+            "& Pérez's mixture tracking, without their re-clustering). DPS is then a mixture "
+            "of C PS filters, one per ordering, weighted by their evidence. The components "
+            "start as contiguous blocks of the initial set (all its particles are equal)."),
+        "mixture": (
+            choices(MIXTURES),
+            "**(open)** The components' mixture weights at reassembly: \"evidence\", "
+            "π_c,t ∝ π_c,t−1 Σ_{n∈c} w̃_n (π_c,t−1 times the component's evidence, Vermaak "
+            "et al.), or \"prior\", π_c,t = π_c,t−1: each component keeps its share whatever "
+            "its evidence (the other reading of the paper's \"multiplied by the prior factor "
+            "π_C,t to ensure a fair representation\"; docs/algorithms.md §2.6)."),
+    }
 
     n_groups: int | None = None
     assignment: str = "random"
@@ -474,6 +451,7 @@ class _ParticleTracker(Tracker):
         return self._estimate(weights[:, None])
 
 
+@documented(extra=RNG_RANDOM)
 class Condensation(_ParticleTracker):
     """Condensation (Isard & Blake 1998): one independent filter of N particles per target.
 
@@ -486,31 +464,7 @@ class Condensation(_ParticleTracker):
 
     Parameters
     ----------
-    n_particles : int, default 300
-        N, particles per target, in [1, ``trackers.params.MAX_PARTICLES``].
-    lam : float, default 20.0
-        λ of the likelihood exp(−λ d²), finite and > 0.
-    model : {"hsv", "rgb"}, default "hsv"
-        Colour-histogram observation model (``trackers.models.observation``).
-    bins : int, default 10
-        Histogram bins per colour channel, in [1, 256].
-    n_parts : int or None, default None
-        Spatial components (horizontal bands) of a region; None: the model's default.
-    kernel : {"uniform", "epanechnikov", "cone", "box"} or None, default None
-        Kernel weighting the pixels of a region; None: the model's default.
-    box_levels : int, default 3
-        Levels of the "box" kernel (nested rectangles), in [1, 16].
-    sigma : tuple of 3 float, default (2.0, 2.0, 0.001)
-        (σ_u, σ_v, σ_a) of the AR2 tracking dynamics: px, px and log scale per frame.
-    a1, a2 : float, default 2.0 and -1.0
-        AR2 coefficients, not explosive (``trackers.models.dynamics.check_ar2``).
-    resampler : {"systematic", "multinomial", "stratified", "residual"}, default "systematic"
-        Resampling scheme of every (weighted) resampling step.
-    observation : ObservationModel or None, default None
-        Replaces the colour-histogram model built from ``lam``, ``model``, ``bins``,
-        ``n_parts``, ``kernel`` and ``box_levels`` (then unused).
-    rng : Generator, int or None, optional
-        Source of all randomness; the same seed gives the same track.
+    {parameters}
 
     Attributes
     ----------
@@ -549,6 +503,7 @@ class Condensation(_ParticleTracker):
         return self._estimate(self.weights)
 
 
+@documented(extra=RNG_RANDOM)
 class JointPF(_ParticleTracker):
     """Joint particle filter over all targets ("Non-PS", docs/algorithms.md §2.3).
 
@@ -558,31 +513,7 @@ class JointPF(_ParticleTracker):
 
     Parameters
     ----------
-    n_particles : int, default 300
-        N, particles of the whole set, in [1, ``trackers.params.MAX_PARTICLES``].
-    lam : float, default 20.0
-        λ of the likelihood exp(−λ d²), finite and > 0.
-    model : {"hsv", "rgb"}, default "hsv"
-        Colour-histogram observation model (``trackers.models.observation``).
-    bins : int, default 10
-        Histogram bins per colour channel, in [1, 256].
-    n_parts : int or None, default None
-        Spatial components (horizontal bands) of a region; None: the model's default.
-    kernel : {"uniform", "epanechnikov", "cone", "box"} or None, default None
-        Kernel weighting the pixels of a region; None: the model's default.
-    box_levels : int, default 3
-        Levels of the "box" kernel (nested rectangles), in [1, 16].
-    sigma : tuple of 3 float, default (2.0, 2.0, 0.001)
-        (σ_u, σ_v, σ_a) of the AR2 tracking dynamics: px, px and log scale per frame.
-    a1, a2 : float, default 2.0 and -1.0
-        AR2 coefficients, not explosive (``trackers.models.dynamics.check_ar2``).
-    resampler : {"systematic", "multinomial", "stratified", "residual"}, default "systematic"
-        Resampling scheme of every (weighted) resampling step.
-    observation : ObservationModel or None, default None
-        Replaces the colour-histogram model built from ``lam``, ``model``, ``bins``,
-        ``n_parts``, ``kernel`` and ``box_levels`` (then unused).
-    rng : Generator, int or None, optional
-        Source of all randomness; the same seed gives the same track.
+    {parameters}
 
     Attributes
     ----------
@@ -753,6 +684,7 @@ class _Partitioned(_ParticleTracker):
         return reassemble(logw, logpi, sizes, log_prior, evidence)
 
 
+@documented(extra=RNG_RANDOM)
 class PartitionedSampling(_Partitioned):
     """Partitioned sampling (MacCormick & Blake 2000; docs/algorithms.md §2.5).
 
@@ -761,39 +693,7 @@ class PartitionedSampling(_Partitioned):
 
     Parameters
     ----------
-    n_particles : int, default 300
-        N, particles of the whole set, in [1, ``trackers.params.MAX_PARTICLES``].
-    lam : float, default 20.0
-        λ of the likelihood exp(−λ d²), finite and > 0.
-    model : {"hsv", "rgb"}, default "hsv"
-        Colour-histogram observation model (``trackers.models.observation``).
-    bins : int, default 10
-        Histogram bins per colour channel, in [1, 256].
-    n_parts : int or None, default None
-        Spatial components (horizontal bands) of a region; None: the model's default.
-    kernel : {"uniform", "epanechnikov", "cone", "box"} or None, default None
-        Kernel weighting the pixels of a region; None: the model's default.
-    box_levels : int, default 3
-        Levels of the "box" kernel (nested rectangles), in [1, 16].
-    sigma : tuple of 3 float, default (2.0, 2.0, 0.001)
-        (σ_u, σ_v, σ_a) of the AR2 tracking dynamics: px, px and log scale per frame.
-    a1, a2 : float, default 2.0 and -1.0
-        AR2 coefficients, not explosive (``trackers.models.dynamics.check_ar2``).
-    resampler : {"systematic", "multinomial", "stratified", "residual"}, default "systematic"
-        Resampling scheme of every (weighted) resampling step.
-    observation : ObservationModel or None, default None
-        Replaces the colour-histogram model built from ``lam``, ``model``, ``bins``,
-        ``n_parts``, ``kernel`` and ``box_levels`` (then unused).
-    weighting : {"stage", "placed", "g-only"}, default "stage"
-        The weighting function of the weighted resampling stages (``PartitionedParams``).
-    resample_scope : {"joint", "placed"}, default "joint"
-        What a stage's weighted resampling copies from the drawn ancestor
-        (``PartitionedParams``).
-    ordering : int or tuple of int, default 0
-        The order in which objects are sampled: the k-th circular shift, or an explicit
-        permutation of the K targets (``PSParams``).
-    rng : Generator, int or None, optional
-        Source of all randomness; the same seed gives the same track.
+    {parameters}
 
     Attributes
     ----------
@@ -836,6 +736,7 @@ class PartitionedSampling(_Partitioned):
         return est
 
 
+@documented(extra=RNG_RANDOM)
 class DistributedPartitionedSampling(_Partitioned):
     """Distributed partitioned sampling (Smith & Gatica-Perez 2004; docs/algorithms.md §2.6).
 
@@ -845,61 +746,13 @@ class DistributedPartitionedSampling(_Partitioned):
     mixture weights π_c,t ∝ π_c,t−1 Σ_{n∈c} w̃_n. All components of a sampling stage are
     scored in one kernel call. ``Estimate.extras["mixture_weights"]`` is (C,).
 
-    Parameters: ``DPSParams`` (``n_groups``, ``assignment`` and the ``ParticleParams``)
-    as keywords, and ``rng``. ``n_groups=1`` gives PS with the identity ordering, draw
-    for draw. **(open)** ``assignment``: "random" (the paper) draws a uniformly random
-    partition each step; "interleaved" sends particle n of the resampled set to
-    component n mod C: systematic resampling leaves copies of one ancestor next to each
-    other, so this spreads them over the components (stratified assignment) and uses no
-    randomness. "persistent" keeps the components: each is resampled within itself by
-    its own weights, and its mixture weight is carried from step to step (π_c,t ∝
-    π_c,t−1 Σ_{n∈c} w̃_n with the previous π_c,t−1, the general form of the paper's
-    Eq. 3, as in Vermaak, Doucet & Pérez's mixture tracking, without their
-    re-clustering). DPS is then a mixture of C PS filters, one per ordering, weighted by
-    their evidence. The components start as contiguous blocks of the initial set (all
-    its particles are equal). **(open)** ``mixture``: "evidence" (the formula above) or
-    "prior", π_c,t = π_c,t−1: each component keeps its share whatever its evidence (the
-    other reading of the paper's "multiplied by the prior factor π_C,t to ensure a fair
-    representation"; docs/algorithms.md §2.6).
+    Parameters: ``DPSParams`` (``n_groups``, ``assignment``, ``mixture`` and the
+    ``PartitionedParams``) as keywords, and ``rng``. ``n_groups=1`` gives PS with the
+    identity ordering, draw for draw.
 
     Parameters
     ----------
-    n_particles : int, default 300
-        N, particles of the whole set, in [1, ``trackers.params.MAX_PARTICLES``].
-    lam : float, default 20.0
-        λ of the likelihood exp(−λ d²), finite and > 0.
-    model : {"hsv", "rgb"}, default "hsv"
-        Colour-histogram observation model (``trackers.models.observation``).
-    bins : int, default 10
-        Histogram bins per colour channel, in [1, 256].
-    n_parts : int or None, default None
-        Spatial components (horizontal bands) of a region; None: the model's default.
-    kernel : {"uniform", "epanechnikov", "cone", "box"} or None, default None
-        Kernel weighting the pixels of a region; None: the model's default.
-    box_levels : int, default 3
-        Levels of the "box" kernel (nested rectangles), in [1, 16].
-    sigma : tuple of 3 float, default (2.0, 2.0, 0.001)
-        (σ_u, σ_v, σ_a) of the AR2 tracking dynamics: px, px and log scale per frame.
-    a1, a2 : float, default 2.0 and -1.0
-        AR2 coefficients, not explosive (``trackers.models.dynamics.check_ar2``).
-    resampler : {"systematic", "multinomial", "stratified", "residual"}, default "systematic"
-        Resampling scheme of every (weighted) resampling step.
-    observation : ObservationModel or None, default None
-        Replaces the colour-histogram model built from ``lam``, ``model``, ``bins``,
-        ``n_parts``, ``kernel`` and ``box_levels`` (then unused).
-    weighting : {"stage", "placed", "g-only"}, default "stage"
-        The weighting function of the weighted resampling stages (``PartitionedParams``).
-    resample_scope : {"joint", "placed"}, default "joint"
-        What a stage's weighted resampling copies from the drawn ancestor
-        (``PartitionedParams``).
-    n_groups : int or None, default None
-        C, the number of mixture components, in [1, n_particles]; None: one per target.
-    assignment : {"random", "interleaved", "persistent"}, default "random"
-        How particles are assigned to components (above).
-    mixture : {"evidence", "prior"}, default "evidence"
-        The components' mixture weights at reassembly (above).
-    rng : Generator, int or None, optional
-        Source of all randomness; the same seed gives the same track.
+    {parameters}
 
     Attributes
     ----------

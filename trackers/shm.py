@@ -69,6 +69,7 @@ objects (two crossing, 30x30 px) about 12 ms per frame for ``shm-fast`` and 70 m
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -78,7 +79,7 @@ from trackers.filters.kalman import KalmanFilter
 from trackers.filters.weights import normalised_weights
 from trackers.kalman import KalmanParams, boxes_at, measurement_cov
 from trackers.models.layered import LayeredMatcher, orderings
-from trackers.params import check_choice, check_number
+from trackers.params import RNG_UNUSED, FieldDoc, check_choice, check_number, choices, documented
 
 __all__ = [
     "EVIDENCES",
@@ -173,53 +174,40 @@ class _OrderingEvidence:
         return out
 
 
+@documented()
 @dataclass(frozen=True)
 class FastShmParams(KalmanParams):
-    """Parameters of "shm-fast": ``KalmanParams`` and the ordering evidence's (documented on
-    ``SHMTracker``).
+    """Parameters of "shm-fast": ``KalmanParams`` and the ordering evidence's.
 
     Parameters
     ----------
-    motion : {"cv", "ar2"}, default "cv"
-        Motion model (``KalmanParams``, as the next eleven entries).
-    process_std : float, default 1.5
-        Process noise std, px/frame², in [0, 1e6].
-    a1, a2 : float, default 2.0 and -1.0
-        AR2 coefficients, finite and not explosive.
-    velocity_std : float, default 5.0
-        Initial velocity std, px/frame, in (0, 1e6].
-    r_gain : float, default 0.01
-        Measurement variance per unit of mean squared difference, px²/intensity², in
-        [0, 1e12].
-    r_floor : float, default 0.5
-        Smallest measurement variance, px², in [1e-6, 1e12].
-    search_radius : int, default 12
-        Search window half-size, px, in [1, 200].
-    step : int, default 2
-        Coarse-to-fine search stride, in [1, 8].
-    min_visible : float, default 0.25
-        Fraction of the template that must be compared for a match to count, in (0, 1].
-    support : {"box", "ellipse"}, default "ellipse"
-        Template support (``trackers.models.layered``).
-    blur : float, default 2.0
-        Gaussian pre-smoothing std, px, in [0, 20].
-    p_stay : float, default 0.8
-        Probability that the depth ordering stays the same from one frame to the next,
-        in (0, 1].
-    lam : float, default 1.0
-        Sharpness of the squared-difference evidence, in [0, ``MAX_LAM``].
-    mse_rate : float, default 0.1
-        Rate of the moving average ``ē``, in (0, 1].
-    mse_floor : float, default 25.0
-        Smallest ``ē``, intensity², finite and >= ``MIN_MSE_FLOOR``.
-    evidence : {"union", "objects"}, default "union"
-        Which squared-difference mean is scored (module docstring).
+    {parameters}
 
     Raises
     ------
     ValueError
         For a bad value, naming the parameter.
     """
+
+    FIELD_DOCS: ClassVar[dict[str, FieldDoc]] = {
+        "p_stay": ("float", "Probability that the depth ordering stays the same from one "
+                            "frame to the next, in (0, 1] (**open**). The order cannot be "
+                            "observed while the objects are apart and may change then, so "
+                            "the belief should relax towards uniform within a few frames (by "
+                            "a factor ``(L p_stay − 1) / (L − 1)`` per frame). Measured on "
+                            "``shm-crossing`` seeds 0–7: depth-order accuracy 100% for 0.5 to "
+                            "0.9; mean ``max |P − 1/L|`` on frames where the targets are "
+                            "apart 0.04 at 0.8, 0.11 at 0.9."),
+        "lam": ("float", "Sharpness of the squared-difference evidence ``exp(−lam e / ē)``, "
+                         "in [0, ``trackers.shm.MAX_LAM``]."),
+        "mse_rate": ("float", "Rate of the moving average ``ē`` of the best squared-difference "
+                              "mean, in (0, 1]."),
+        "mse_floor": ("float", "Smallest ``ē``, intensity², finite and >= ``MIN_MSE_FLOOR`` "
+                               "(so exact synthetic matches do not give ē = 0)."),
+        "evidence": (choices(EVIDENCES),
+                     "Which squared-difference mean is scored (``trackers.shm`` module "
+                     "docstring)."),
+    }
 
     p_stay: float = 0.8
     lam: float = 1.0
@@ -236,55 +224,27 @@ class FastShmParams(KalmanParams):
         check_number(self, "mse_floor", low=MIN_MSE_FLOOR)
 
 
+@documented()
 @dataclass(frozen=True)
 class ShmParams(FastShmParams):
-    """Parameters of "shm": ``FastShmParams`` and ``use_mse`` (documented on ``SHMTracker``).
+    """Parameters of "shm": ``FastShmParams`` and ``use_mse``.
 
     Parameters
     ----------
-    motion : {"cv", "ar2"}, default "cv"
-        Motion model (``KalmanParams``, as the next eleven entries).
-    process_std : float, default 1.5
-        Process noise std, px/frame², in [0, 1e6].
-    a1, a2 : float, default 2.0 and -1.0
-        AR2 coefficients, finite and not explosive.
-    velocity_std : float, default 5.0
-        Initial velocity std, px/frame, in (0, 1e6].
-    r_gain : float, default 0.01
-        Measurement variance per unit of mean squared difference, px²/intensity², in
-        [0, 1e12].
-    r_floor : float, default 0.5
-        Smallest measurement variance, px², in [1e-6, 1e12].
-    search_radius : int, default 12
-        Search window half-size, px, in [1, 200].
-    step : int, default 2
-        Coarse-to-fine search stride, in [1, 8].
-    min_visible : float, default 0.25
-        Fraction of the template that must be compared for a match to count, in (0, 1].
-    support : {"box", "ellipse"}, default "ellipse"
-        Template support (``trackers.models.layered``).
-    blur : float, default 2.0
-        Gaussian pre-smoothing std, px, in [0, 20].
-    p_stay : float, default 0.8
-        Probability that the depth ordering stays the same from one frame to the next,
-        in (0, 1].
-    lam : float, default 1.0
-        Sharpness of the squared-difference evidence, in [0, ``MAX_LAM``].
-    mse_rate : float, default 0.1
-        Rate of the moving average ``ē``, in (0, 1].
-    mse_floor : float, default 25.0
-        Smallest ``ē``, intensity², finite and >= ``MIN_MSE_FLOOR``.
-    evidence : {"union", "objects"}, default "union"
-        Which squared-difference mean is scored (module docstring).
-    use_mse : bool, default True
-        Include the squared-difference evidence in the hypothesis weights (True, False,
-        or a numpy bool, 0 or 1; stored as ``bool``).
+    {parameters}
 
     Raises
     ------
     ValueError
         For a bad value, naming the parameter.
     """
+
+    FIELD_DOCS: ClassVar[dict[str, FieldDoc]] = {
+        "use_mse": ("bool", "Include the squared-difference evidence in the hypothesis "
+                            "weights (§3.3's generalised measurement); False is the plain "
+                            "§3.2 filter on positions only. True, False, a numpy bool, 0 or 1; "
+                            "stored as ``bool``."),
+    }
 
     use_mse: bool = True
 
@@ -318,6 +278,7 @@ class _SHMBase(Tracker):
         self._log_u = -np.log(float(frame.shape[0] * frame.shape[1]))
 
 
+@documented(extra=RNG_UNUSED)
 class SHMTracker(_SHMBase):
     """SHM filter (§3.2): Gaussian sum over depth orderings with GPB2 collapsing.
 
@@ -326,49 +287,7 @@ class SHMTracker(_SHMBase):
 
     Parameters
     ----------
-    motion : {"cv", "ar2"}, default "cv"
-        As for ``trackers.kalman.KalmanTracker`` (and the next eleven entries).
-    process_std : float, default 1.5
-        Process noise std, px/frame², in [0, 1e6].
-    a1, a2 : float, default 2.0 and -1.0
-        AR2 coefficients, finite and not explosive.
-    velocity_std : float, default 5.0
-        Initial velocity std, px/frame, in (0, 1e6].
-    r_gain : float, default 0.01
-        Measurement variance per unit of mean squared difference, px²/intensity².
-    r_floor : float, default 0.5
-        Smallest measurement variance, px².
-    search_radius : int, default 12
-        Search window half-size, px, in [1, 200].
-    step : int, default 2
-        Coarse-to-fine search stride, in [1, 8].
-    min_visible : float, default 0.25
-        Fraction of the template that must be compared for a match to count, in (0, 1].
-    support : {"box", "ellipse"}, default "ellipse"
-        Template support.
-    blur : float, default 2.0
-        Gaussian pre-smoothing std, px, in [0, 20].
-    p_stay : float, default 0.8
-        Probability that the depth ordering stays the same from one frame to the next
-        (**open**). The order cannot be observed while the objects are apart and may
-        change then, so the belief should relax towards uniform within a few frames
-        (by a factor ``(L p_stay − 1) / (L − 1)`` per frame). Measured on
-        ``shm-crossing`` seeds 0–7: depth-order accuracy 100% for 0.5 to 0.9; mean
-        ``max |P − 1/L|`` on frames where the targets are apart 0.04 at 0.8, 0.11 at 0.9.
-    lam : float, default 1.0
-        Sharpness of the squared-difference evidence ``exp(−lam e / ē)``, in [0, 1e6].
-    mse_rate : float, default 0.1
-        Rate of the moving average ``ē`` of the best squared-difference mean, in (0, 1].
-    mse_floor : float, default 25.0
-        Smallest ``ē``, intensity², >= 1e-6 (so exact synthetic matches do not give
-        ē = 0).
-    evidence : {"union", "objects"}, default "union"
-        Which squared-difference mean is scored (module docstring).
-    use_mse : bool, default True
-        Include the squared-difference evidence in the hypothesis weights (§3.3's
-        generalised measurement); False is the plain §3.2 filter on positions only.
-    rng : Generator, int or None, optional
-        Unused (the filter is deterministic); accepted like every tracker's.
+    {parameters}
 
     Attributes
     ----------
@@ -448,6 +367,7 @@ class SHMTracker(_SHMBase):
         )
 
 
+@documented(extra=RNG_UNUSED)
 class FastSHMTracker(_SHMBase):
     """Fast SHM filter (§3.3): ordering posterior from the matches, one Kalman filter.
 
@@ -456,41 +376,7 @@ class FastSHMTracker(_SHMBase):
 
     Parameters
     ----------
-    motion : {"cv", "ar2"}, default "cv"
-        As for ``SHMTracker`` (and every entry below but ``rng``).
-    process_std : float, default 1.5
-        Process noise std, px/frame², in [0, 1e6].
-    a1, a2 : float, default 2.0 and -1.0
-        AR2 coefficients, finite and not explosive.
-    velocity_std : float, default 5.0
-        Initial velocity std, px/frame, in (0, 1e6].
-    r_gain : float, default 0.01
-        Measurement variance per unit of mean squared difference, px²/intensity².
-    r_floor : float, default 0.5
-        Smallest measurement variance, px².
-    search_radius : int, default 12
-        Search window half-size, px, in [1, 200].
-    step : int, default 2
-        Coarse-to-fine search stride, in [1, 8].
-    min_visible : float, default 0.25
-        Fraction of the template that must be compared for a match to count, in (0, 1].
-    support : {"box", "ellipse"}, default "ellipse"
-        Template support.
-    blur : float, default 2.0
-        Gaussian pre-smoothing std, px, in [0, 20].
-    p_stay : float, default 0.8
-        Probability that the depth ordering stays the same from one frame to the next,
-        in (0, 1].
-    lam : float, default 1.0
-        Sharpness of the squared-difference evidence ``exp(−lam e / ē)``, in [0, 1e6].
-    mse_rate : float, default 0.1
-        Rate of the moving average ``ē``, in (0, 1].
-    mse_floor : float, default 25.0
-        Smallest ``ē``, intensity², >= 1e-6.
-    evidence : {"union", "objects"}, default "union"
-        Which squared-difference mean is scored (module docstring).
-    rng : Generator, int or None, optional
-        Unused (the filter is deterministic); accepted like every tracker's.
+    {parameters}
 
     Attributes
     ----------

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -15,7 +16,7 @@ from trackers.meanshift import (
     set_mean_shift,
     window_boxes,
 )
-from trackers.params import check_number
+from trackers.params import RNG_UNUSED, FieldDoc, check_number, documented
 
 __all__ = ["SOK", "SokParams"]
 
@@ -27,30 +28,36 @@ _OCTAL = np.array([(-1, -1), (0, -1), (1, -1), (-1, 0), (1, 0), (-1, 1), (0, 1),
                   dtype=np.float64)
 
 
+@documented()
 @dataclass(frozen=True)
 class SokParams(MeanShiftParams):
     """Parameters of SOK: ``MeanShiftParams``, ``threshold`` and ``spacing`` (see ``SOK``).
 
     Parameters
     ----------
-    kernel : {"cone", "epanechnikov"}, default "cone"
-        Histogram kernel (``ColourParams``).
-    bins : int, default 10
-        Bins per RGB channel, in [1, 32].
-    max_iter : int, default 20
-        Mean-shift iterations per tracker and frame, in [0, ``MAX_ITER``].
-    eps : float, default 0.5
-        Mean-shift stopping shift in px, >= 0.
-    threshold : float, default 0.9
-        Confidence below which the grid search runs, in [0, 1].
-    spacing : float, default 0.5
-        Grid spacing in units of the target's box width and height, finite and > 0.
+    {parameters}
 
     Raises
     ------
     ValueError
         For a bad value, naming the parameter.
     """
+
+    FIELD_DOCS: ClassVar[dict[str, FieldDoc]] = {
+        "threshold": ("float", "Confidence threshold T in [0, 1]: below it, the eight extra "
+                               "trackers are spawned. **(open)** The default 0.9 suits the "
+                               "kams presets: on the target C_t stays above 0.95, while mean "
+                               "shift caught by a clutter disc there typically ends at "
+                               "0.8–0.9 (sok on kams-a, seeds 0–9: 2/10 runs tracked at "
+                               "T = 0.75, 5/10 at T = 0.9)."),
+        "spacing": ("float", "**(open)** Grid spacing in units of the target's box width and "
+                             "height, finite and > 0. The SOK paper's search area of about "
+                             "nine times the target's is ``spacing=1``; we default to 0.5 "
+                             "(about four times), because jumps on the kams presets stay "
+                             "within about one radius and the outer cells mostly meet "
+                             "clutter (sok on kams-a, seeds 0–9: 8/10 runs tracked to the "
+                             "end at 0.5, 5/10 at 1)."),
+    }
 
     threshold: float = 0.9
     spacing: float = 0.5
@@ -61,6 +68,7 @@ class SokParams(MeanShiftParams):
         check_number(self, "spacing", low=0.0, low_open=True)
 
 
+@documented(extra=RNG_UNUSED)
 class SOK(Tracker):
     """A kernel mean-shift tracker that searches a 3x3 grid when its confidence drops.
 
@@ -74,27 +82,7 @@ class SOK(Tracker):
 
     Parameters
     ----------
-    threshold : float, optional
-        Confidence threshold T in [0, 1]: below it, the eight extra trackers are spawned.
-        **(open)** The default 0.9 suits the kams presets: on the target C_t stays above
-        0.95, while mean shift caught by a clutter disc there typically ends at 0.8–0.9
-        (sok on kams-a, seeds 0–9: 2/10 runs tracked at T = 0.75, 5/10 at T = 0.9).
-    spacing : float, optional
-        **(open)** Grid spacing in units of the target's box width and height (> 0). The
-        SOK paper's search area of about nine times the target's is ``spacing=1``; we
-        default to 0.5 (about four times), because jumps on the kams presets stay within
-        about one radius and the outer cells mostly meet clutter (sok on kams-a, seeds
-        0–9: 8/10 runs tracked to the end at 0.5, 5/10 at 1).
-    max_iter : int, default 20
-        As for ``MeanShiftTracker`` (``MeanShiftParams``): per tracker and frame.
-    eps : float, default 0.5
-        As for ``MeanShiftTracker``: the stopping shift, in px.
-    kernel : {"cone", "epanechnikov"}, default "cone"
-        As for ``MeanShiftTracker``.
-    bins : int, default 10
-        As for ``MeanShiftTracker``.
-    rng : Generator, int or None, optional
-        Unused (the tracker is deterministic).
+    {parameters}
 
     Notes
     -----
