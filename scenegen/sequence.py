@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import operator
 from dataclasses import dataclass, field, fields
 from typing import Any
 
@@ -197,9 +198,17 @@ class Sequence:
         -------
         ndarray of shape (M,), intp
             Ascending indices into K of the targets with ``gt.present[frame]`` true.
+
+        Raises
+        ------
+        TypeError
+            If ``frame`` is not an integer (a bool is not one).
+        IndexError
+            If ``frame`` is outside [-T, T - 1]; the message names ``frame`` and the range.
         """
+        t = self._frame(frame)
         idx = self.target_indices()
-        return idx[np.asarray(self.gt.present[frame, idx], dtype=bool)]
+        return idx[np.asarray(self.gt.present[t, idx], dtype=bool)]
 
     def init_boxes(self, frame: int = 0) -> NDArray[np.float64]:
         """Amodal boxes (M, 4) of :meth:`initial_targets` at ``frame``: what trackers start from.
@@ -213,8 +222,31 @@ class Sequence:
         -------
         ndarray of shape (M, 4), float64
             ``gt.box`` of those targets at ``frame``, [x, y, w, h] in pixels.
+
+        Raises
+        ------
+        TypeError
+            If ``frame`` is not an integer (a bool is not one).
+        IndexError
+            If ``frame`` is outside [-T, T - 1]; the message names ``frame`` and the range.
         """
-        return np.asarray(self.gt.box[frame, self.initial_targets(frame)], dtype=np.float64)
+        return np.asarray(self.gt.box[self._frame(frame), self.initial_targets(frame)],
+                          dtype=np.float64)
+
+    def _frame(self, frame: Any) -> int:
+        """``frame`` as an int index into T; else one line naming ``frame`` and the range."""
+        t = int(self.gt.present.shape[0])
+        try:
+            i = None if isinstance(frame, bool) else operator.index(frame)
+        except TypeError:
+            i = None
+        if i is None:
+            got = repr(frame)
+            got = got if len(got) <= 40 and "\n" not in got else type(frame).__name__
+            raise TypeError(f"frame must be an integer in [{-t}, {t - 1}], got {got}")
+        if not -t <= i < t:
+            raise IndexError(f"frame must be an integer in [{-t}, {t - 1}], got {i}")
+        return i
 
     def __repr__(self) -> str:
         t, h, w = self.n_frames, self.height, self.width

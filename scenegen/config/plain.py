@@ -155,5 +155,13 @@ def to_dict(config: SceneConfig) -> dict[str, Any]:
     dict of str to Any
         Every field, defaults included (but a field added after the first release, left
         out while it holds its default), nested configs as dicts and tuples as lists.
+
+    Raises
+    ------
+    ConfigError
+        If ``config`` is not a :class:`SceneConfig` (plain data, a preset name, ...; it
+        was returned unchanged), naming its type.
     """
+    if not isinstance(config, SceneConfig):
+        raise ConfigError(f"to_dict takes a SceneConfig, got a {type(config).__name__}")
     return _plain(config)

@@ -335,11 +335,15 @@ def pick_target(sequence: Any, target_id: int | None = None, option: str = "targ
     Raises
     ------
     ConfigError
-        If ``target_id`` is not a target present at frame 0, or it is None and several
-        targets are, naming them.
+        If ``target_id`` is not an integer (a bool is not one) or not a target present at
+        frame 0, or it is None and several targets are, naming them.
     DataError
         If no target is present at frame 0.
     """
+    if target_id is not None and (
+            isinstance(target_id, (bool, np.bool_))
+            or not isinstance(target_id, (int, np.integer))):  # fmt: skip
+        raise ConfigError(f"{option} must be an integer entity id, got {target_id!r}")
     idx = np.asarray(sequence.target_indices())
     idx = idx[np.asarray(sequence.gt.present)[0, idx]]
     ids = [int(i) for i in np.asarray(sequence.entities.id)[idx]]
@@ -417,7 +421,8 @@ def evaluate_target(
         a box row is neither a box (finite, w, h >= 0) nor all NaN, or no target is
         present at frame 0.
     ConfigError
-        If an option is out of range, or ``target_id`` as :func:`pick_target` says.
+        If an option is out of range, or ``target_id`` is not an integer (a bool is not
+        one) or not a target present at frame 0 (:func:`pick_target`).
 
     Examples
     --------
@@ -484,7 +489,9 @@ def _int_ids(values: ArrayLike, name: str) -> NDArray[np.int64]:
     """``values`` as int64 ids, shape (N,); a fractional or non-finite id is a DataError
     (it was truncated: 7.6 scored as track 7)."""
     raw = np.asarray(values).reshape(-1)
-    if raw.dtype.kind not in "iub":
+    if raw.dtype.kind == "b":  # True was scored as id 1
+        raise DataError(f"{name} must be integers, got booleans {raw[:5].tolist()}")
+    if raw.dtype.kind not in "iu":
         try:
             num = raw.astype(np.float64)
         except (TypeError, ValueError):

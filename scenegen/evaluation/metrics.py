@@ -21,12 +21,14 @@ Examples
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from scenegen.config.limits import MAX_SIDE
 from scenegen.evaluation import mot
 
 __all__ = [
@@ -435,6 +437,21 @@ class OtbCurves:
     precision_20: float
 
 
+_MAX_OVERLAP_THRESHOLDS = 10001
+_MAX_ERROR = 2 * MAX_SIDE  # pixels: beyond the diagonal of the largest frame
+
+
+def _pixels(value: Any, name: str, upper: float) -> float:
+    """``value`` as a float in [0, upper] (a real number, not a bool, finite); else
+    ValueError naming ``name`` and the value."""
+    ok = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(
+        value, (bool, np.bool_)) and math.isfinite(value) and 0 <= value <= upper  # fmt: skip
+    if not ok:
+        bound = f"in [0, {upper:g}]" if math.isfinite(upper) else ">= 0 and finite"
+        raise ValueError(f"{name} must be a number {bound}, pixels, got {value!r}")
+    return float(value)
+
+
 def otb_curves(
     est: ArrayLike,
     gt: ArrayLike,
@@ -456,12 +473,17 @@ def otb_curves(
     est, gt : array_like of shape (..., 4)
         Estimated and ground-truth boxes (any leading axes, e.g. (T, K) or (R, T)).
     n_overlap : int
-        Number of overlap thresholds (≥ 2).
+        Number of overlap thresholds, 2 … 10001 (a step of 0.0001, finer than any AUC is
+        reported; each threshold is compared with every frame, so more only costs memory).
     max_error : float
-        Largest centre-error threshold, pixels (≥ 0); thresholds are the whole pixels 0, 1,
-        …, up to ``max_error`` (51 values, 0 … 50, by default, as in OTB).
+        Largest centre-error threshold, pixels, 0 … 16384; thresholds are the whole pixels
+        0, 1, …, up to ``max_error`` (51 values, 0 … 50, by default, as in OTB). The bound
+        is twice the largest frame side (:data:`scenegen.config.limits.MAX_SIDE`), beyond
+        the diagonal of any frame, so no threshold that tells two runs apart is left out;
+        each threshold is compared with every frame, so a larger one would only cost memory.
     precision_at : float
-        Centre-error threshold of the headline precision, pixels.
+        Centre-error threshold of the headline precision, pixels (finite, ≥ 0: a missing
+        estimate's error is infinite).
 
     Returns
     -------
@@ -470,13 +492,17 @@ def otb_curves(
     Raises
     ------
     ValueError
-        For ``est`` and ``gt`` of different shapes, ``n_overlap`` < 2 or a negative
-        ``max_error``.
+        For ``est`` and ``gt`` of different shapes, or ``n_overlap``, ``max_error`` or
+        ``precision_at`` not a number in its range above (a bool is not one); the message
+        names the parameter and its value.
     """
-    if n_overlap < 2:
-        raise ValueError(f"n_overlap must be >= 2, got {n_overlap}")
-    if not max_error >= 0:
-        raise ValueError(f"max_error must be >= 0, got {max_error}")
+    if (isinstance(n_overlap, bool) or not isinstance(n_overlap, (int, np.integer))
+            or not 2 <= n_overlap <= _MAX_OVERLAP_THRESHOLDS):  # fmt: skip
+        raise ValueError(
+            f"n_overlap must be an integer in [2, {_MAX_OVERLAP_THRESHOLDS}], got {n_overlap!r}"
+        )
+    _pixels(max_error, "max_error", _MAX_ERROR)
+    _pixels(precision_at, "precision_at", math.inf)
     e, g = _boxes(est), _boxes(gt)
     if e.shape != g.shape:  # a broadcast would score one box against every frame
         raise ValueError(f"est has shape {e.shape} and gt {g.shape}: one box per frame each")

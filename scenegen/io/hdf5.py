@@ -532,7 +532,8 @@ class LazyArray:
     Raises
     ------
     DataError
-        When the file cannot be opened, is not the expected version, or a read fails.
+        When the file cannot be opened, is not the expected version, holds no dataset
+        ``dataset`` (missing, or a group), or a read fails.
     """
 
     def __init__(
@@ -564,7 +565,10 @@ class LazyArray:
                     "read it again"
                 )
             self._file, self._stamp = f, stamp
-        return self._file[self.dataset]
+        ds = self._file.get(self.dataset)
+        if not isinstance(ds, h5py.Dataset):
+            raise DataError(f"{self.path}: holds no dataset {self.dataset!r}")
+        return ds
 
     def __getstate__(self) -> dict[str, Any]:
         state = self.__dict__.copy()

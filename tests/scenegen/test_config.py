@@ -126,6 +126,16 @@ def test_presets_round_trip_through_plain_data(name):
     assert from_dict(data) == cfg
 
 
+@pytest.mark.parametrize(("value", "kind"), [
+    ({"width": 64}, "dict"), ("kams-a", "str"), (None, "NoneType"),
+    (scenegen.presets.get("kams-a").entities[0], "EntitySpec"),
+])  # fmt: skip
+def test_to_dict_refuses_what_is_not_a_scene_config(value, kind):
+    # Was returned unchanged: to_dict(plain data) looked like a resolved config.
+    with pytest.raises(ConfigError, match=rf"^to_dict takes a SceneConfig, got a {kind}$"):
+        to_dict(value)
+
+
 def test_unknown_preset_lists_valid_ones():
     with pytest.raises(ConfigError, match="unknown preset 'nope'; valid presets: dps-synthetic"):
         scenegen.presets.get("nope")

@@ -201,7 +201,8 @@ def test_fractional_ids_and_broken_boxes_are_refused_from_python(seq):
     ids = seq.target_ids().astype(np.float64)
     for call, name in ((evaluate, "target_ids"), (evaluate_tracks, "track_ids")):
         assert call(seq, est, ids).targets  # integral floats are ids
-        for bad in (ids + 0.6, np.where(np.arange(ids.size) == 0, np.nan, ids)):
+        bools = np.ones(ids.size, dtype=bool)  # True was scored as id 1
+        for bad in (ids + 0.6, np.where(np.arange(ids.size) == 0, np.nan, ids), bools):
             with pytest.raises(DataError, match=rf"^{name} must be integers, got "):
                 call(seq, est, bad)
         broken = est.copy()

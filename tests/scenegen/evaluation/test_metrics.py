@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -133,6 +134,25 @@ def test_otb_precision_thresholds_stop_at_max_error():
     for bad in (-1.0, float("nan")):
         with pytest.raises(ValueError, match="max_error"):
             m.otb_curves(gt, gt, max_error=bad)
+
+
+@pytest.mark.parametrize(("name", "bad"), [
+    ("max_error", float("inf")), ("max_error", 1e12), ("max_error", 16384.5),
+    ("max_error", "50"), ("max_error", True), ("n_overlap", 10**9), ("n_overlap", 2.5),
+    ("n_overlap", True), ("n_overlap", "3"), ("precision_at", float("nan")),
+    ("precision_at", float("inf")), ("precision_at", -1.0), ("precision_at", "20"),
+    ("precision_at", True),
+])  # fmt: skip
+def test_otb_thresholds_out_of_range_are_refused_naming_the_value(name, bad):
+    """A huge or infinite ``max_error`` / ``n_overlap`` tried to allocate that many
+    thresholds (numpy's MemoryError or "Maximum allowed size exceeded"); a NaN, infinite or
+    negative ``precision_at`` gave a silent 0 or 1; strings and bools were numpy's errors
+    or taken as numbers."""
+    gt = np.array([[0, 0, 10, 10.0]])
+    with pytest.raises(ValueError, match=rf"^{name} must be .*, got {re.escape(repr(bad))}$"):
+        m.otb_curves(gt, gt, **{name: bad})
+    c = m.otb_curves(gt, gt, max_error=16384, n_overlap=10001, precision_at=0)
+    assert len(c.error_thresholds) == 16385 and c.precision_20 == 1.0
 
 
 def test_failure_frame_and_tracked_fraction():

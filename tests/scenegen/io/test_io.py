@@ -69,6 +69,15 @@ def test_lazy_read_of_a_range(tmp_path, seq):
     assert back.frames.shape == seq.frames.shape and len(back.frames) == 12
 
 
+@pytest.mark.parametrize("name", ["no/such/dataset", "sequences/shm-crossing", ""])
+def test_lazy_array_of_a_missing_dataset_is_a_data_error(tmp_path, seq, name):
+    # Was h5py's raw KeyError (missing) or an AttributeError (a group has no shape).
+    path = tmp_path / "s.h5"
+    write(path, seq)
+    with pytest.raises(DataError, match=f"holds no dataset {re.escape(repr(name))}"):
+        LazyArray(path, name)
+
+
 @pytest.mark.parametrize("key", [
     np.s_[::-1], np.s_[9:2:-3], [0, 3, 3], [5, 1], [-1, 0], [], np.s_[::-2, 5:9],
     ([4, 2], slice(None), 7), np.array([[0, 1], [1, 0]]), np.arange(12) % 3 == 0,

@@ -119,6 +119,18 @@ def test_pick_target_defaults_to_the_only_target_at_frame_0():
                               "'enter-leave', where a single-object tracker starts (ids 1)")
 
 
+@pytest.mark.parametrize("bad", [True, np.True_, 1.0, "1"])
+def test_a_target_id_that_is_not_an_integer_is_refused_naming_target_id(bad):
+    # True was taken as target 1 and scored; 1.0 likewise; "1" was "target_id 1 is not a
+    # target ... (ids 1)".
+    seq = read(FIXTURES / "enter-leave.h5")
+    boxes = np.asarray(seq.gt.box[:, 0], dtype=np.float64)
+    with pytest.raises(ConfigError,
+                       match=rf"^target_id must be an integer entity id, got {bad!r}$"):
+        evaluate_target(seq, boxes, bad)
+    assert evaluate_target(seq, boxes, np.int64(1)).targets[0].id == 1
+
+
 def test_separators_nan_rows_byte_order_mark_and_line_ends_are_read(tmp_path):
     path = tmp_path / "r.txt"
     rows = ["1,2,3,4", "1\t2\t3\t4", "1 2  3 4", " 1, 2 ,3\t,4 ", "nan,nan,nan,nan",

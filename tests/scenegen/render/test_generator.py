@@ -470,3 +470,16 @@ def test_a_start_outside_a_bounded_axis_is_brought_inside_at_frame_1(boundary, f
     cfg = SceneConfig(width=320, height=120, n_frames=3, entities=(e,))
     path = scenegen.generate(cfg, seed=0).gt.path_center[:, 0, 0]
     assert path[0] == 5.0 and path[1] == frame1 and 35.0 <= path[2] <= 285.0
+
+
+@pytest.mark.parametrize(("frame", "error"), [
+    (5, IndexError), (-6, IndexError), (1.5, TypeError), (True, TypeError),
+    ("0", TypeError), ([0, 1], TypeError), (None, TypeError),
+])  # fmt: skip
+def test_a_frame_outside_the_sequence_is_one_line_naming_frame_and_the_range(frame, error):
+    # Was numpy's IndexError naming neither ([0, 1] even returned boxes of two frames).
+    seq = scenegen.generate("shm-crossing", seed=3, frames=5)
+    for method in (seq.init_boxes, seq.initial_targets):
+        with pytest.raises(error, match=r"^frame must be an integer in \[-5, 4\], got "):
+            method(frame)
+    assert seq.init_boxes(np.int64(-5)).tolist() == seq.init_boxes(0).tolist()
