@@ -81,13 +81,14 @@ from trackers.kernels.stages import (
 )
 from trackers.models.dynamics import AR2, boxes_from_states, check_ar2, states_from_boxes
 from trackers.models.observation import (
+    MAX_HISTOGRAM_LENGTH,
+    MAX_PARTS,
     MODELS,
     ColourModel,
     FrameLikelihood,
     ObservationModel,
 )
 from trackers.params import (
-    MAX_PARTICLES,
     RNG_RANDOM,
     FieldDoc,
     TrackerParams,
@@ -177,7 +178,10 @@ class ParticleParams(TrackerParams):
                                    "(``trackers.models.observation``)."),
         "bins": ("int", "Histogram bins per colour channel, in [1, 256]."),
         "n_parts": ("int or None", "Spatial components (horizontal bands) of a region, in "
-                                   "[1, ``trackers.params.MAX_PARTICLES``]; None: the "
+                                   f"[1, {MAX_PARTS}] (the colour model's histogram, "
+                                   "``n_parts`` × its bins per part, at most "
+                                   f"{MAX_HISTOGRAM_LENGTH} long: "
+                                   "``trackers.models.observation.ColourModel``); None: the "
                                    "model's default ("
                                    + ", ".join(f'{n} for "{m}"' for m, (n, _) in MODELS.items())
                                    + ")."),
@@ -225,7 +229,7 @@ class ParticleParams(TrackerParams):
         check_number(self, "lam", low=0.0, low_open=True)
         check_choice(self, "model", MODELS, what="observation model")
         check_integer(self, "bins", low=1, high=256)
-        check_integer(self, "n_parts", low=1, high=MAX_PARTICLES, optional=True)
+        check_integer(self, "n_parts", low=1, high=MAX_PARTS, optional=True)
         if self.kernel is not None:
             check_choice(self, "kernel", KERNELS)
         check_integer(self, "box_levels", low=1, high=16)

@@ -29,9 +29,10 @@ class TrackResult:
     boxes : ndarray of shape (T, K, 4)
         Estimated boxes; frame 0 holds the initial boxes.
     extras : dict of str to ndarray
-        Per-frame diagnostics stacked over frames, shape (T, ...); frame 0 repeats frame 1's
-        shape with NaN (floats) where the tracker reports nothing before its first step
-        (0 for other dtypes).
+        Per-frame diagnostics stacked over frames, shape (T, ...), one entry per key any
+        step gave. A key first given at frame t0 is filled with NaN (floats; 0 for other
+        dtypes) at frames 0 to t0 − 1 (frame 0: the tracker reports nothing before its
+        first step), and must then be given, with the same shape, at every later frame.
         Empty for a tracker whose estimates have no ``extras``.
     """
 
@@ -104,24 +105,26 @@ def estimate_boxes(tracker: Any, estimate: Any, n_targets: int, frame: int) -> N
 
 def _stack_extras(tracker: Any, per_frame: list[dict[str, Any]], n: int) -> dict[str, Any]:
     extras: dict[str, NDArray[Any]] = {}
-    if n < 2:
-        return extras
-    for key in per_frame[1]:
-        first = np.asarray(per_frame[1][key])
+    # Every key, in the order first given; one given from frame t0 on is kept, filled for
+    # the frames before it as frame 0 is (it was dropped when t0 > 1).
+    keys = dict.fromkeys(key for frame_extras in per_frame for key in frame_extras)
+    for key in keys:
+        t0 = next(t for t in range(1, n) if key in per_frame[t])
+        first = np.asarray(per_frame[t0][key])
         is_float = first.dtype.kind == "f"
         stacked = np.empty((n, *first.shape), dtype=np.float64 if is_float else first.dtype)
-        stacked[0] = np.nan if is_float else 0
-        for t in range(1, n):
+        stacked[:t0] = np.nan if is_float else 0
+        for t in range(t0, n):
             if key not in per_frame[t]:
                 raise ValueError(
                     f"{_label(tracker)}.step() at frame {t}: extras lacks {key!r}, "
-                    "given at frame 1 (extras must have the same keys every frame)"
+                    f"given at frame {t0} (a key, once given, must be given every later frame)"
                 )
             value = np.asarray(per_frame[t][key])
             if value.shape != first.shape:
                 raise ValueError(
                     f"{_label(tracker)}.step() at frame {t}: extras[{key!r}] has shape "
-                    f"{value.shape}, {first.shape} at frame 1"
+                    f"{value.shape}, {first.shape} at frame {t0}"
                 )
             stacked[t] = value
         extras[key] = stacked
@@ -158,13 +161,16 @@ def track(
     Returns
     -------
     TrackResult
-        ``boxes`` (T, K, 4), ``init_boxes`` at frame 0, and the stacked ``extras``.
+        ``boxes`` (T, K, 4), ``init_boxes`` at frame 0, and the stacked ``extras``: every
+        key any step gave, NaN (0 for a non-float dtype) at the frames before its first
+        (:class:`TrackResult`).
 
     Raises
     ------
     ValueError
         If ``frames`` is empty, ``init_boxes`` is not (K, 4), or an estimate breaks the
-        protocol (naming the frame).
+        protocol (naming the frame): its ``boxes`` are wrong, or its ``extras`` lack a key
+        given at an earlier frame or change a key's shape (naming the key).
     TypeError
         If ``tracker`` lacks ``init`` or ``step``, or is a class rather than an instance,
         or ``frames`` has no length (a generator: pass ``list(frames)``).

@@ -20,7 +20,11 @@ import trackers
         ("annealed", {"sigma": "abc"}, "sigma must be a number or"),
         ("annealed", {"sigma": np.array([30, 15])}, "(one per layer), got [30, 15]"),  # np.int64
         ("kams", {"n_layers": 10**8}, "n_layers must be an integer in [1, 1000]"),  # 23 s, 1.6 GB
-        ("condensation", {"n_parts": 10**12}, "n_parts must be an integer in [1, 1000000]"),
+        ("condensation", {"n_parts": 10**12}, "n_parts must be an integer in [1, 256]"),
+        # 10**6 was accepted: 880 MB per box histogram.
+        ("dps", {"n_parts": 10**6}, "n_parts must be an integer in [1, 256] or None, got 1000000"),
+        ("ps", {"model": "rgb", "bins": 256, "n_parts": 2},
+         "n_parts=2 with bins=256 makes a 'rgb' histogram of 33554432 bins, more than"),
         ("condensation", {"rng": -1}, "rng must be a numpy Generator, a non-negative int"),
         ("kalman", {"process_std": 1e300}, "process_std must be in [0, 1e+06]"),  # Overflow
         # NaN boxes (a1 was bounded by 100, which still overflowed: see below).

@@ -86,6 +86,36 @@ def test_track_stacks_extras_and_names_a_missing_key():
         trackers.track(WithExtras(), _frames(4), [[2, 3, 5, 6]])
 
 
+def test_track_keeps_an_extras_key_first_given_after_frame_1():
+    # A key first given at frame 2 was silently dropped (only frame 1's keys were stacked).
+    class Late(Still):
+        def init(self, frame, boxes):
+            super().init(frame, boxes)
+            self.t = 0
+
+        def step(self, frame):
+            self.t += 1
+            extras = {"n": np.array(self.t)} if self.t >= 2 else {}
+            if self.t >= 3:
+                extras["late"] = np.array([0.5 * self.t])
+            return SimpleNamespace(boxes=self.boxes, extras=extras)
+
+    out = trackers.track(Late(), _frames(4), [[2, 3, 5, 6]])
+    assert list(out.extras) == ["n", "late"]
+    assert out.extras["n"].tolist() == [0, 0, 2, 3]  # an integer key: 0 before
+    assert np.isnan(out.extras["late"][:3]).all() and out.extras["late"][3, 0] == 1.5
+
+    class Gone(Late):
+        def step(self, frame):
+            est = super().step(frame)
+            if self.t == 3:
+                del est.extras["n"]
+            return est
+
+    with pytest.raises(ValueError, match="at frame 3: extras lacks 'n', given at frame 2"):
+        trackers.track(Gone(), _frames(4), [[2, 3, 5, 6]])
+
+
 @pytest.mark.parametrize("value", ["abc", [1, 2], None, True])
 def test_matcher_parameters_of_the_wrong_type_are_named(value):
     # numpy's "ufunc 'isfinite' not supported" named no parameter.

@@ -326,7 +326,9 @@ class KalmanFilter:
         ------
         ValueError
             If ``H``, ``R`` or ``z`` has the wrong shape (for ``R``: not (m', m') for the
-            ``H`` used, ``self.R`` included).
+            ``H`` used, ``self.R`` included), or the innovation covariance S of a filter
+            given a measurement is singular (say R = 0 and P = 0), naming the filter;
+            ``x`` and ``P`` are then left as they were.
         """
         b, n = self.x.shape
         h = self.H if H is None else np.asarray(H, dtype=np.float64)
@@ -355,7 +357,15 @@ class KalmanFilter:
         # S = H P H' + R  (innovation covariance)
         s = h @ pht + rr
         # SI = S^-1
-        si = np.linalg.inv(s)
+        try:
+            si = np.linalg.inv(s)
+        except np.linalg.LinAlgError:  # "Singular matrix", naming no filter
+            i = next(j for j in range(s.shape[0]) if _singular(s[j]))
+            raise ValueError(
+                f"KalmanFilter.update: the innovation covariance S = H P H' + R of filter "
+                f"{int(np.flatnonzero(seen)[i])} is singular (R and P leave no uncertainty "
+                f"in a measured direction)"
+            ) from None
         # K = P H' S^-1  (Kalman gain)
         k = pht @ si
         # x = x + K y  (posterior mean)
@@ -391,6 +401,15 @@ class KalmanFilter:
         self.K[miss] = 0.0
         self.x_post = self.x.copy()
         self.P_post = self.P.copy()
+
+
+def _singular(s: FloatArray) -> bool:
+    """Whether ``np.linalg.inv`` refuses the square matrix ``s``."""
+    try:
+        np.linalg.inv(s)
+    except np.linalg.LinAlgError:
+        return True
+    return False
 
 
 def _matrix(name: str, value: ArrayLike, shape: tuple[int, int]) -> FloatArray:

@@ -85,6 +85,8 @@ from trackers.kernels.meanshift import MEAN_SHIFT_KERNELS, MeanShiftResult, mean
 from trackers.kernels.quantize import _is_integer, _is_number
 
 __all__ = [
+    "MAX_HISTOGRAM_LENGTH",
+    "MAX_PARTS",
     "MODELS",
     "ColourModel",
     "FrameLikelihood",
@@ -164,6 +166,15 @@ class ObservationModel(Protocol):
         """
         ...
 
+#: Largest ``n_parts``, as ``bins``: a band carries colour only while at least a pixel row
+#: tall, so more bands only pay for boxes over 256 px tall. It was unbounded here, and
+#: ``ParticleParams`` took up to 10⁶ (880 MB per "hsv" box histogram).
+MAX_PARTS = 256
+
+#: Largest histogram length ``n_parts * n_bins`` (128 MiB of float64): that of the largest
+#: one-part model, "rgb" with 256 bins per channel.
+MAX_HISTOGRAM_LENGTH = 256**3
+
 #: Observation model names and their default (n_parts, kernel).
 MODELS: dict[str, tuple[int, str]] = {
     "hsv": (2, "epanechnikov"),
@@ -181,8 +192,9 @@ class ColourModel:
     bins : int, optional
         Bins per channel (1–256).
     n_parts : int or None, optional
-        Horizontal bands per region (spatial components); None takes the model's default
-        (2 for "hsv", 1 for "rgb").
+        Horizontal bands per region (spatial components), in [1, :data:`MAX_PARTS`], with
+        ``n_parts * n_bins`` at most :data:`MAX_HISTOGRAM_LENGTH`; None takes the model's
+        default (2 for "hsv", 1 for "rgb").
     kernel : {"uniform", "epanechnikov", "cone", "box"} or None, optional
         Kernel profile weighting the pixels of a region; None takes the model's default
         ("epanechnikov" for "hsv", "cone" for "rgb"). "box" is the nested-rectangle step
@@ -194,6 +206,13 @@ class ColourModel:
         λ of the likelihood p(Z | X) ∝ exp(−λ d²) (docs/algorithms.md §2.2), > 0.
     s_min, v_min : float, optional
         Saturation and value thresholds of the "hsv" model (fractions of the range).
+
+    Raises
+    ------
+    ValueError
+        For a bad value, naming the parameter: an unknown ``kind`` or ``kernel``, or a
+        number out of its range (``n_parts`` above :data:`MAX_PARTS`, or a histogram
+        longer than :data:`MAX_HISTOGRAM_LENGTH`, included).
 
     Attributes
     ----------
@@ -237,6 +256,8 @@ class ColourModel:
             raise ValueError(f"bins must be an integer in [1, 256], got {bins!r}")
         if not (_is_integer(n_parts) and n_parts >= 1):
             raise ValueError(f"n_parts must be a positive integer, got {n_parts!r}")
+        if n_parts > MAX_PARTS:
+            raise ValueError(f"n_parts must be an integer in [1, {MAX_PARTS}], got {n_parts!r}")
         if not isinstance(kernel, str) or kernel not in KERNELS:
             raise ValueError(f"unknown kernel {kernel!r}; valid: {', '.join(KERNELS)}")
         if not (_is_number(lam) and np.isfinite(lam) and lam > 0):
@@ -256,6 +277,10 @@ class ColourModel:
         self.n_bins = hsv_n_bins(self.bins, self.bins, self.bins) if kind == "hsv" else (
             self.bins ** 3)
         self.dim = self.n_parts * self.n_bins
+        if self.dim > MAX_HISTOGRAM_LENGTH:
+            raise ValueError(f"n_parts={self.n_parts} with bins={self.bins} makes a {kind!r} "
+                             f"histogram of {self.dim} bins, more than "
+                             f"MAX_HISTOGRAM_LENGTH = {MAX_HISTOGRAM_LENGTH}")
         self._prepared: PreparedReferences | None = None
 
     def quantize(self, frame: NDArray[np.uint8]) -> NDArray[np.int32]:
@@ -571,9 +596,36 @@ class _PositionFrame:
 
     def log_likelihoods(self, boxes: NDArray[np.floating], objects: NDArray[np.integer]
                         ) -> NDArray[np.float64]:
-        """log N(c(box); z_k, R) (P,) of boxes (P, 4) of objects (P,)."""
+        """log N(c(box); z_k, R) (P,) of boxes (P, 4) of objects (P,).
+
+        Parameters
+        ----------
+        boxes : ndarray of shape (P, 4)
+            Candidate boxes [x, y, w, h] in px.
+        objects : ndarray of shape (P,), integer
+            Object index k of each box, in [0, K).
+
+        Returns
+        -------
+        ndarray of float64, shape (P,)
+            log N(c(box); z_k, R); log N at its mean where z_k is NaN.
+
+        Raises
+        ------
+        ValueError
+            If an object index is not an integer in [0, K) (naming the range given).
+        """
         b = np.asarray(boxes, dtype=np.float64)
+        idx = np.asarray(objects)
+        n_objects = self.z.shape[0]
+        # A raw IndexError (or a negative index read from the end) named nothing.
+        if idx.size and idx.dtype.kind not in "iu":
+            raise ValueError(f"objects must be integers in [0, {n_objects}), got dtype "
+                             f"{idx.dtype}")
+        if idx.size and (idx.min() < 0 or idx.max() >= n_objects):
+            raise ValueError(f"objects must be integers in [0, {n_objects}) (the "
+                             f"measurements' objects), got [{idx.min()}, {idx.max()}]")
         centres = b[:, :2] + b[:, 2:4] / 2
-        dev = (centres - self.z[np.asarray(objects)]) @ self.model._chol_inv.T
+        dev = (centres - self.z[idx]) @ self.model._chol_inv.T
         ll = self.model._log_norm - 0.5 * np.einsum("pc,pc->p", dev, dev)
         return np.where(np.isnan(ll), self.model._log_norm, ll)

@@ -360,3 +360,19 @@ def test_ar2_explosive_coefficients_are_refused(a1, a2):
 @pytest.mark.parametrize("a1, a2", [(2.0, -1.0), (0.0, 1.0), (-2.0, -1.0), (1.9, -0.9)])
 def test_ar2_coefficients_on_the_stable_boundary_are_accepted(a1, a2):
     assert MotionModel.ar2(a1=a1, a2=a2, noise_std=1.0).F[0, 0] == a1
+
+
+def test_a_singular_innovation_covariance_is_one_error_naming_the_filter():
+    # R = 0 and P = 0 made S = 0: a raw numpy LinAlgError "Singular matrix".
+    model = MotionModel.constant_velocity(accel_std=1.0)
+    p = np.zeros((3, 4, 4))
+    p[0] = p[2] = np.eye(4)
+    kf = KalmanFilter(np.zeros((3, 4)), p, model.F, np.zeros((4, 4)), model.H, np.zeros((2, 2)))
+    z = np.zeros((3, 2))
+    with pytest.raises(ValueError, match="covariance S = H P H' \\+ R of filter 1 is singular"
+                       ) as info:
+        kf.update(z)
+    assert type(info.value) is ValueError
+    assert np.array_equal(kf.P, p) and np.array_equal(kf.x, np.zeros((3, 4)))
+    z[1] = np.nan  # filter 1 missed: only the others are updated
+    kf.update(z)

@@ -292,6 +292,12 @@ def test_model_scores_template_at_zero_and_shifted_worse(kind):
     ({"bins": float("nan")}, "bins must be an integer in \\[1, 256\\], got nan"),
     ({"bins": True}, "bins must be an integer in \\[1, 256\\], got True"),
     ({"n_parts": "2"}, "n_parts must be a positive integer, got '2'"),
+    # Unbounded: 10**9 parts asked for an 880 GB histogram per box.
+    ({"n_parts": 10**9}, "n_parts must be an integer in \\[1, 256\\], got 1000000000"),
+    ({"n_parts": 257}, "n_parts must be an integer in \\[1, 256\\], got 257"),
+    ({"kind": "rgb", "bins": 64, "n_parts": 65},
+     "n_parts=65 with bins=64 makes a 'rgb' histogram of 17039360 bins, more than "
+     "MAX_HISTOGRAM_LENGTH = 16777216"),
     ({"lam": "20"}, "lam must be a positive number, got '20'"),
     ({"lam": None}, "lam must be a positive number, got None"),
     ({"s_min": "0.1"}, "s_min must lie in \\[0, 1\\], got '0.1'"),

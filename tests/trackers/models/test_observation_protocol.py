@@ -89,3 +89,19 @@ def test_position_model_rejects_bad_input():
     model.observe(None)
     with pytest.raises(ValueError, match="frame 2 observed"):
         model.observe(None)
+
+
+@pytest.mark.parametrize(
+    ("objects", "needle"),
+    [
+        ([0, 2], r"objects must be integers in \[0, 2\) .*got \[0, 2\]"),  # was IndexError
+        ([-1, 0], r"got \[-1, 0\]"),  # was read silently from the last object
+        ([0.0, 1.0], "got dtype float64"),  # was IndexError
+    ],
+)
+def test_position_model_names_an_object_index_out_of_range(objects, needle):
+    model = PositionModel(np.zeros((2, 2, 2)), np.eye(2))
+    model.set_references(np.zeros((5, 5, 3), np.uint8), np.ones((2, 4)))
+    obs = model.observe(None)
+    with pytest.raises(ValueError, match=needle):
+        obs.log_likelihoods(np.ones((2, 4)), np.array(objects))
