@@ -131,7 +131,7 @@ def test_otb_curves_of_one_frame_and_of_no_frame():
                       ).error_thresholds.tolist() == [0.0, 1.0, 2.0, 3.0]
     # Two overlap thresholds (0 and 1) are allowed, one is not.
     assert otb_curves(est, gt, n_overlap=2).success.tolist() == [1.0, 0.0]
-    with pytest.raises(ValueError, match="n_overlap must be >= 2"):
+    with pytest.raises(ValueError, match=r"n_overlap must be an integer in \[2, 10001\], got 1"):
         otb_curves(est, gt, n_overlap=1)
     assert otb_curves(np.array([[19.5, 0.0, 10.0, 10.0]]), gt).precision_20 == 1.0
     # No frame with ground truth: NaN curves, without a warning.
