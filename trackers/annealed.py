@@ -240,11 +240,6 @@ class AnnealedParams(ColourParams):
     Parameters
     ----------
     {parameters}
-
-    Raises
-    ------
-    ValueError
-        For a bad value, naming the parameter.
     """
 
     FIELD_DOCS: ClassVar[dict[str, FieldDoc]] = {

@@ -33,11 +33,6 @@ class HybridParams(MeanShiftParams):
     Parameters
     ----------
     {parameters}
-
-    Raises
-    ------
-    ValueError
-        For a bad value, naming the parameter.
     """
 
     FIELD_DOCS: ClassVar[dict[str, FieldDoc]] = {

@@ -100,11 +100,6 @@ class KalmanParams(TrackerParams):
     Parameters
     ----------
     {parameters}
-
-    Raises
-    ------
-    ValueError
-        For a bad value, naming the parameter.
     """
 
     FIELD_DOCS: ClassVar[dict[str, FieldDoc]] = {

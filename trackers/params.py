@@ -26,7 +26,8 @@ it redeclares, say with another default, included). The ``Parameters`` sections 
 dataclass and of its tracker class are generated from those entries by the class
 decorator :func:`documented` (the pattern of scipy's and matplotlib's shared docstring
 parts): a line ``{parameters}`` in the class docstring becomes one numpydoc entry per
-field, in field order, with the default read from the field itself::
+field, in field order, with the default read from the field itself, and a parameter
+dataclass gets the one ``Raises`` section of its checks (:data:`PARAMS_RAISES`)::
 
     >>> from dataclasses import dataclass
     >>> @documented()
@@ -48,6 +49,11 @@ field, in field order, with the default read from the field itself::
             Window kernel.
         cells : int, default 3
             Cells per side, >= 1.
+    <BLANKLINE>
+        Raises
+        ------
+        ValueError
+            For a bad value, naming the parameter.
 
 A field that no ``FIELD_DOCS`` of its declaring class documents is refused when the
 class is decorated (at import), so a parameter cannot be added undocumented, nor its
@@ -88,6 +94,10 @@ FieldDoc = tuple[str, str]
 
 #: The line of a class docstring that :func:`documented` replaces by the parameters.
 PARAMETERS_MARKER = "{parameters}"
+
+#: The ``Raises`` section :func:`documented` gives a parameter dataclass (its checks in
+#: ``__post_init__``), after its parameters, unless its docstring has one of its own.
+PARAMS_RAISES = ("Raises", "------", "ValueError", "    For a bad value, naming the parameter.")
 
 #: The ``rng`` entry (``extra`` of :func:`documented`) of a tracker that draws random numbers.
 RNG_RANDOM: dict[str, FieldDoc] = {
@@ -432,9 +442,11 @@ def documented(params: type[TrackerParams] | None = None, *,
     The docstring's line ``{parameters}`` (:data:`PARAMETERS_MARKER`, alone on its line,
     at the docstring's indentation, under the ``Parameters`` heading) is replaced by
     :func:`parameter_entries` of ``params`` at that indentation, followed by the
-    ``extra`` entries (a tracker's ``rng``: :data:`RNG_RANDOM`, :data:`RNG_UNUSED`).
-    Decorate a parameter dataclass *above* ``@dataclass``. Under ``python -OO`` the
-    docstring is left as it is (stripped); the fields are checked all the same.
+    ``extra`` entries (a tracker's ``rng``: :data:`RNG_RANDOM`, :data:`RNG_UNUSED`). A
+    parameter dataclass whose docstring has no ``Raises`` section gets
+    :data:`PARAMS_RAISES` after its parameters. Decorate a parameter dataclass *above*
+    ``@dataclass``. Under ``python -OO`` the docstring is left as it is (stripped); the
+    fields are checked all the same.
 
     Parameters
     ----------
@@ -485,6 +497,8 @@ def documented(params: type[TrackerParams] | None = None, *,
         block = parameter_entries(source, indent)
         for name, (type_text, description) in (extra or {}).items():
             block += _entry(name, type_text, description, indent)
+        if own is cls and not any(line.strip() == "Raises" for line in lines):
+            block += ["", *(indent + part for part in PARAMS_RAISES), ""]
         lines[at[0]: at[0] + 1] = block
         cls.__doc__ = "\n".join(lines)
         return cls

@@ -182,11 +182,6 @@ class FastShmParams(KalmanParams):
     Parameters
     ----------
     {parameters}
-
-    Raises
-    ------
-    ValueError
-        For a bad value, naming the parameter.
     """
 
     FIELD_DOCS: ClassVar[dict[str, FieldDoc]] = {
@@ -232,11 +227,6 @@ class ShmParams(FastShmParams):
     Parameters
     ----------
     {parameters}
-
-    Raises
-    ------
-    ValueError
-        For a bad value, naming the parameter.
     """
 
     FIELD_DOCS: ClassVar[dict[str, FieldDoc]] = {

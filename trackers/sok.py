@@ -36,11 +36,6 @@ class SokParams(MeanShiftParams):
     Parameters
     ----------
     {parameters}
-
-    Raises
-    ------
-    ValueError
-        For a bad value, naming the parameter.
     """
 
     FIELD_DOCS: ClassVar[dict[str, FieldDoc]] = {

@@ -126,3 +126,22 @@ def test_entries_keep_the_docstring_indentation_and_extras_follow():
     assert "\n".join([*lines, "rng : int", "    Seed."]) in doc
     assert list(_section(Tool)) == ["kernel", "bins", "max_iter", "eps", "rng"]
     assert doc.endswith("Notes\n-----\nNothing.")
+
+
+def test_a_parameter_dataclass_gets_the_standard_raises_section_once():
+    # Written once (trackers.params.PARAMS_RAISES) instead of in every dataclass; a
+    # docstring with a Raises section of its own keeps it alone.
+    from trackers.params import PARAMS_RAISES
+    from trackers.particle import ParticleParams
+
+    made = _decorate("WiderParams", ParticleParams, [("n_rings", int, 2)],
+                     docs={"n_rings": ("int", "Rings.")})
+    doc = ClassDoc(made, config={"show_class_members": False})
+    assert [(e.type, e.desc) for e in doc["Raises"]] == [("ValueError", [PARAMS_RAISES[3].strip()])]
+    own = _decorate("OwnParams", TrackerParams, [],
+                    doc="Own.\n\n    Parameters\n    ----------\n    {parameters}\n\n"
+                        "    Raises\n    ------\n    KeyError\n        Never.\n    ")
+    assert [e.type for e in ClassDoc(own, config={"show_class_members": False})["Raises"]] == \
+        ["KeyError"]
+    for name in NAMES:
+        assert inspect.getdoc(get_class(name).Params).count("\nRaises\n") == 1, name
