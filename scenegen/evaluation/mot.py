@@ -25,7 +25,9 @@ Examples
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -40,9 +42,15 @@ __all__ = [
     "MotScores",
     "box_iou",
     "check_threshold",
+    "COUNT_KEYS",
+    "HOTA_COUNT_KEYS",
+    "add_counts",
     "clear",
+    "combine",
+    "from_counts",
     "hota",
     "identity",
+    "mot_counts",
     "mot_frames",
     "remove_distractor_matches",
     "score_all",
@@ -282,6 +290,8 @@ class ClearScores:
         Objects tracked in more than 80 %, 20–80 %, less than 20 % of their frames.
     frag : int
         Times an object's track resumes after an interruption.
+    motp_sum : float
+        Summed IoU of the matches (TrackEval's ``MOTP_sum``; what :func:`combine` adds up).
     """
 
     mota: float
@@ -295,6 +305,7 @@ class ClearScores:
     pt: int
     ml: int
     frag: int
+    motp_sum: float = 0.0
 
 
 def _clear_final(tp: int, fn: int, fp: int, idsw: int, motp_sum: float, mt: int, pt: int,
@@ -304,7 +315,7 @@ def _clear_final(tp: int, fn: int, fp: int, idsw: int, motp_sum: float, mt: int,
         mota=(tp - fp - idsw) / n,
         motp=motp_sum / max(1.0, tp),
         moda=(tp - fp) / n,
-        tp=tp, fn=fn, fp=fp, idsw=idsw, mt=mt, pt=pt, ml=ml, frag=frag,
+        tp=tp, fn=fn, fp=fp, idsw=idsw, mt=mt, pt=pt, ml=ml, frag=frag, motp_sum=motp_sum,
     )  # fmt: skip
 
 
@@ -498,6 +509,11 @@ class HotaScores:
     detre, detpr, assre, asspr : float
         Detection and association recall and precision.
     hota_alpha, deta_alpha, assa_alpha, loca_alpha : ndarray of shape (19,)
+    assre_alpha, asspr_alpha : ndarray of shape (19,)
+        Association recall and precision per threshold.
+    tp_alpha, fn_alpha, fp_alpha : ndarray of shape (19,)
+        Detection true positives, misses and false positives per threshold (TrackEval's
+        ``HOTA_TP``, ``HOTA_FN``, ``HOTA_FP``; what :func:`combine` adds up).
     """
 
     hota: float
@@ -512,6 +528,11 @@ class HotaScores:
     deta_alpha: NDArray[np.float64]
     assa_alpha: NDArray[np.float64]
     loca_alpha: NDArray[np.float64]
+    assre_alpha: NDArray[np.float64]
+    asspr_alpha: NDArray[np.float64]
+    tp_alpha: NDArray[np.float64]
+    fn_alpha: NDArray[np.float64]
+    fp_alpha: NDArray[np.float64]
 
 
 def _hota_final(tp: NDArray, fn: NDArray, fp: NDArray, assa: NDArray, assre: NDArray,
@@ -525,6 +546,7 @@ def _hota_final(tp: NDArray, fn: NDArray, fp: NDArray, assa: NDArray, assre: NDA
         loca=float(np.mean(loca)), detre=float(np.mean(detre)), detpr=float(np.mean(detpr)),
         assre=float(np.mean(assre)), asspr=float(np.mean(asspr)),
         hota_alpha=h, deta_alpha=deta, assa_alpha=assa, loca_alpha=loca,
+        assre_alpha=assre, asspr_alpha=asspr, tp_alpha=tp, fn_alpha=fn, fp_alpha=fp,
     )  # fmt: skip
 
 
@@ -548,9 +570,12 @@ def hota(data: MotFrames) -> HotaScores:
     n_a = len(HOTA_ALPHAS)
     zeros = np.zeros(n_a)
     if data.n_tracker_dets == 0 or data.n_gt_dets == 0:
-        # TrackEval returns before computing the final fields: all 0 but LocA = 1.
-        return HotaScores(0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0,
-                          zeros, zeros, zeros, np.ones(n_a))  # fmt: skip
+        # TrackEval returns before computing the final fields: all 0 but LocA = 1; every
+        # ground-truth detection is a miss and every tracker detection a false positive.
+        fn = np.full(n_a, float(data.n_gt_dets))
+        fp = np.full(n_a, float(data.n_tracker_dets))
+        return HotaScores(0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, zeros, zeros, zeros,
+                          np.ones(n_a), zeros, zeros, zeros, fn, fp)  # fmt: skip
     ng, nt = data.n_gt_ids, data.n_tracker_ids
     potential = np.zeros((ng, nt))
     gt_count = np.zeros((ng, 1))
@@ -640,3 +665,166 @@ def score_all(data: MotFrames, *, threshold: float = 0.5) -> MotScores:
         identity=identity(data, threshold=threshold),
         hota=hota(data),
     )
+
+
+_CLEAR_COUNTS = ("tp", "fn", "fp", "idsw", "motp_sum", "mt", "pt", "ml", "frag")
+_IDENTITY_COUNTS = ("idtp", "idfn", "idfp")
+HOTA_COUNT_KEYS = ("hota_tp", "hota_fn", "hota_fp", "assa_tp", "assre_tp", "asspr_tp", "loca_tp")
+"""The keys of :func:`mot_counts` that hold one value per HOTA threshold (19)."""
+COUNT_KEYS = (*_CLEAR_COUNTS, *_IDENTITY_COUNTS, *HOTA_COUNT_KEYS)
+"""The keys of :func:`mot_counts`: CLEAR's, the identity scores', then HOTA's (per threshold)."""
+
+
+def mot_counts(scores: MotScores) -> dict[str, Any]:
+    """The additive counts behind ``scores``: what TrackEval adds up over sequences.
+
+    Parameters
+    ----------
+    scores : MotScores
+        The scores of one sequence (:func:`score_all`), or of several (:func:`combine`).
+
+    Returns
+    -------
+    dict of str to int, float or list of float
+        One entry per :data:`COUNT_KEYS`: CLEAR's ``tp``, ``fn``, ``fp``, ``idsw``,
+        ``motp_sum`` (the matches' summed IoU), ``mt``, ``pt``, ``ml``, ``frag``; the
+        identity scores' ``idtp``, ``idfn``, ``idfp``; and HOTA's per-threshold lists
+        (19 values) ``hota_tp``, ``hota_fn``, ``hota_fp`` and AssA, AssRe, AssPr and LocA
+        each multiplied by that threshold's TP (``assa_tp`` ...). Plain JSON types:
+        :func:`from_counts` of the sum of several is :func:`combine` of their scores.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> gt = np.array([[[0, 0, 10, 10.]], [[1, 0, 10, 10.]]])      # (T=2, K=1, 4)
+    >>> counts = mot_counts(score_all(mot_frames(gt, gt)))
+    >>> counts["tp"], counts["idtp"], counts["hota_tp"][0]
+    (2, 2, 2.0)
+    """
+    c, i, h = scores.clear, scores.identity, scores.hota
+    out: dict[str, Any] = {k: getattr(c, k) for k in _CLEAR_COUNTS}
+    out["motp_sum"] = float(c.motp_sum)
+    out.update({k: getattr(i, k) for k in _IDENTITY_COUNTS})
+    tp = np.asarray(h.tp_alpha, dtype=np.float64)
+    out.update(hota_tp=tp.tolist(), hota_fn=np.asarray(h.fn_alpha, float).tolist(),
+               hota_fp=np.asarray(h.fp_alpha, float).tolist(),
+               assa_tp=(h.assa_alpha * tp).tolist(), assre_tp=(h.assre_alpha * tp).tolist(),
+               asspr_tp=(h.asspr_alpha * tp).tolist(), loca_tp=(h.loca_alpha * tp).tolist())
+    return out
+
+
+def add_counts(counts: Sequence[dict[str, Any]]) -> dict[str, Any]:
+    """The sum of several :func:`mot_counts`, key by key, in the given order.
+
+    Parameters
+    ----------
+    counts : sequence of dict
+        :func:`mot_counts` of each sequence, at least one.
+
+    Returns
+    -------
+    dict
+        The same keys: ints and floats added from 0 in order, as TrackEval's
+        ``_combine_sum`` adds; per-threshold lists added element by element.
+
+    Raises
+    ------
+    ValueError
+        If ``counts`` is empty or an entry lacks a key of :data:`COUNT_KEYS` or has a
+        per-threshold list of another length than 19.
+    """
+    counts = list(counts)
+    if not counts:
+        raise ValueError("add_counts: no counts to add (give one per sequence)")
+    n_a = len(HOTA_ALPHAS)
+    for c in counts:
+        bad = next((k for k in COUNT_KEYS if not isinstance(c, dict) or k not in c
+                    or (k in HOTA_COUNT_KEYS and len(c[k]) != n_a)), None)  # fmt: skip
+        if bad is not None:
+            raise ValueError(f"add_counts: an entry has no {bad!r} "
+                             f"(mot_counts gives {', '.join(COUNT_KEYS)})")  # fmt: skip
+    out: dict[str, Any] = {}
+    for k in COUNT_KEYS:
+        if k in HOTA_COUNT_KEYS:
+            out[k] = sum(np.asarray(c[k], dtype=np.float64) for c in counts).tolist()
+        else:
+            out[k] = sum(c[k] for c in counts)
+    return out
+
+
+def from_counts(counts: dict[str, Any]) -> MotScores:
+    """The scores of counts (:func:`mot_counts`, or :func:`add_counts` of several).
+
+    Parameters
+    ----------
+    counts : dict
+        Every key of :data:`COUNT_KEYS`.
+
+    Returns
+    -------
+    MotScores
+        The rates computed from the counts as TrackEval's ``_compute_final_fields`` does:
+        AssA, AssRe and AssPr the TP-weighted sums over max(1, TP), LocA the weighted sum
+        over TP (each at least 1e-10).
+    """
+    c = counts
+    clear_ = _clear_final(*(float(c[k]) if k == "motp_sum" else int(c[k])
+                            for k in _CLEAR_COUNTS))  # fmt: skip
+    identity_ = _identity_final(*(int(c[k]) for k in _IDENTITY_COUNTS))
+    tp, fn, fp = (np.asarray(c[k], dtype=np.float64) for k in ("hota_tp", "hota_fn", "hota_fp"))
+    share = {k: np.asarray(c[k], dtype=np.float64) / np.maximum(1.0, tp)
+             for k in ("assa_tp", "assre_tp", "asspr_tp")}  # fmt: skip
+    loca = np.maximum(1e-10, np.asarray(c["loca_tp"], dtype=np.float64)) / np.maximum(1e-10, tp)
+    hota_ = _hota_final(tp, fn, fp, share["assa_tp"], share["assre_tp"], share["asspr_tp"], loca)
+    return MotScores(clear=clear_, identity=identity_, hota=hota_)
+
+
+def combine(scores: Sequence[MotScores]) -> MotScores:
+    """The scores of several sequences taken as one, as TrackEval's ``COMBINED_SEQ``.
+
+    CLEAR MOT and the identity scores add up their counts over the sequences (TP, FN, FP,
+    IDSW, MT/PT/ML, Frag, the matches' summed IoU; IDTP, IDFN, IDFP) and compute the
+    rates from the sums. HOTA adds up its per-threshold TP, FN and FP and takes AssA,
+    AssRe, AssPr and LocA as means over the sequences weighted by their TP at each
+    threshold (:func:`mot_counts`, :func:`add_counts`, :func:`from_counts`). So a long or
+    crowded sequence weighs more than a short one, unlike the mean of the sequences'
+    rates; a sequence without any detection still adds its misses or false positives.
+
+    Parameters
+    ----------
+    scores : sequence of MotScores
+        One per sequence (:func:`score_all`), at least one, in the order to add them
+        (TrackEval adds in its sequence list's order; the sums' last bits depend on it).
+
+    Returns
+    -------
+    MotScores
+        The combined scores; for a single sequence, the same numbers.
+
+    Raises
+    ------
+    ValueError
+        If ``scores`` is empty or holds anything but :class:`MotScores`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> gt = np.array([[[0, 0, 10, 10.]], [[1, 0, 10, 10.]]])      # (T=2, K=1, 4)
+    >>> perfect = score_all(mot_frames(gt, gt))
+    >>> missed = score_all(mot_frames(gt, np.full_like(gt, np.nan)))
+    >>> both = combine([perfect, missed])
+    >>> both.clear.mota, both.clear.tp, both.clear.fn, both.identity.idf1
+    (0.5, 2, 2, 0.6666666666666666)
+    """
+    if isinstance(scores, MotScores) or not isinstance(scores, Iterable):
+        raise ValueError(f"combine: scores must be a sequence of MotScores (one per "
+                         f"sequence), not {type(scores).__name__}")  # fmt: skip
+    scores = list(scores)
+    if not scores:
+        raise ValueError("combine: scores is empty (give one MotScores per sequence)")
+    bad = next((s for s in scores if not isinstance(s, MotScores)), None)
+    if bad is not None:
+        raise ValueError(f"combine: scores must be MotScores (from score_all), "
+                         f"not {type(bad).__name__}")  # fmt: skip
+
+    return from_counts(add_counts([mot_counts(s) for s in scores]))

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass, field, fields
 from typing import Any
 
 from scenegen.evaluation.mot import MotScores
@@ -44,6 +44,10 @@ class MotSummary:
     hota, deta, assa, loca : float
         HOTA and its detection, association and localisation accuracy (means over the
         thresholds).
+    scores : MotScores or None
+        The full scores the numbers come from (:meth:`from_scores`), with the counts
+        :func:`scenegen.evaluation.mot.combine` adds up to score several sequences as one,
+        as TrackEval's ``COMBINED_SEQ``; not compared, not in :meth:`to_dict`.
 
     See Also
     --------
@@ -69,6 +73,7 @@ class MotSummary:
     deta: float
     assa: float
     loca: float
+    scores: MotScores | None = field(default=None, compare=False, repr=False)
 
     @classmethod
     def from_scores(cls, s: MotScores) -> MotSummary:
@@ -82,13 +87,26 @@ class MotSummary:
         Returns
         -------
         MotSummary
-            The same numbers, unchanged (undefined ones stay NaN until :meth:`to_dict`).
+            The same numbers, unchanged (undefined ones stay NaN until :meth:`to_dict`),
+            and ``s`` itself as :attr:`scores`.
+
+        Examples
+        --------
+        Two sequences scored as one, as TrackEval's summary row:
+
+        >>> import numpy as np
+        >>> from scenegen.evaluation.mot import combine, mot_frames, score_all
+        >>> gt = np.array([[[0, 0, 10, 10.]], [[1, 0, 10, 10.]]])      # (T=2, K=1, 4)
+        >>> a = MotSummary.from_scores(score_all(mot_frames(gt, gt)))
+        >>> b = MotSummary.from_scores(score_all(mot_frames(gt, np.full_like(gt, np.nan))))
+        >>> MotSummary.from_scores(combine([a.scores, b.scores])).mota
+        0.5
         """
         c, i, h = s.clear, s.identity, s.hota
         return cls(
             mota=c.mota, motp=c.motp, moda=c.moda, tp=c.tp, fp=c.fp, fn=c.fn, idsw=c.idsw,
             frag=c.frag, mt=c.mt, pt=c.pt, ml=c.ml, idf1=i.idf1, idp=i.idp, idr=i.idr,
-            hota=h.hota, deta=h.deta, assa=h.assa, loca=h.loca,
+            hota=h.hota, deta=h.deta, assa=h.assa, loca=h.loca, scores=s,
         )  # fmt: skip
 
     def to_dict(self) -> dict[str, Any]:
@@ -97,10 +115,11 @@ class MotSummary:
         Returns
         -------
         dict of str to float, int or None
-            One key per attribute (``mota`` ... ``loca``), in field order; floats that are
-            NaN or infinite become None, counts stay ints.
+            One key per attribute (``mota`` ... ``loca``; not :attr:`scores`), in field
+            order; floats that are NaN or infinite become None, counts stay ints.
         """
-        return {k: (_finite(v) if isinstance(v, float) else v) for k, v in asdict(self).items()}
+        values = {f.name: getattr(self, f.name) for f in fields(self) if f.name != "scores"}
+        return {k: (_finite(v) if isinstance(v, float) else v) for k, v in values.items()}
 
 
 @dataclass(frozen=True)
@@ -159,7 +178,7 @@ class TargetScores:
             :meth:`MotSummary.to_dict` (``mota``, ``idf1``, ``hota``, ...) at the same
             level; floats that are NaN or infinite become None.
         """
-        out = {k: v for k, v in asdict(self).items() if k != "mot"}
+        out = {f.name: getattr(self, f.name) for f in fields(self) if f.name != "mot"}
         for k, v in out.items():
             if isinstance(v, float):
                 out[k] = _finite(v)

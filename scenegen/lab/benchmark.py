@@ -80,6 +80,14 @@ CI_SEED = 0
 MULTI_TARGET = ("mota", "idf1", "hota")
 """Metrics reported only on sequences with several targets."""
 
+COMBINED: dict[str, str] = {
+    "mota_combined": "MOTA (combined)",
+    "idf1_combined": "IDF1 (combined)",
+    "hota_combined": "HOTA (combined)",
+}
+"""Leaderboard columns of the multi-target sequences taken as one, as TrackEval's
+``COMBINED_SEQ`` (their counts added up, :func:`scenegen.evaluation.mot.combine`)."""
+
 _CURVE_METRICS = ("auc", "precision_20", "success", "recovery", "mota", "idf1", "hota")
 _MAX_LEVELS = 8  # a numeric axis with more distinct values is binned into quantiles
 _BINS = 6
@@ -209,9 +217,11 @@ def run_pair(task: BenchTask) -> dict[str, Any]:
         ``key`` (:meth:`BenchTask.key`), ``tracker_seed``, ``targets`` (count),
         ``n_frames``, ``scores`` (one value or None per metric of :data:`METRICS`; every
         one None, and ``targets`` 0, when no target is present at frame 0),
-        ``sequence_params`` and ``deterministic``.
+        ``sequence_params`` and ``deterministic``; on a sequence with several targets
+        also ``mot_counts`` (:func:`scenegen.evaluation.mot.mot_counts`, floats rounded).
     """
     from scenegen.evaluation import evaluate
+    from scenegen.evaluation.mot import mot_counts
     from scenegen.io import read
     from scenegen.lab.run import run
 
@@ -229,7 +239,7 @@ def run_pair(task: BenchTask) -> dict[str, Any]:
         seq, res.boxes, res.target_ids, tracker=task.tracker,
         order_prob=res.order_prob, orderings=res.orderings,
     )  # fmt: skip
-    rep = report if isinstance(report, dict) else report.to_dict()
+    rep = report.to_dict()
     targets = rep["targets"]
     multi = len(targets) > 1
 
@@ -249,6 +259,8 @@ def run_pair(task: BenchTask) -> dict[str, Any]:
     for m in MULTI_TARGET:
         if m in rep["overall"]:
             scores[m] = rep["overall"][m] if multi else None
+    # What TrackEval adds up over sequences, for the leaderboard's combined columns.
+    counts = {"mot_counts": mot_counts(report.overall.mot.scores)} if multi else {}
     return _round(
         {
             "key": task.key(),
@@ -260,6 +272,7 @@ def run_pair(task: BenchTask) -> dict[str, Any]:
             # False for a tracker that says its runs are not reproducible (OpenCV's MIL):
             # ``validate --deep`` does not run it again.
             "deterministic": bool(getattr(done.tracker, "deterministic", True)),
+            **counts,
         }
     )
 
@@ -569,6 +582,9 @@ def _fmt(v: Any) -> str:
 _CI_NOTE = ("Each cell: the mean over the scored sequences [its 95 % percentile bootstrap "
             "interval over the sequences]; a ranking between overlapping intervals is not "
             "settled.")
+_COMBINED_NOTE = ("(combined): the sequences with several targets taken as one, as "
+                  "TrackEval's COMBINED_SEQ row: their counts added up, so each sequence "
+                  "weighs by its detections; no interval.")
 NONE_SCORED = "no sequence was scored (none has a target at frame 0)"
 """What the report says when no sequence of the dataset has a target at frame 0."""
 _NONE_SCORED_NOTE = (f"{NONE_SCORED[0].upper()}{NONE_SCORED[1:]}: no tracker has a score, "
@@ -605,8 +621,12 @@ def _cell(e: dict[str, Any], metric: str) -> str:
     return f"{_fmt(e[metric])} [{_fmt(ci[0])}, {_fmt(ci[1])}]"
 
 
+def _label(metric: str) -> str:
+    return METRICS.get(metric) or COMBINED[metric]
+
+
 def _columns(board: list[dict[str, Any]]) -> list[str]:
-    return [m for m in METRICS if any(e.get(m) is not None for e in board)]
+    return [m for m in (*METRICS, *COMBINED) if any(e.get(m) is not None for e in board)]
 
 
 def _markdown(board: list[dict[str, Any]]) -> str:
@@ -615,12 +635,14 @@ def _markdown(board: list[dict[str, Any]]) -> str:
     def row(cells: list[str]) -> str:
         return "| " + " | ".join(cells) + " |"
 
-    lines = [row(["rank", "tracker", "sequences", *(METRICS[c] for c in cols)]),
+    lines = [row(["rank", "tracker", "sequences", *(_label(c) for c in cols)]),
              "|---:|---|---:|" + "---:|" * len(cols)]  # fmt: skip
     for e in board:
         lines.append(row([str(e["rank"]), _md_text(e["tracker"]), str(e["sequences"]),
                           *(_cell(e, c) for c in cols)]))  # fmt: skip
     note = _CI_NOTE if scored(board) else _NONE_SCORED_NOTE
+    if scored(board) and any(c in cols for c in COMBINED):
+        note += "\n\n" + _COMBINED_NOTE
     return "\n".join(lines) + "\n\n" + note + "\n"
 
 
@@ -628,7 +650,7 @@ def _html(meta: dict[str, Any], board: list[dict[str, Any]], figures: list[tuple
           params: dict[str, dict[str, Any]]) -> str:  # fmt: skip
     e = html.escape
     cols = _columns(board)
-    head = "".join(f"<th>{e(METRICS[c])}</th>" for c in cols)
+    head = "".join(f"<th>{e(_label(c))}</th>" for c in cols)
     body = ""
     for r in board:
         cells = "".join(f"<td>{_cell(r, c)}</td>" for c in cols)
@@ -643,7 +665,8 @@ def _html(meta: dict[str, Any], board: list[dict[str, Any]], figures: list[tuple
     multi = [m for m in MULTI_TARGET if m in cols]
     note = f"<p>{e(_CI_NOTE)}</p>" + (
         f"<p>{', '.join(METRICS[m] for m in multi)}: means over the sequences with several "
-        "targets only.</p>" if multi else
+        "targets only.</p>" + (f"<p>{e(_COMBINED_NOTE)}</p>" if any(
+            c in cols for c in COMBINED) else "") if multi else
         "<p>No multi-target metric: every sequence has one target (or none was computed).</p>"
     )  # fmt: skip
     if not scored(board):
@@ -817,6 +840,43 @@ def dataset_meta(man: dict[str, Any], root: str | Path) -> dict[str, Any]:
     }
 
 
+def combined_scores(records: list[dict[str, Any]]) -> dict[str, dict[str, float | None]]:
+    """Per tracker, MOTA, IDF1 and HOTA of its multi-target sequences taken as one.
+
+    The counts of the records (``mot_counts``) are added up in record order and the rates
+    computed from the sums, as TrackEval's ``COMBINED_SEQ`` row
+    (:func:`scenegen.evaluation.mot.combine`): each sequence weighs by its detections.
+
+    Parameters
+    ----------
+    records : list of dict
+        Run records (:func:`run_pair`), trackers x sequences in task order.
+
+    Returns
+    -------
+    dict of str to dict
+        Per tracker of the records, one value per key of :data:`COMBINED`: None when it
+        has no multi-target sequence, or when one of its records has no counts (a run
+        recorded by a version before them).
+    """
+    from scenegen.evaluation.mot import add_counts, from_counts
+
+    multi: dict[str, list[dict[str, Any] | None]] = {}
+    for rec in records:
+        per = multi.setdefault(rec["key"]["tracker"], [])
+        if rec["targets"] > 1:
+            per.append(rec.get("mot_counts"))
+    out: dict[str, dict[str, float | None]] = {}
+    for tracker, counts in multi.items():
+        if not counts or any(c is None for c in counts):
+            out[tracker] = dict.fromkeys(COMBINED)
+            continue
+        s = from_counts(add_counts(counts))
+        out[tracker] = {"mota_combined": s.clear.mota, "idf1_combined": s.identity.idf1,
+                        "hota_combined": s.hota.hota}  # fmt: skip
+    return out
+
+
 def results_document(
     meta: dict[str, Any], trackers: list[str], records: list[dict[str, Any]]
 ) -> dict[str, Any]:
@@ -849,11 +909,16 @@ def results_document(
     per_tracker = {t: {} for t in trackers}
     for rec in records:
         per_tracker[rec["key"]["tracker"]] = dict(rec["key"]["params"])
+    board = leaderboard(rows, list(trackers))
+    if any("mot_counts" in rec for rec in records):
+        combined = combined_scores(records)
+        for e in board:
+            e.update(combined[e["tracker"]])
     return _round({
         "dataset": meta,
         "trackers": list(trackers),
         "params": per_tracker,
-        "leaderboard": leaderboard(rows, list(trackers)),
+        "leaderboard": board,
         "curves": curves(rows, list(meta["axes"]), list(trackers)),
         "scores": rows,
         "records": listing(records),

@@ -78,7 +78,8 @@ def record_problems(data: Any) -> list[str]:
         :meth:`scenegen.lab.benchmark.BenchTask.key`, ``tracker_seed``, ``targets`` or
         ``n_frames`` not ints, ``scores`` not metrics of
         :data:`scenegen.lab.benchmark.METRICS` with numbers or null,
-        ``sequence_params`` not a dict, ``deterministic`` not a bool.
+        ``sequence_params`` not a dict, ``deterministic`` not a bool, ``mot_counts`` (if
+        present) not the counts of :func:`scenegen.evaluation.mot.mot_counts`.
     """
     from scenegen.lab.benchmark import METRICS
 
@@ -100,7 +101,22 @@ def record_problems(data: Any) -> list[str]:
         out.append("sequence_params is missing or not a dict")
     if not isinstance(data.get("deterministic"), bool):
         out.append("deterministic is missing or not a bool")
+    if "mot_counts" in data and not _counts_ok(data["mot_counts"]):
+        out.append("mot_counts is not the counts of scenegen.evaluation.mot.mot_counts")
     return out
+
+
+def _counts_ok(counts: Any) -> bool:
+    """Whether ``counts`` has every key of ``mot_counts``: numbers, or lists of 19 numbers."""
+    from scenegen.evaluation.mot import COUNT_KEYS, HOTA_ALPHAS, HOTA_COUNT_KEYS
+
+    def number(v: Any) -> bool:
+        return _is(v, int) or _is(v, float)
+
+    return isinstance(counts, dict) and set(counts) == set(COUNT_KEYS) and all(
+        (isinstance(v, list) and len(v) == len(HOTA_ALPHAS) and all(map(number, v)))
+        if k in HOTA_COUNT_KEYS else number(v)
+        for k, v in counts.items())  # fmt: skip
 
 
 def read_record(path: Path) -> dict[str, Any]:

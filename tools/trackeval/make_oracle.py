@@ -13,7 +13,9 @@ fixtures). Every tracker is scored on every sequence under both ground-truth mod
 TrackEval's MOTChallenge dataset (``BENCHMARK=MOT17``, preprocessing on: rows with
 conf 0 are ignored and tracker boxes matched to distractors dropped) and its HOTA, CLEAR
 and Identity metrics. ``oracle.json`` holds, per mode, tracker and sequence, TrackEval's
-per-sequence numbers (full float precision) and the TrackEval commit used.
+per-sequence numbers (full float precision), and under ``combined``, per mode and
+tracker, its ``COMBINED_SEQ`` row (all the sequences taken as one), with the TrackEval
+commit used.
 This script does not import scenegen.
 """
 
@@ -57,7 +59,7 @@ def _value(metric: str, res: dict, field: str) -> float:
     return float(v)
 
 
-def score(mode: str, trackers: list[str], seqs: list[str]) -> dict:
+def score(mode: str, trackers: list[str], seqs: list[str]) -> tuple[dict, dict]:
     with tempfile.TemporaryDirectory() as out:
         eval_cfg = trackeval.Evaluator.get_default_eval_config()
         eval_cfg.update(
@@ -92,6 +94,7 @@ def score(mode: str, trackers: list[str], seqs: list[str]) -> dict:
         res, msg = evaluator.evaluate([trackeval.datasets.MotChallenge2DBox(data_cfg)], metrics)
     out_res = res["MotChallenge2DBox"]
     table: dict = {}
+    combined: dict = {}
     for tracker in trackers:
         if msg["MotChallenge2DBox"][tracker] != "Success":
             raise SystemExit(f"TrackEval failed on {tracker}: {msg['MotChallenge2DBox'][tracker]}")
@@ -100,7 +103,10 @@ def score(mode: str, trackers: list[str], seqs: list[str]) -> dict:
             table.setdefault(tracker, {})[seq] = {
                 f: _value(m, r, f) for m, fields in FIELDS.items() for f in fields
             }
-    return table
+        # TrackEval's scores of all the sequences taken as one (its summary row).
+        r = out_res[tracker]["COMBINED_SEQ"]["pedestrian"]
+        combined[tracker] = {f: _value(m, r, f) for m, fields in FIELDS.items() for f in fields}
+    return table, combined
 
 
 def _trackeval_commit() -> str:
@@ -128,10 +134,11 @@ def main() -> None:
         "numpy": np.__version__,
         "python": sys.version.split()[0],
         "modes": {},
+        "combined": {},
     }
     for mode in ("amodal", "visible"):
         seqs = sorted(p.name for p in (DATA / "gt" / mode).iterdir() if p.is_dir())
-        oracle["modes"][mode] = score(mode, trackers, seqs)
+        oracle["modes"][mode], oracle["combined"][mode] = score(mode, trackers, seqs)
     args.out.write_text(json.dumps(oracle, indent=1, sort_keys=True) + "\n")
     print(f"wrote {args.out}")
 

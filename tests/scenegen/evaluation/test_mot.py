@@ -8,12 +8,15 @@ import pytest
 from scenegen.evaluation import metrics
 from scenegen.evaluation.mot import (
     HOTA_ALPHAS,
+    MotScores,
     box_iou,
     clear,
+    combine,
     hota,
     identity,
     mot_frames,
     remove_distractor_matches,
+    score_all,
 )
 
 
@@ -104,3 +107,67 @@ def test_identity_of_twenty_thousand_track_ids_fits_in_memory():
     assert done.returncode == 0, done.stderr[-2000:]
     # Each object shares one frame with each of its tracks: one pair each is matched.
     assert done.stdout.split() == ["2", "18", str(20_000 - 2)]
+
+
+def _part(rng: np.random.Generator, kind: str) -> tuple[np.ndarray, np.ndarray]:
+    """A short seeded sequence (gt (T, K, 4), tracks (T, H, 4)): objects on random walks
+    with gaps; tracks that follow them with noise, drop boxes, swap and add clutter."""
+    t, k = int(rng.integers(3, 9)), int(rng.integers(1, 4))
+    gt = np.cumsum(rng.normal(0, 3, (t, k, 4)), axis=0) + [40, 40, 20, 20]
+    gt[..., 2:] = np.abs(gt[..., 2:]) + 5
+    gt[rng.random((t, k)) < 0.15] = np.nan
+    est = np.concatenate([gt + rng.normal(0, 2, gt.shape), gt[:, :1] + 30], axis=1)
+    est[rng.random(est.shape[:2]) < 0.2] = np.nan
+    est[t // 2:, :k] = est[t // 2:, rng.permutation(k)]
+    if kind == "no-tracks":
+        est[:] = np.nan
+    elif kind == "no-gt":
+        gt[:] = np.nan
+    return gt, est
+
+
+def _joined(parts):
+    """The parts one after another in time, each with its own object and track ids."""
+    t = sum(g.shape[0] for g, _ in parts)
+    gt = np.full((t, sum(g.shape[1] for g, _ in parts), 4), np.nan)
+    est = np.full((t, sum(e.shape[1] for _, e in parts), 4), np.nan)
+    t0 = k0 = h0 = 0
+    for g, e in parts:
+        gt[t0:t0 + len(g), k0:k0 + g.shape[1]] = g
+        est[t0:t0 + len(e), h0:h0 + e.shape[1]] = e
+        t0, k0, h0 = t0 + len(g), k0 + g.shape[1], h0 + e.shape[1]
+    return gt, est
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_combine_equals_the_sequences_scored_as_one(seed):
+    """TrackEval's COMBINED_SEQ (mot.combine) is the score of the sequences joined in time
+    with disjoint ids: the CLEAR and identity counts add, HOTA's per-threshold TP/FN/FP add
+    and its association and localisation are TP-weighted means. Parts without any track
+    or any object (TrackEval's early returns) add their misses or false positives."""
+    rng = np.random.default_rng(seed)
+    kinds = ["plain"] * int(rng.integers(1, 4)) + [["no-tracks", "no-gt", "plain"][seed % 3]]
+    parts = [_part(rng, kind) for kind in kinds]
+    got = combine([score_all(mot_frames(g, e), threshold=0.3) for g, e in parts])
+    want = score_all(mot_frames(*_joined(parts)), threshold=0.3)
+    for part in ("clear", "identity", "hota"):
+        a, b = getattr(got, part), getattr(want, part)
+        for name in a.__dataclass_fields__:
+            np.testing.assert_allclose(getattr(a, name), getattr(b, name), rtol=0,
+                                       atol=1e-12, err_msg=f"{part}.{name}")  # fmt: skip
+    assert want.clear.tp > 0 and want.clear.fn > 0
+
+
+def test_combine_of_one_sequence_and_bad_input():
+    gt, est = _part(np.random.default_rng(5), "plain")
+    one = score_all(mot_frames(gt, est))
+    again = combine([one])
+    assert again.clear == one.clear and again.identity == one.identity
+    assert again.hota.hota == one.hota.hota
+    with pytest.raises(ValueError, match="scores is empty"):
+        combine([])
+    with pytest.raises(ValueError, match="sequence of MotScores"):
+        combine(one)
+    with pytest.raises(ValueError, match="not dict"):
+        combine([one, {}])
+    assert isinstance(again, MotScores)

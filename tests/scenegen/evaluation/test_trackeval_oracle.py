@@ -18,6 +18,8 @@ import numpy as np
 import pytest
 
 from scenegen.evaluation import evaluate, evaluate_tracks
+from scenegen.evaluation.mot import combine
+from scenegen.evaluation.report import MotSummary
 from scenegen.io import read
 from scenegen.io.mot import gt_rows, read_mot_tracker, read_mot_tracker_rows
 
@@ -66,6 +68,32 @@ def test_scores_equal_trackeval(mode):
                         f"{tracker} on {name}: {field} {getattr(got, attr)} vs {ref[field]}"
                     )
     assert not diffs, "differs from TrackEval:\n" + "\n".join(diffs[:20])
+
+
+@pytest.mark.parametrize("mode", ["amodal", "visible"])
+def test_combined_scores_equal_trackeval(mode):
+    """mot.combine over a tracker's six sequences equals TrackEval's COMBINED_SEQ row (its
+    summary over a benchmark), and differs from the mean of the sequences' values."""
+    table, combined = ORACLE["modes"][mode], ORACLE["combined"][mode]
+    assert sorted(combined) == sorted(table)
+    cache = {}
+    diffs, apart = [], 0
+    for tracker, ref in combined.items():
+        parts = []
+        for name in sorted(table[tracker]):  # TrackEval adds in its sorted sequence list
+            seq = cache.setdefault(name, _seq(name))
+            path = DATA / "trackers" / tracker / f"{name}.txt"
+            ids, boxes, rank = read_mot_tracker_rows(path, seq.n_frames)
+            parts.append(evaluate_tracks(seq, boxes, ids, gt_mode=mode, rank=rank)
+                         .overall.mot.scores)  # fmt: skip
+        got = MotSummary.from_scores(combine(parts))
+        for field, attr in FIELDS.items():
+            if not abs(float(getattr(got, attr)) - ref[field]) <= TOL:
+                diffs.append(f"{tracker}: {field} {getattr(got, attr)} vs {ref[field]}")
+        mean_mota = np.mean([table[tracker][n]["MOTA"] for n in table[tracker]])
+        apart += abs(mean_mota - ref["MOTA"]) > 1e-3
+    assert not diffs, "differs from TrackEval's COMBINED_SEQ:\n" + "\n".join(diffs[:20])
+    assert apart >= 5  # the combined row is not the mean: the comparison is sharp
 
 
 def test_oracle_counts_every_kind_of_error():

@@ -73,6 +73,62 @@ def test_report(reference):
     assert len(csv) == 9 and csv[0].startswith("tracker,index,name,targets,clutter[0].count")
 
 
+def test_combined_columns_are_trackevals_combined_row(dataset, reference):
+    """MOTA/IDF1/HOTA (combined): the multi-target sequences' scores taken as one by
+    mot.combine (TrackEval's COMBINED_SEQ; test_trackeval_oracle), from each run redone
+    here, not the mean of the sequences' values; shown on both pages."""
+    from scenegen.evaluation import evaluate
+    from scenegen.evaluation.mot import combine
+    from scenegen.io import read
+    from scenegen.lab.benchmark import plan_benchmark
+    from scenegen.lab.run import run
+
+    res = json.loads((reference / "results.json").read_text())
+    _, tasks = plan_benchmark(dataset, TRACKERS, PARAMS)
+    for entry in res["leaderboard"]:
+        parts = []
+        for task in (t for t in tasks if t.tracker == entry["tracker"]):
+            seq = read(Path(task.root) / task.file, task.name)
+            out = run(seq, task.tracker, dict(task.params), task.tracker_seed(),
+                      single_thread=True).result  # fmt: skip
+            parts.append(evaluate(seq, out.boxes, out.target_ids).overall.mot.scores)
+        want = combine(parts)
+        got = (entry["mota_combined"], entry["idf1_combined"], entry["hota_combined"])
+        assert got == pytest.approx((want.clear.mota, want.identity.idf1, want.hota.hota),
+                                    abs=2e-6)  # fmt: skip
+    # Equal-length sequences with two targets each: MOTA's mean is its combined value,
+    # HOTA's (a square root of products) is not.
+    mean = [e["hota"] for e in res["leaderboard"]]
+    assert [e["hota_combined"] for e in res["leaderboard"]] != pytest.approx(mean, abs=1e-4)
+    for page in ("leaderboard.md", "index.html"):
+        text = (reference / page).read_text()
+        assert "MOTA (combined)" in text and "COMBINED_SEQ" in text
+
+
+def test_combined_columns_need_every_runs_counts(reference):
+    """A tracker whose multi-target runs lack counts (recorded before them) or that has
+    none gets None, not a sum over some of its runs; malformed counts are named."""
+    from scenegen.lab.benchmark import combined_scores
+    from scenegen.lab.benchmark_outputs import read_record, record_problems
+
+    recs = [read_record(p) for p in sorted((reference / "runs").rglob("*.json"))]
+    full = combined_scores(recs)
+    assert all(v is not None for per in full.values() for v in per.values())
+    old = [dict(r) for r in recs]
+    del old[0]["mot_counts"]
+    part = combined_scores(old)
+    first = old[0]["key"]["tracker"]
+    assert set(part[first].values()) == {None}
+    assert all(part[t] == full[t] for t in part if t != first)
+    single = [{**r, "targets": 1} for r in recs]
+    assert all(set(v.values()) == {None} for v in combined_scores(single).values())
+    assert record_problems(old[0]) == []
+    for bad in ({}, {**recs[0]["mot_counts"], "hota_tp": [1.0] * 18},
+                {**recs[0]["mot_counts"], "tp": "3"}):
+        assert record_problems({**recs[0], "mot_counts": bad}) == [
+            "mot_counts is not the counts of scenegen.evaluation.mot.mot_counts"]
+
+
 def test_same_results_with_two_processes_and_resume(dataset, reference, tmp_path):
     out = tmp_path / "b"
     run_benchmark(dataset, TRACKERS, out, params=PARAMS, jobs=2)
