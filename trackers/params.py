@@ -72,6 +72,8 @@ from typing import Any, ClassVar, TypeVar
 
 import numpy as np
 
+from trackers.numbers import is_integral
+
 __all__ = [
     "MAX_PARTICLES",
     "PARAMETERS_MARKER",
@@ -85,6 +87,7 @@ __all__ = [
     "check_particle_count",
     "choices",
     "documented",
+    "is_integral",
     "parameter_entries",
 ]
 
@@ -208,8 +211,7 @@ def check_integer(params: TrackerParams, name: str, *, low: int | None = None,
     value = getattr(params, name)
     if optional and value is None:
         return
-    ok = (not isinstance(value, bool) and isinstance(value, (int, float, np.integer, np.floating))
-          and np.isfinite(value) and int(value) == value
+    ok = (is_integral(value)
           and (low is None or value >= low) and (high is None or value <= high))
     if not ok:
         if low is not None and high is not None:

@@ -98,6 +98,7 @@ from trackers.params import (
     check_particle_count,
     choices,
     documented,
+    is_integral,
 )
 
 __all__ = [
@@ -307,7 +308,7 @@ class PSParams(PartitionedParams):
     def __post_init__(self) -> None:
         super().__post_init__()
         order = self.ordering
-        if isinstance(order, (int, np.integer)) and not isinstance(order, bool):
+        if is_integral(order):
             if order < 0:
                 raise ValueError(f"ordering must be a circular shift >= 0 or a permutation, "
                                  f"got {order!r}")
@@ -318,11 +319,7 @@ class PSParams(PartitionedParams):
             items = [] if isinstance(order, (str, bytes)) else list(order)
         except TypeError:
             items = []
-        if not items or not all(
-            (isinstance(o, (int, np.integer)) and not isinstance(o, bool))
-            or (isinstance(o, (float, np.floating)) and np.isfinite(o) and int(o) == o)
-            for o in items
-        ):
+        if not items or not all(is_integral(o) for o in items):
             raise ValueError(f"ordering must be an int (circular shift) or a sequence of "
                              f"target indices, got {order!r}")
         self._set("ordering", tuple(int(o) for o in items))

@@ -18,7 +18,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("demo", help="generate every preset, run the experiments, write a report")
     p.add_argument("-o", "--output", type=Path, default=Path("report"), help="report folder")
     p.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="worker processes")
-    p.add_argument("--seed", type=seed_arg, default=0, help="seed of the preset sequences")
+    p.add_argument("--seed", type=seed_arg, default=0,
+                   help="seed of the preset sequences written to OUTPUT/presets/ (default 0); "
+                        "the experiments always run on base seed 0, the seed of the demo's "
+                        "rerun command (`scenegen demo -o DIR`)")
     p.set_defaults(func=cmd_demo)
 
 

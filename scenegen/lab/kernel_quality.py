@@ -24,7 +24,6 @@ A value is "inside" when the other side's value lies in the base side's interval
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
@@ -86,7 +85,9 @@ class Row:
 def load_records(folders: Iterable[Path]) -> list[dict[str, Any]]:
     """The run records (``runs/*.json``) of the experiment folders, in name order.
 
-    The files are parsed as plain JSON: their seals are neither checked nor removed.
+    Each file is read as the experiments read a run record
+    (:func:`scenegen.lab.experiments.outputs.read_record`): its seal is checked and
+    removed, and its fields are checked.
 
     Parameters
     ----------
@@ -96,12 +97,19 @@ def load_records(folders: Iterable[Path]) -> list[dict[str, Any]]:
     Returns
     -------
     list of dict
-        The records, folder by folder, each folder's by file name.
+        The records (without their digests), folder by folder, each folder's by file name.
+
+    Raises
+    ------
+    DataError
+        One line naming the file: damaged, edited, unsealed or not a run record.
     """
+    from scenegen.lab.experiments.outputs import read_record
+
     out = []
     for folder in folders:
         for path in sorted((Path(folder) / "runs").glob("*.json")):
-            out.append(json.loads(path.read_text(encoding="utf-8")))
+            out.append(read_record(path))
     return out
 
 
@@ -193,6 +201,11 @@ def compare_root(root: Path, experiments: Sequence[str] | None = None) -> list[R
     list of Row
         Experiment by experiment, :func:`compare` of both sides' summaries (the runs of
         ``shared/``, when present, added to both).
+
+    Raises
+    ------
+    DataError
+        As :func:`load_records`, for a damaged or edited run record.
     """
     root = Path(root)
     names = experiments or sorted(p.name for p in root.iterdir()
@@ -256,7 +269,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     Returns
     -------
     int
-        The exit status, 0 (bad arguments exit through argparse).
+        The exit status: 0, or 1 (one line on stderr) for a damaged or edited run
+        record; bad arguments, a ``ROOT`` that is not a folder among them, exit 2
+        through argparse.
     """
     p = argparse.ArgumentParser(prog="python -m scenegen.lab.kernel_quality",
                                 description=__doc__.split("\n\n")[0])
@@ -269,7 +284,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     p.add_argument("--other-label", default="other")
     p.add_argument("-o", "--output", type=Path, default=None, help="write the table here")
     args = p.parse_args(argv)
-    rows = compare_root(args.root, args.experiment)
+    if not args.root.is_dir():
+        p.error(f"ROOT {args.root} is not a folder")
+    from scenegen.errors import DataError
+
+    try:
+        rows = compare_root(args.root, args.experiment)
+    except DataError as err:
+        print(f"{p.prog}: error: {err}", file=sys.stderr)
+        return 1
     text = render(rows, base=args.base_label, other=args.other_label, metrics=args.metric)
     if args.output is None:
         sys.stdout.write(text)

@@ -36,6 +36,7 @@ from scenegen.config import (
     AR2,
     Appearance,
     Background,
+    Camera,
     ClutterSpec,
     EntitySpec,
     Motion,
@@ -132,6 +133,26 @@ def _scale_entity(e: EntitySpec, f: float) -> EntitySpec:
     )
 
 
+def _scale_camera(cam: Camera | None, f: float) -> Camera | None:
+    if cam is None:
+        return None
+    ex, ey = round(cam.extent[0] * f), round(cam.extent[1] * f)
+    # An offset scaled with its extent stays within it but for the extent's rounding
+    # (less than half a pixel; the offset is a whole number of pixels anyway).
+    keyframes = tuple(
+        (t, min(max(dx * f, -ex), ex), min(max(dy * f, -ey), ey)) for t, dx, dy in cam.keyframes
+    )
+    return replace(
+        cam,
+        extent=(ex, ey),
+        x=_scale_ar2(cam.x, f),
+        y=_scale_ar2(cam.y, f),
+        zoom=_scale_ar2(cam.zoom, f, log_scale=True),
+        velocity=(cam.velocity[0] * f, cam.velocity[1] * f),
+        keyframes=keyframes,
+    )
+
+
 def _scale_clutter(c: ClutterSpec, f: float, max_count: int | None) -> ClutterSpec:
     app = _scale_appearance(c.appearance, f)
     count = round(c.count * f * f)  # same density on the smaller canvas
@@ -152,10 +173,11 @@ def downsized(
     """``config`` on a canvas scaled by ``factor``, with ``n_frames`` frames.
 
     Positions, sizes, speeds, noise stds, margins and texture scales are scaled by
-    ``factor``; clutter counts by ``factor**2`` (same density), capped at
-    ``max_clutter``. Frame-indexed fields (appear, disappear, depth keyframes) are kept,
-    and so are the camera, the photometric settings, the sensor noise and an
-    appearance's ``noise_scale``.
+    ``factor``, the camera's too (its extent, offset motion, velocity and keyframe
+    offsets; not its log zoom); clutter counts by ``factor**2`` (same density), capped at
+    ``max_clutter``. Frame-indexed fields (appear, disappear, depth keyframes, the frames
+    of camera keyframes) are kept, and so are the photometric settings, the sensor noise
+    and an appearance's ``noise_scale``.
 
     Parameters
     ----------
@@ -192,6 +214,7 @@ def downsized(
         entities=tuple(_scale_entity(e, factor) for e in config.entities),
         clutter=tuple(_scale_clutter(c, factor, max_clutter) for c in config.clutter),
         sensor_noise=config.sensor_noise,
+        camera=_scale_camera(config.camera, factor),
     )
 
 

@@ -143,6 +143,8 @@ def test_window_outside_the_frame_stays_put():
         ({"max_iter": None}, "max_iter must be an integer >= 0, got None"),
         ({"eps": "0.5"}, "eps must be >= 0, got '0.5'"),
         ({"min_distance": None}, "min_distance must be >= 0, got None"),
+        # True was KERNEL_EPANECHNIKOV (1).
+        ({"kernel": True}, "kernel must be KERNEL_EPANECHNIKOV .*, got True"),
     ],
 )
 def test_bad_input_raises_value_error_naming_it(kwargs, message):

@@ -45,6 +45,17 @@ def test_fields_read_as_attributes_and_integral_values_are_normalised():
         tracker.nonsense  # noqa: B018
 
 
+def test_an_integral_float_ordering_is_an_int_like_every_integer_parameter():
+    # ordering=1.0 was refused while (1.0, 0) and n_particles=120.0 were taken.
+    assert trackers.make("ps", ordering=1.0).params == trackers.make("ps", ordering=1).params
+    assert type(trackers.make("ps", ordering=np.float64(2.0)).params.ordering) is int
+    for bad in (True, 1.5, float("nan")):
+        with pytest.raises(ValueError, match="ordering must be an int"):
+            trackers.make("ps", ordering=bad)
+    with pytest.raises(ValueError, match="ordering must be a circular shift >= 0"):
+        trackers.make("ps", ordering=-1.0)
+
+
 def test_a_params_object_can_be_passed_and_overridden():
     from trackers.particle import DistributedPartitionedSampling, DPSParams
 

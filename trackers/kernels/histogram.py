@@ -72,6 +72,7 @@ from trackers.kernels.profiles import (
     KERNEL_EPANECHNIKOV,
     KERNEL_UNIFORM,
     KERNELS,
+    _is_kernel_code,
     _level_args,
     _pixel_range,
     box_kernel_levels,
@@ -275,7 +276,7 @@ def _check_region_args(bin_img, boxes, n_bins, kernel, n_parts, check_bins=True)
     if check_bins and img.size and (img.min() < 0 or img.max() >= n_bins):
         raise ValueError(f"bin_img values must lie in [0, {n_bins}), got "
                          f"[{img.min()}, {img.max()}]")
-    if kernel not in KERNELS.values():
+    if not _is_kernel_code(kernel, KERNELS.values()):
         raise ValueError(f"kernel must be one of {sorted(KERNELS.values())} "
                          f"({', '.join(KERNELS)}), got {kernel!r}")
     if not _is_integer(n_parts) or n_parts < 1:
@@ -544,7 +545,7 @@ def prepared_distances(
     """
     if method not in METHODS:
         raise ValueError(f"unknown method {method!r}; valid: {', '.join(METHODS)}")
-    if kernel not in KERNELS.values():
+    if not _is_kernel_code(kernel, KERNELS.values()):
         raise ValueError(f"kernel must be one of {sorted(KERNELS.values())} "
                          f"({', '.join(KERNELS)}), got {kernel!r}")
     bx = np.ascontiguousarray(boxes, dtype=np.float64)

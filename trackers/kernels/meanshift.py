@@ -45,6 +45,7 @@ from numba import njit
 from numpy.typing import NDArray
 
 from trackers.kernels.histogram import KERNEL_CONE, KERNEL_EPANECHNIKOV
+from trackers.kernels.profiles import _is_kernel_code
 from trackers.kernels.quantize import _is_integer, _is_number
 
 __all__ = ["MEAN_SHIFT_KERNELS", "MeanShiftResult", "mean_shift"]
@@ -399,7 +400,7 @@ def _checked_inputs(bin_img, models, model_index, centres, sizes, *, kernel, max
     if check_bins and img.size and (img.min() < 0 or img.max() >= q.shape[1]):
         raise ValueError(f"bin_img values must lie in [0, {q.shape[1]}), got "
                          f"[{img.min()}, {img.max()}]")
-    if kernel not in MEAN_SHIFT_KERNELS.values():
+    if not _is_kernel_code(kernel, MEAN_SHIFT_KERNELS.values()):
         raise ValueError(f"kernel must be KERNEL_EPANECHNIKOV ({KERNEL_EPANECHNIKOV}) or "
                          f"KERNEL_CONE ({KERNEL_CONE}), got {kernel!r}")
     if not _is_integer(max_iter) or max_iter < 0:

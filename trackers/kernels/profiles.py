@@ -10,6 +10,8 @@ helpers that write one row's weights (``trackers.kernels.direct``).
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+
 import numpy as np
 from numba import njit
 from numpy.typing import NDArray
@@ -41,6 +43,13 @@ KERNELS: dict[str, int] = {
     "cone": KERNEL_CONE,
     "box": KERNEL_BOX,
 }
+
+
+def _is_kernel_code(value: object, codes: Iterable[int]) -> bool:
+    """Whether ``value`` is one of the kernel ``codes``: an integer (an integral float
+    too, like every integer argument of the kernels), not a bool (True was
+    ``KERNEL_EPANECHNIKOV``)."""
+    return _is_integer(value) and int(value) in codes
 
 
 # Weights are accumulated in 32.32 fixed point (int64): integer adds do not stall on

@@ -11,6 +11,8 @@ import numpy as np
 from numba import njit
 from numpy.typing import NDArray
 
+from trackers.numbers import is_integral, is_number
+
 __all__ = ["hsv_n_bins", "quantize_hsv", "quantize_rgb"]
 
 
@@ -21,20 +23,8 @@ def _check_frame(frame: NDArray[np.uint8]) -> NDArray[np.uint8]:
     return np.ascontiguousarray(arr)
 
 
-def _is_number(value: object) -> bool:
-    """Whether ``value`` is a real number (int or float, numpy's too), not a bool or text.
-
-    The one test of the kernels' and the colour model's numeric arguments: None and text
-    failed in ``int()`` or a comparison with their own TypeError, and True was 1.
-    """
-    return (not isinstance(value, (bool, np.bool_))
-            and isinstance(value, (int, float, np.integer, np.floating)))
-
-
-def _is_integer(value: object) -> bool:
-    """Whether ``value`` is an integer or an integral finite float (not a bool): NaN failed
-    in ``int()`` with "cannot convert float NaN to integer", naming no argument."""
-    return _is_number(value) and bool(np.isfinite(value)) and int(value) == value
+_is_number = is_number  # trackers.numbers: the one definition
+_is_integer = is_integral
 
 
 def _check_bin_count(name: str, value: int) -> int:

@@ -51,6 +51,9 @@ __all__ = [
 
 
 _DECIMALS = 6
+#: Longest run file name with its overrides written out (``Task.filename``): the file
+#: system's limit is 255 bytes, and a temporary file's name adds up to about 90.
+MAX_FILENAME = 150
 _MIN_OVERLAP = 0.1  # pairs overlapping less than this say nothing about depth order
 
 
@@ -172,6 +175,11 @@ class Task:
     def filename(self) -> str:
         """The run's record file name, in the experiment's ``runs/`` folder.
 
+        Equal tasks have the same name: an override value is written as
+        :func:`_value_text` gives it (``n_particles=100.0`` as ``100``, like 100). A name
+        longer than :data:`MAX_FILENAME` characters (many or long overrides) writes the
+        overrides as ``__params-`` and 16 hex digits of their SHA-256 instead.
+
         Returns
         -------
         str
@@ -180,9 +188,13 @@ class Task:
             zero-padded to three digits (e.g. ``"dps__dps-occlusion__s000__r001.json"``).
         """
         sweep = f"__{self.param}{self.value:g}" if self.param else ""
-        over = "".join(f"__{k}-{v}" for k, v in self.overrides)
-        return (f"{self.method}__{self.preset}{sweep}{over}__s{self.scene:03d}"
-                f"__r{self.run:03d}.json")
+        over = "".join(f"__{k}-{_value_text(v)}" for k, v in self.overrides)
+        tail = f"__s{self.scene:03d}__r{self.run:03d}.json"
+        name = f"{self.method}__{self.preset}{sweep}{over}{tail}"
+        if len(name) > MAX_FILENAME:
+            digest = hashlib.sha256(over.encode("utf-8")).hexdigest()[:16]
+            name = f"{self.method}__{self.preset}{sweep}__params-{digest}{tail}"
+        return name
 
     def key(self) -> dict[str, Any]:
         """What identifies the run's record: a stored record of another key is stale.
@@ -285,6 +297,18 @@ def plan_tasks(
                         tasks.append(Task(exp.name, m.slug, preset, param, v, s, r, seed, quick,
                                           over))
     return tasks
+
+
+def _value_text(value: Any) -> str:
+    """An override value as a run's file name writes it: the same text for equal values
+    (``100``, ``100.0`` and ``True == 1`` as numbers), a tuple as ``(a, b, c)``."""
+    if isinstance(value, tuple):
+        return "(" + ", ".join(_value_text(v) for v in value) + ")"
+    if isinstance(value, float) and value.is_integer():
+        return str(int(value))
+    if isinstance(value, (bool, int)):
+        return str(int(value))
+    return str(value)
 
 
 def _frozen(value: Any) -> Any:
@@ -486,7 +510,15 @@ def run_task(task: Task) -> dict[str, Any]:
         )
         pairs = metrics.overlapping_pairs(gt, min_overlap=_MIN_OVERLAP)
         record["overlap"] = np.any(pairs, axis=(1, 2))
-    return _round(record)
+    rounded = _round(record)
+    rounded["key"] = _stored_key(task)  # the run's identity, not a measure: not rounded
+    return rounded
+
+
+def _stored_key(task: Task) -> Any:
+    """``task.key()`` as its record stores it: as JSON reads it back, floats exact (an
+    override rounded to 6 decimals named another run, and reran as another one)."""
+    return json.loads(json.dumps(task.key()))
 
 
 def write_json_atomic(path: Path, data: Any, *, indent: int | None = None) -> None:
@@ -549,7 +581,7 @@ def load_record(path: Path, task: Task) -> dict[str, Any] | None:
         warn(f"{path}: holds another run ({Task(**data['key']).filename()}); computing this "
              "run again")  # fmt: skip
         return None
-    if data.get("key") != _round(task.key()):
+    if data.get("key") != _stored_key(task):
         return None
     # Parameters changed since the run was stored (a new version of the experiment).
     if data.get("params") != _round(tracker_params(get(task.experiment), task)):

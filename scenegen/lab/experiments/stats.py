@@ -184,7 +184,8 @@ def wilson(k: int, n: int, level: float = LEVEL) -> tuple[float, float]:
 
 def newcombe_diff(k1: int, n1: int, k2: int, n2: int,
                   level: float = LEVEL) -> tuple[float, float]:
-    """Newcombe's hybrid score interval of p1 − p2 (from the two Wilson intervals).
+    """Newcombe's hybrid score interval of p1 − p2 (from the two Wilson intervals);
+    (nan, nan) for an empty sample (n1 or n2 of 0), as :func:`wilson`.
 
     Parameters
     ----------
@@ -202,11 +203,11 @@ def newcombe_diff(k1: int, n1: int, k2: int, n2: int,
 
     Raises
     ------
-    ZeroDivisionError
-        For ``n1`` or ``n2`` of 0.
     ValueError
-        For a ``k`` outside [0, n].
+        For a ``k`` outside [0, n] (with n > 0).
     """
+    if n1 <= 0 or n2 <= 0:
+        return (float("nan"), float("nan"))
     p1, p2 = k1 / n1, k2 / n2
     l1, u1 = wilson(k1, n1, level)
     l2, u2 = wilson(k2, n2, level)
@@ -276,13 +277,12 @@ def two_proportion_z(k1: int, n1: int, k2: int, n2: int) -> Test:
     -------
     Test
         Statistic z (±inf for a difference with zero pooled variance, 0 for none) and
-        p-value P(Z > z).
-
-    Raises
-    ------
-    ZeroDivisionError
-        For ``n1`` or ``n2`` of 0.
+        p-value P(Z > z); statistic NaN and p-value 1.0 for an empty sample (``n1`` or
+        ``n2`` of 0: no evidence), as :func:`bootstrap_paired_diff` without pairs.
     """
+    name = "two-proportion z (pooled, one-sided)"
+    if n1 <= 0 or n2 <= 0:
+        return Test(name, float("nan"), 1.0)
     p = (k1 + k2) / (n1 + n2)
     se = math.sqrt(p * (1 - p) * (1 / n1 + 1 / n2))
     d = k1 / n1 - k2 / n2
@@ -290,7 +290,7 @@ def two_proportion_z(k1: int, n1: int, k2: int, n2: int) -> Test:
         z = 0.0 if d == 0 else math.copysign(math.inf, d)
     else:
         z = d / se
-    return Test("two-proportion z (pooled, one-sided)", z, norm_sf(z))
+    return Test(name, z, norm_sf(z))
 
 
 def mcnemar_exact(n_sf: int, n_fs: int) -> Test:

@@ -176,6 +176,15 @@ def test_every_seed_option_takes_0_to_2_64_minus_1(verb, value, capsys):
     assert f"error: argument --seed: must be an integer in [0, 2**64 - 1], got {value!r} " in err
 
 
+def test_demo_help_says_what_its_seed_seeds(capsys):
+    # "seed of the preset sequences": the experiments run on preset sequences too, yet
+    # always on base seed 0 (a demo folder of another seed has no rerun command).
+    assert main(["demo", "--help"]) == 0
+    text = " ".join(capsys.readouterr().out.split())
+    assert "written to OUTPUT/presets/" in text
+    assert "the experiments always run on base seed 0" in text
+
+
 def test_the_largest_seed_is_written_and_read_back(tmp_path):
     out = tmp_path / "g.h5"
     assert main(["generate", "--preset", "kams-a", "--frames", "2", "--seed",

@@ -8,13 +8,22 @@ import json
 import pytest
 
 from scenegen.cli.experiment import parse_overrides
-from scenegen.errors import ConfigError
+from scenegen.errors import ConfigError, DataError
 from scenegen.lab import kernel_quality as kq
 from scenegen.lab.experiments import get, run_experiment
-from scenegen.lab.experiments.runner import Task, load_record, plan_tasks, tracker_params
+from scenegen.lab.experiments.outputs import write_record
+from scenegen.lab.experiments.runner import (
+    MAX_FILENAME,
+    Task,
+    load_record,
+    plan_tasks,
+    tracker_params,
+)
 
 NAME = "dps-synthetic"
 EXP = get(NAME)
+EXP_KEY = {"experiment": "shm-depth", "method": "shm", "preset": "shm-depth", "param": "",
+           "value": None, "scene": 0, "run": 0, "seed": 0, "quick": False}
 
 
 def test_parse_overrides_reads_json_and_keeps_words():
@@ -104,6 +113,38 @@ def test_an_overridden_run_is_recorded_and_stale_for_the_default(tmp_path):
     assert load_record(tmp_path / "runs" / task.filename(), plain) is None
 
 
+def _name(**overrides) -> str:
+    (task,) = plan_tasks(EXP, runs=1, scenes=1, seed=0, quick=True, methods=["dps"],
+                         overrides=overrides)
+    return task.filename()
+
+
+def test_equal_override_values_name_the_same_run_file():
+    # n_particles=100.0 is the run of n_particles=100 (an equal task, the same tracker
+    # parameters) but was stored in another file: computed again, and both files counted
+    # by the readers of runs/*.json (kernel_quality).
+    assert _name(n_particles=100.0) == _name(n_particles=100) == \
+        "dps__dps-synthetic__lam20__n_particles-100__s000__r000.json"
+    assert _name(sigma=[1, 1, 0.01]) == _name(sigma=[1.0, 1.0, 0.01])
+    assert _name(sigma=[1.0, 1.0, 0.01]) != _name(sigma=[1.0, 1.0, 0.02])
+    on = Task(**{**EXP_KEY, "overrides": (("use_mse", True),)})
+    assert on.filename() == Task(**{**EXP_KEY, "overrides": (("use_mse", 1),)}).filename()
+
+
+def test_many_or_long_overrides_keep_the_run_file_name_short():
+    # Every value passes the tracker's checks; the name was 269 characters long, beyond
+    # the file system's 255: "internal error: OSError: File name too long".
+    over = {"sigma": [2.0000000000000004, 2.0000000000000004, 0.0010000000000000002],
+            "assignment": "interleaved", "box_levels": 3, "kernel": "epanechnikov",
+            "mixture": "evidence", "model": "hsv", "n_groups": 2, "n_particles": 40,
+            "resample_scope": "joint", "weighting": "stage"}
+    name = _name(**over)
+    assert len(name) <= MAX_FILENAME
+    assert name.startswith("dps__dps-synthetic__lam20__params-") and name.endswith("__r000.json")
+    assert _name(**{**over, "n_groups": 3}) != name
+    assert _name(**{**over, "n_particles": 40.0}) == name
+
+
 def test_a_list_valued_override_resumes_and_validates(tmp_path, capsys):
     # Read back from a record, the key gives the override as a JSON list; the task must
     # still name the file it was stored in, or every resume recomputes every run (with a
@@ -129,6 +170,26 @@ def test_a_list_valued_override_resumes_and_validates(tmp_path, capsys):
     assert main(["validate", str(tmp_path)]) == 0
 
 
+def test_an_override_with_more_than_six_decimals_keeps_its_run(tmp_path, capsys):
+    # Records round their floats to 6 decimals, the key's too: the stored key named
+    # another file (validate: "no such file"), every resume warned and computed the run
+    # again, and `validate --deep` reran it with the rounded value.
+    from scenegen.cli import main
+
+    over = {"sigma": [1.0, 1.0, 0.0012345678]}
+    kw = dict(runs=1, scenes=1, quick=True, methods=["dps"], jobs=1, progress=False,
+              figures=False, overrides=over)  # fmt: skip
+    run_experiment(NAME, tmp_path, **kw)
+    (path,) = (tmp_path / "runs").iterdir()
+    record = json.loads(path.read_text())
+    assert Task(**record["key"]).filename() == path.name
+    before = path.read_bytes()
+    capsys.readouterr()
+    run_experiment(NAME, tmp_path, **kw)
+    assert capsys.readouterr().err == "" and path.read_bytes() == before
+    assert main(["validate", "--deep", str(tmp_path)]) == 0
+
+
 def _rate(k, n, lo, hi):
     return {"k": k, "n": n, "pct": 100.0 * k / n, "ci": [lo, hi]}
 
@@ -151,12 +212,26 @@ def test_compare_puts_each_value_beside_the_base_interval():
     assert "**no**" in text and "1 of 2 values of box inside epan's interval" in text
 
 
-def test_compare_root_summarises_both_sides_and_adds_shared_runs(tmp_path, monkeypatch):
-    for side, n in (("base", 2), ("other", 1), ("shared", 1)):
-        runs = tmp_path / "exp" / side / "runs"
-        runs.mkdir(parents=True)
+def _run_record(side: str, scene: int) -> dict:
+    """A sound run record (two frames, one target), marked with its side."""
+    series = {f: [1.0, 1.0] for f in ("precision", "recall", "iou", "centre_error",
+                                       "path_error")}  # fmt: skip
+    return {"key": {"experiment": NAME, "method": "dps", "preset": "dps-synthetic",
+                    "param": "", "value": None, "scene": scene, "run": 0, "seed": 0,
+                    "quick": True},
+            "tracker": "dps", "params": {}, "scene_digest": "0" * 64, "scene_seed": 0,
+            "tracker_seed": 0, "n_frames": 2, "failure_threshold": 0.5, "side": side,
+            "targets": [{"name": "a", "state": [1, 1], **series}]}
+
+
+def _write_sides(root, sides) -> None:
+    for side, n in sides:
         for i in range(n):
-            (runs / f"r{i}.json").write_text(json.dumps({"side": side}))
+            write_record(root / "exp" / side / "runs" / f"r{i}.json", _run_record(side, i))
+
+
+def test_compare_root_summarises_both_sides_and_adds_shared_runs(tmp_path, monkeypatch):
+    _write_sides(tmp_path, (("base", 2), ("other", 1), ("shared", 1)))
     seen = {}
 
     def fake_summary(name, records):
@@ -173,6 +248,36 @@ def test_compare_root_summarises_both_sides_and_adds_shared_runs(tmp_path, monke
     out = tmp_path / "t.md"
     assert kq.main([str(tmp_path), "-o", str(out)]) == 0
     assert "M/success" in out.read_text()
+
+
+@pytest.mark.parametrize("damage", ["edit", "truncate", "unseal"])
+def test_a_damaged_or_edited_run_record_is_one_line(tmp_path, capsys, damage):
+    # Records were parsed as plain JSON: an edited one counted as it read, a truncated
+    # one ended in a JSONDecodeError traceback.
+    _write_sides(tmp_path, (("base", 2), ("other", 2)))
+    path = tmp_path / "exp" / "other" / "runs" / "r1.json"
+    doc = json.loads(path.read_text())
+    if damage == "edit":
+        doc["targets"][0]["state"] = [0, 0]
+        path.write_text(json.dumps(doc))
+    elif damage == "truncate":
+        path.write_bytes(path.read_bytes()[:40])
+    else:
+        del doc["sha256"]
+        path.write_text(json.dumps(doc))
+    with pytest.raises(DataError, match="r1.json"):
+        kq.load_records([tmp_path / "exp" / "other"])
+    capsys.readouterr()
+    assert kq.main([str(tmp_path)]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("python -m scenegen.lab.kernel_quality: error: ") and "r1.json" in err
+    assert err.count("\n") == 1
+
+
+def test_a_root_that_is_not_a_folder_is_a_usage_error(tmp_path, capsys):
+    with pytest.raises(SystemExit) as info:
+        kq.main([str(tmp_path / "missing")])
+    assert info.value.code == 2 and "is not a folder" in capsys.readouterr().err
 
 
 @pytest.mark.parametrize(("name", "plan", "options"), [

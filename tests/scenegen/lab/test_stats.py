@@ -75,6 +75,17 @@ def test_two_proportion_z_by_hand():
     assert stats.two_proportion_z(5, 5, 5, 5).p_value == 0.5
 
 
+@pytest.mark.parametrize(("n1", "n2"), [(0, 10), (10, 0), (0, 0)])
+def test_an_empty_sample_gives_no_evidence_like_the_other_functions(n1, n2):
+    # Both divided by zero (ZeroDivisionError) where wilson and newcombe_paired_diff give
+    # (nan, nan) and bootstrap_paired_diff p = 1 for no cases.
+    assert all(math.isnan(x) for x in stats.newcombe_diff(0, n1, 0, n2))
+    t = stats.two_proportion_z(0, n1, 0, n2)
+    assert math.isnan(t.statistic) and t.p_value == 1.0
+    assert stats.verdict(t.p_value, stats.newcombe_diff(0, n1, 0, n2), 0.1, 0) == \
+        "inconclusive"
+
+
 def test_exact_mcnemar_and_binomial():
     assert stats.mcnemar_exact(8, 2).p_value == pytest.approx(56 / 1024)
     assert stats.mcnemar_exact(0, 0).p_value == 1.0

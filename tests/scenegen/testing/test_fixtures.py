@@ -3,6 +3,7 @@
 import json
 import os
 import shutil
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -10,6 +11,7 @@ import pytest
 import trackers
 from scenegen import presets
 from scenegen.cli import main
+from scenegen.config import AR2, Camera
 from scenegen.errors import ConfigError
 from scenegen.io import read, write
 from scenegen.lab.regen import regen, verify
@@ -192,6 +194,29 @@ def test_downsized_scales_geometry_and_clutter():
                 {"factor": 0.5, "n_frames": 0}):  # fmt: skip
         with pytest.raises(ConfigError):
             downsized(cfg, **bad)
+
+
+def test_downsized_scales_the_camera_in_pixels():
+    # The camera was kept: on a half-size canvas it panned twice as far, relative to the
+    # frame, as on the full one.
+    cfg = presets.get("tiger-like")
+    cam = cfg.camera
+    small = downsized(cfg, factor=0.5, n_frames=4).camera
+    assert small.extent == (cam.extent[0] // 2, cam.extent[1] // 2)
+    assert small.x.sigma == pytest.approx(cam.x.sigma / 2)
+    assert small.y.sigma == pytest.approx(cam.y.sigma / 2)
+    assert small.velocity == pytest.approx((cam.velocity[0] / 2, cam.velocity[1] / 2))
+    assert (small.x.a1, small.x.a2, small.x.boundary) == (cam.x.a1, cam.x.a2, cam.x.boundary)
+    # Keyframe offsets scale with the extent and stay within it after its rounding
+    # (5 * 0.5 rounds to 2); frames are kept; the log zoom is scale-free.
+    zoom = AR2(boundary="reflect", sigma=0.02, margin=0.3)
+    scripted = replace(cfg, camera=Camera(extent=(5, 6), zoom=zoom,
+                                          keyframes=((0, 0.0, 0.0), (3, 5.0, -4.0))))
+    small = downsized(scripted, factor=0.5, n_frames=4).camera
+    assert small.extent == (2, 3)
+    assert small.keyframes == ((0, 0.0, 0.0), (3, 2.0, -2.0))
+    assert small.zoom == zoom
+    assert downsized(replace(cfg, camera=None), factor=0.5, n_frames=4).camera is None
 
 
 def test_committed_files_read_back():

@@ -344,10 +344,26 @@ def test_kernel_rejects_bad_input():
     (lambda b, f: quantize_hsv(f, s_bins=float("nan")), "s_bins must be an integer in"),
     (lambda b, f: quantize_hsv(f, s_min="0.1"), "s_min must lie in \\[0, 1\\], got '0.1'"),
     (lambda b, f: ColourModel(kernel="box", box_levels=None), "box_levels must be an integer"),
+    # A bool is not a kernel code: True was KERNEL_EPANECHNIKOV, at every entry point.
+    (lambda b, f: region_histograms(b, np.ones((1, 4)), 4, True),
+     "kernel must be one of .*, got True"),
+    (lambda b, f: region_distances(b, np.ones((1, 4)), np.full((1, 4), 0.25), np.array([0]),
+                                   np.True_), "kernel must be one of .*, got np.True_"),
+    (lambda b, f: prepared_distances(b, np.ones((1, 4)),
+                                     prepare_references(np.full((1, 4), 0.25)),
+                                     np.array([0]), True), "kernel must be one of .*, got True"),
 ])
 def test_kernel_entry_points_name_a_bad_number(call, match):
     with pytest.raises(ValueError, match=match):
         call(np.zeros((10, 10), dtype=np.int32), np.zeros((4, 4, 3), dtype=np.uint8))
+
+
+def test_an_integral_float_kernel_code_is_the_code():
+    # As every integer argument of the kernels (n_bins=4.0), a kernel code may be 4.0.
+    bins = np.zeros((10, 10), dtype=np.int32)
+    boxes = np.array([[1.0, 1.0, 3.0, 3.0]])
+    np.testing.assert_array_equal(region_histograms(bins, boxes, 4, float(KERNEL_CONE)),
+                                  region_histograms(bins, boxes, 4, KERNEL_CONE))
 
 
 _DETERMINISM_SCRIPT = """
