@@ -279,10 +279,18 @@ def two_proportion_z(k1: int, n1: int, k2: int, n2: int) -> Test:
         Statistic z (±inf for a difference with zero pooled variance, 0 for none) and
         p-value P(Z > z); statistic NaN and p-value 1.0 for an empty sample (``n1`` or
         ``n2`` of 0: no evidence), as :func:`bootstrap_paired_diff` without pairs.
+
+    Raises
+    ------
+    ValueError
+        If a sample has more successes than trials, or fewer than 0 (as :func:`wilson`).
     """
     name = "two-proportion z (pooled, one-sided)"
     if n1 <= 0 or n2 <= 0:
         return Test(name, float("nan"), 1.0)
+    for k, n, which in ((k1, n1, "1"), (k2, n2, "2")):
+        if not 0 <= k <= n:
+            raise ValueError(f"need 0 <= k{which} <= n{which}, got k{which}={k}, n{which}={n}")
     p = (k1 + k2) / (n1 + n2)
     se = math.sqrt(p * (1 - p) * (1 / n1 + 1 / n2))
     d = k1 / n1 - k2 / n2

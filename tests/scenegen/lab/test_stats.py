@@ -354,3 +354,11 @@ def test_bootstrap_mean_in_blocks_draws_as_one_array(monkeypatch, n):
     for block in (1, 3 * n + 1, 1 << 22):
         monkeypatch.setattr(stats, "_BLOCK", block)
         assert stats.bootstrap_mean(v, 9) == want
+
+
+def test_two_proportion_z_refuses_more_successes_than_trials():
+    with pytest.raises(ValueError, match="k1 <= n1, got k1=5, n1=3"):
+        stats.two_proportion_z(5, 3, 1, 2)
+    with pytest.raises(ValueError, match="k2=-1"):
+        stats.two_proportion_z(1, 3, -1, 2)
+    assert stats.two_proportion_z(3, 3, 0, 2).p_value < 0.05
