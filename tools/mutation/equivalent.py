@@ -911,3 +911,38 @@ EQUIVALENT["mot-io"] = [  # noqa: F821
      "ids = np.asarray(track_ids).astype(np.int64).reshape(- 2)",
      "numpy reads any negative size in reshape as the one unknown dimension"),
 ]
+
+# 2026-12-03, a sample of each histogram kernel (trackers/kernels/{integral,direct,profiles,
+# quantize}.py): the box kernel's scratch rectangles, one row per level of the 1-d fracs.
+_RECTS = "rects = np.empty((max(fracs.shape[0], 1), 4), dtype=np.int64)"
+_RECTS_EQ = [
+    (_RECTS, _RECTS.replace("shape[0]", "shape[ -1]"),
+     "fracs is one-dimensional: shape[-1] is shape[0]"),
+    (_RECTS, _RECTS.replace("1), 4)", "2), 4)"),
+     "a larger scratch: rows past the levels' are never read (with no levels, the kernel "
+     "is not the box kernel and rects is not read at all)"),
+]
+EQUIVALENT["integral"] = [  # noqa: F821
+    *_RECTS_EQ,
+    ("hgt = R1 - R0", "hgt = R1 + R0",
+     "only sizes the integral array and picks its integer type in _integral_distances: "
+     "_integral_score fills and reads the ROI's R1 - R0 + 1 rows of it, and the counts "
+     "are the same integers in uint16 or int32"),
+]
+EQUIVALENT["direct"] = [  # noqa: F821
+    *_RECTS_EQ,
+    (_RECTS, _RECTS.replace("1), 4)", "1), 5)"), "a fifth column that nothing writes or reads"),
+    ("if dy2 >= 1.0:", "if dy2 >= 2.0:",
+     "rows with 1 <= dy^2 < 2 lie outside the ellipse: their Epanechnikov row weight "
+     "(1 - dy^2 in fixed point) is <= 0 and their cone weights 1 - r < 0, all clamped to 0"),
+    ("return 4 if dim <= _SMALL_BINS else 1", "return 3 if dim <= _SMALL_BINS else 1",
+     "any lane count but 4 takes _scatter's one-copy loop; the copies it leaves at zero "
+     "add nothing when the copies are summed"),
+]
+_UNCOVERED = ("_box_row_weights' last loop (columns no covering rectangle holds) never runs: "
+              "the last rectangle (fraction l / L = 1 exactly) has the box's own pixel range, "
+              "so every row of the box is covered, and the level loop ends with lo == hi")
+EQUIVALENT["profiles"] = [  # noqa: F821
+    ("kbuf[c - c0] = 0", "kbuf[c - c0] = 1", _UNCOVERED),
+    ("kbuf[c - c0] = 0", "kbuf[c + c0] = 0", _UNCOVERED),
+]
