@@ -946,3 +946,24 @@ EQUIVALENT["profiles"] = [  # noqa: F821
     ("kbuf[c - c0] = 0", "kbuf[c - c0] = 1", _UNCOVERED),
     ("kbuf[c - c0] = 0", "kbuf[c + c0] = 0", _UNCOVERED),
 ]
+_BIT_IDENTICAL = ("only chooses the path: a reference's boxes then all take the direct path, "
+                  "which gives the same bits as the integral path (the tests compare them bit "
+                  "for bit); only the time changes")
+EQUIVALENT["histogram"] = [  # noqa: F821
+    ("n_groups += 1", "n_groups += 0",
+     "no group is formed (starts[:1] = [n_boxes]): " + _BIT_IDENTICAL),
+    ("if integral_ok and method != METHOD_DIRECT and n_boxes > 0:",
+     "if integral_ok and method != METHOD_DIRECT and n_boxes >= 0:",
+     "with no boxes, _reference_groups returns no group: the loop over groups is empty"),
+    ("rects = np.empty((n_levels, 4), dtype=np.int64)",
+     "rects = np.empty((n_levels, 5), dtype=np.int64)",
+     "a fifth column that nothing writes or reads"),
+    ("kbuf = np.empty(cols + 2 + _PAD, dtype=np.int64)",
+     "kbuf = np.empty(cols + 1 + _PAD, dtype=np.int64)",
+     "a scratch row is read and written below index cols (the box's clipped columns, or "
+     "the support path's padded run, at most cols long when the frame is that wide)"),
+    ("if q[r, b] > 0:", "if q[r, b] >= 0:",
+     "bins where q = 0 join the support: each adds sqrt(p) * 0 = +0.0 to rho (the same "
+     "bits) and 0 to the empty band's rho; they only make the support path or the "
+     "integral's channels less likely, both bit-identical to the whole histogram"),
+]

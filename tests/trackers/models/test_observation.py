@@ -82,6 +82,16 @@ def test_bhattacharyya_equals_opencv(seed, n_bins, n_hists, common_ref):
     np.testing.assert_allclose(ours, theirs, atol=2e-6)
 
 
+@pytest.mark.parametrize("hists, refs", [((3, 4), (5,)), ((3, 4), (4, 4)), ((3, 4), (3, 5)),
+                                          ((4,), (4,))])
+def test_bhattacharyya_names_the_reference_shapes_it_accepts(hists, refs):
+    # One reference of B bins for every row, or one per row; a row's bins are the last axis.
+    want = (r"refs must have shape \(4,\) or \(3, 4\) for hists of shape \(P, B\); "
+            if len(hists) == 2 else r"refs must have shape \(4,\) or \(4,\) ")
+    with pytest.raises(ValueError, match=want):
+        bhattacharyya_distance(np.ones(hists), np.ones(refs))
+
+
 @settings(max_examples=25)
 @given(seed=st.integers(0, 2**32 - 1), height=st.integers(5, 40), width=st.integers(5, 40),
        model=st.sampled_from(["rgb", "hsv"]), bins=st.integers(1, 12),
