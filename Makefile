@@ -31,7 +31,8 @@ bench: $(STAMP)
 
 # Mutation score of the formula modules (cosmic-ray; long, not part of `make test`).
 # MODULES: a subset (resampling particle meanshift ms-trackers sok hybrid annealed shm
-# kalman metrics mot mot-io stats runner summary motion compose ground-truth);
+# kalman metrics mot mot-io stats runner summary motion compose ground-truth quantize
+# profiles direct integral histogram);
 # SAMPLE: mutants per module (0: all). Results in build/mutate/<module>.txt.
 MODULES ?=
 SAMPLE ?= 60

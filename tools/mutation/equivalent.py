@@ -911,3 +911,59 @@ EQUIVALENT["mot-io"] = [  # noqa: F821
      "ids = np.asarray(track_ids).astype(np.int64).reshape(- 2)",
      "numpy reads any negative size in reshape as the one unknown dimension"),
 ]
+
+# 2026-12-03, a sample of each histogram kernel (trackers/kernels/{integral,direct,profiles,
+# quantize}.py): the box kernel's scratch rectangles, one row per level of the 1-d fracs.
+_RECTS = "rects = np.empty((max(fracs.shape[0], 1), 4), dtype=np.int64)"
+_RECTS_EQ = [
+    (_RECTS, _RECTS.replace("shape[0]", "shape[ -1]"),
+     "fracs is one-dimensional: shape[-1] is shape[0]"),
+    (_RECTS, _RECTS.replace("1), 4)", "2), 4)"),
+     "a larger scratch: rows past the levels' are never read (with no levels, the kernel "
+     "is not the box kernel and rects is not read at all)"),
+]
+EQUIVALENT["integral"] = [  # noqa: F821
+    *_RECTS_EQ,
+    ("hgt = R1 - R0", "hgt = R1 + R0",
+     "only sizes the integral array and picks its integer type in _integral_distances: "
+     "_integral_score fills and reads the ROI's R1 - R0 + 1 rows of it, and the counts "
+     "are the same integers in uint16 or int32"),
+]
+EQUIVALENT["direct"] = [  # noqa: F821
+    *_RECTS_EQ,
+    (_RECTS, _RECTS.replace("1), 4)", "1), 5)"), "a fifth column that nothing writes or reads"),
+    ("if dy2 >= 1.0:", "if dy2 >= 2.0:",
+     "rows with 1 <= dy^2 < 2 lie outside the ellipse: their Epanechnikov row weight "
+     "(1 - dy^2 in fixed point) is <= 0 and their cone weights 1 - r < 0, all clamped to 0"),
+    ("return 4 if dim <= _SMALL_BINS else 1", "return 3 if dim <= _SMALL_BINS else 1",
+     "any lane count but 4 takes _scatter's one-copy loop; the copies it leaves at zero "
+     "add nothing when the copies are summed"),
+]
+_UNCOVERED = ("_box_row_weights' last loop (columns no covering rectangle holds) never runs: "
+              "the last rectangle (fraction l / L = 1 exactly) has the box's own pixel range, "
+              "so every row of the box is covered, and the level loop ends with lo == hi")
+EQUIVALENT["profiles"] = [  # noqa: F821
+    ("kbuf[c - c0] = 0", "kbuf[c - c0] = 1", _UNCOVERED),
+    ("kbuf[c - c0] = 0", "kbuf[c + c0] = 0", _UNCOVERED),
+]
+_BIT_IDENTICAL = ("only chooses the path: a reference's boxes then all take the direct path, "
+                  "which gives the same bits as the integral path (the tests compare them bit "
+                  "for bit); only the time changes")
+EQUIVALENT["histogram"] = [  # noqa: F821
+    ("n_groups += 1", "n_groups += 0",
+     "no group is formed (starts[:1] = [n_boxes]): " + _BIT_IDENTICAL),
+    ("if integral_ok and method != METHOD_DIRECT and n_boxes > 0:",
+     "if integral_ok and method != METHOD_DIRECT and n_boxes >= 0:",
+     "with no boxes, _reference_groups returns no group: the loop over groups is empty"),
+    ("rects = np.empty((n_levels, 4), dtype=np.int64)",
+     "rects = np.empty((n_levels, 5), dtype=np.int64)",
+     "a fifth column that nothing writes or reads"),
+    ("kbuf = np.empty(cols + 2 + _PAD, dtype=np.int64)",
+     "kbuf = np.empty(cols + 1 + _PAD, dtype=np.int64)",
+     "a scratch row is read and written below index cols (the box's clipped columns, or "
+     "the support path's padded run, at most cols long when the frame is that wide)"),
+    ("if q[r, b] > 0:", "if q[r, b] >= 0:",
+     "bins where q = 0 join the support: each adds sqrt(p) * 0 = +0.0 to rho (the same "
+     "bits) and 0 to the empty band's rho; they only make the support path or the "
+     "integral's channels less likely, both bit-identical to the whole histogram"),
+]

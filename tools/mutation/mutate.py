@@ -42,6 +42,7 @@ import ast
 import hashlib
 import os
 import re
+import shlex
 import shutil
 import subprocess
 import sys
@@ -61,6 +62,7 @@ class Module:
     scope: tuple[str, ...]          # qualified function names (Class.method or function)
     tests: tuple[str, ...]          # pytest arguments (paths, -k expressions)
     env: dict[str, str] = field(default_factory=dict)
+    timeout: float = 30.0           # the least time a mutant's tests get (s)
 
 
 _MEAN_SHIFT_TESTS = (
@@ -79,6 +81,11 @@ _RENDER_TESTS = (
 # Hypothesis without shrinking (tests/conftest.py): a failing example kills the mutant,
 # and shrinking it took 20-40 s a mutant in the generator's drawn scenes.
 _NO_SHRINK = {"HYPOTHESIS_PROFILE": "mutate"}
+# The histogram kernels' tests: per-box numpy transcriptions of every kernel, the paths
+# (direct, support, integral) against them and against each other, the box kernel.
+_HISTOGRAM_TESTS = (
+    "tests/trackers/models/test_observation.py", "tests/trackers/models/test_box_kernel.py",
+)
 
 MODULES: dict[str, Module] = {
     "resampling": Module(
@@ -241,6 +248,52 @@ MODULES: dict[str, Module] = {
         ("tests/scenegen/render/test_compose_oracle.py", *_RENDER_TESTS),
         _NO_SHRINK,
     ),
+    # The colour-histogram kernels every particle filter and mean-shift tracker weighs its
+    # boxes with: the bin-index image (quantize), which pixels a box holds and their
+    # fixed-point weights (profiles), the per-pixel path (direct) and the integral-histogram
+    # path (integral), checked against plain-numpy transcriptions and each other.
+    # _check_frame, _check_bin_count, _is_number and _is_integer are argument checking.
+    # A kernel file changed drops every kernel's numba cache (numba_cache.drop_stale), so
+    # each mutant recompiles the kernels its tests use (30-60 s on the shared cores, above
+    # 4 x the warm baseline): hence the timeout. quantize's tests compile only its kernels.
+    "quantize": Module(
+        "trackers/kernels/quantize.py",
+        ("_planes", "_quantize_rgb", "quantize_rgb", "_quantize_hsv", "hsv_n_bins",
+         "quantize_hsv"),
+        ("tests/trackers/models/test_observation.py",
+         "tests/trackers/test_docstring_examples.py", "-k",
+         "quantize or saturation or bad_number"),
+        {"NUMBA_BOUNDSCHECK": "1", **_NO_SHRINK}, timeout=300.0,
+    ),
+    "profiles": Module(
+        "trackers/kernels/profiles.py",
+        ("box_kernel_levels", "_level_args", "_first_inside", "_pixel_range",
+         "_cone_weights", "_epanechnikov_weights", "_level_rects", "_box_row_weights",
+         "_next_change"),
+        _HISTOGRAM_TESTS, {"NUMBA_BOUNDSCHECK": "1", **_NO_SHRINK}, timeout=300.0,
+    ),
+    "direct": Module(
+        "trackers/kernels/direct.py",
+        ("_lanes", "_scatter", "_scatter_unit", "_pair_sums", "_epanechnikov_pair_sums",
+         "_accumulate", "_accumulate_support", "_region_histograms", "_band_rho",
+         "_sums_rho", "_direct_distance"),
+        _HISTOGRAM_TESTS, {"NUMBA_BOUNDSCHECK": "1", **_NO_SHRINK}, timeout=300.0,
+    ),
+    "integral": Module(
+        "trackers/kernels/integral.py",
+        ("_band_rows", "_corner_rho", "_gather_rho", "_box_band_rho", "_integral_distances",
+         "_integral_score"),
+        _HISTOGRAM_TESTS, {"NUMBA_BOUNDSCHECK": "1", **_NO_SHRINK}, timeout=300.0,
+    ),
+    # What histogram.py computes around them: the references' supports and empty-band
+    # rho, the boxes grouped by reference, each group's choice of path (its cost model
+    # and ROI), the parallel dispatch, and the Bhattacharyya coefficient and distance.
+    "histogram": Module(
+        "trackers/kernels/histogram.py",
+        ("_reference_groups", "_integral_group", "_region_distances", "_support",
+         "bhattacharyya_coefficient", "bhattacharyya_distance"),
+        _HISTOGRAM_TESTS, {"NUMBA_BOUNDSCHECK": "1", **_NO_SHRINK}, timeout=300.0,
+    ),
 }
 
 # One replacement per operator site (cosmic-ray's operator names).
@@ -308,7 +361,7 @@ def make_tree() -> None:
 
 
 def test_command(mod: Module) -> str:
-    args = " ".join(mod.tests)
+    args = " ".join(shlex.quote(arg) for arg in mod.tests)  # a -k expression has spaces
     return f"{sys.executable} -m pytest -x -q -p no:cacheprovider --no-header {args}"
 
 
@@ -451,7 +504,7 @@ def run(name: str, mod: Module, *, count_only: bool, report_only: bool, sample: 
         raise SystemExit(f"{name}: the tests fail on the unmutated sources:\n"
                          f"{base.stdout[-3000:]}")
     baseline = time.monotonic() - start
-    cfg = write_config(name, mod, timeout=max(30.0, 4 * baseline))
+    cfg = write_config(name, mod, timeout=max(mod.timeout, 4 * baseline))
     stamp = BUILD / f"{name}.sha256"
     digest = hashlib.sha256((ROOT / mod.path).read_bytes()).hexdigest()
     if session.exists() and (not stamp.exists() or stamp.read_text() != digest):

@@ -82,6 +82,16 @@ def test_bhattacharyya_equals_opencv(seed, n_bins, n_hists, common_ref):
     np.testing.assert_allclose(ours, theirs, atol=2e-6)
 
 
+@pytest.mark.parametrize("hists, refs", [((3, 4), (5,)), ((3, 4), (4, 4)), ((3, 4), (3, 5)),
+                                          ((4,), (4,))])
+def test_bhattacharyya_names_the_reference_shapes_it_accepts(hists, refs):
+    # One reference of B bins for every row, or one per row; a row's bins are the last axis.
+    want = (r"refs must have shape \(4,\) or \(3, 4\) for hists of shape \(P, B\); "
+            if len(hists) == 2 else r"refs must have shape \(4,\) or \(4,\) ")
+    with pytest.raises(ValueError, match=want):
+        bhattacharyya_distance(np.ones(hists), np.ones(refs))
+
+
 @settings(max_examples=25)
 @given(seed=st.integers(0, 2**32 - 1), height=st.integers(5, 40), width=st.integers(5, 40),
        model=st.sampled_from(["rgb", "hsv"]), bins=st.integers(1, 12),
@@ -489,3 +499,77 @@ def _check_support_path(seed, width, n_parts, kernel, dtype):
     np.testing.assert_array_equal(support, whole)
     np.testing.assert_array_equal(
         region_distances(bin_img, boxes, refs, index, kernel, n_parts, method="direct"), whole)
+
+
+@pytest.mark.parametrize("kernel", [*KERNELS, KERNEL_BOX])
+@pytest.mark.parametrize("method", ["direct", "integral"])
+def test_a_box_scored_against_its_own_histogram_has_distance_zero(kernel, method):
+    """d = sqrt(max(0, 1 − ρ)): a box against its own histogram has ρ = 1 up to rounding,
+    d = 0 exactly where ρ rounds to 1 or above (never NaN, never 1), and a box of one
+    colour has ρ = 1 exactly. Bands of 1, 2 and 3; whole, support and integral paths."""
+    rng = np.random.default_rng(21)
+    bin_img = rng.integers(0, 3, (24, 30)).astype(np.int32)
+    bin_img[4:12, 8:16] = 1  # a flat square: 8 x 8 pixels of colour 1
+    boxes = np.column_stack([rng.uniform(-2, 26, 200), rng.uniform(-2, 20, 200),
+                             rng.uniform(1, 9, 200), rng.uniform(1, 9, 200)])
+    boxes[0] = [8.0, 4.0, 8.0, 8.0]
+    boxes[1] = [10.0, 6.0, 4.0, 4.0]
+    for n_parts in (1, 2, 3):
+        refs = region_histograms(bin_img, boxes, 3, kernel, n_parts)
+        for max_support in (-1, 3):  # the whole histogram, then the support path
+            prepared = prepare_references(refs, n_parts)
+            fracs, a_fixed = _level_args(kernel, 3)
+            d = _region_distances(bin_img, boxes, prepared.sqrt_refs, np.arange(200),
+                                  prepared.nz, prepared.nz_start, prepared.empty_rho, 3,
+                                  kernel, n_parts, _lanes(3 * n_parts), METHODS[method],
+                                  fracs, a_fixed, 1, max_support)
+            assert np.all(np.isfinite(d)) and np.all(d >= 0.0)
+            assert d.max() < 1e-7, (n_parts, max_support)
+            assert d[0] == 0.0 and d[1] == 0.0
+            if n_parts == 1:
+                # Exact where ρ rounds to 1 or above: at least one box of the cloud.
+                assert np.sum(d == 0.0) > 2
+
+
+@pytest.mark.parametrize("kernel", [*KERNELS, KERNEL_BOX])
+def test_more_bands_than_bins_equal_per_patch_numpy(kernel):
+    """Two bins in three or five bands: each band's bins lie n_bins apart, fewer than the
+    bands (the histogram's four copies, at multiples of the whole length, must not
+    overlap)."""
+    rng = np.random.default_rng(8)
+    bin_img = rng.integers(0, 2, (20, 26)).astype(np.int32)
+    boxes = np.column_stack([rng.uniform(-3, 22, 30), rng.uniform(-3, 16, 30),
+                             rng.uniform(2, 14, 30), rng.uniform(2, 14, 30)])
+    for n_parts in (3, 5):
+        hists = region_histograms(bin_img, boxes, 2, kernel, n_parts)
+        if kernel == KERNEL_BOX:
+            assert np.all(np.isfinite(hists)) and np.allclose(hists.sum(axis=1), 1.0)
+            continue  # the box kernel's transcription is in test_box_kernel.py
+        expected = np.stack([_reference_histogram(bin_img, b, 2, kernel, n_parts)
+                             for b in boxes])
+        np.testing.assert_allclose(hists, expected, rtol=0, atol=1e-8)
+        refs = rng.dirichlet(np.ones(2 * n_parts), 2)
+        index = rng.integers(0, 2, 30)
+        np.testing.assert_allclose(
+            region_distances(bin_img, boxes, refs, index, kernel, n_parts, method="direct"),
+            bhattacharyya_distance(expected, refs[index]), rtol=0, atol=1e-7)
+
+
+@pytest.mark.parametrize("s_min, v_min", [(0.0, 0.0), (1.0, 1.0), (0.0, 1.0), (1.0, 0.0)])
+def test_quantize_hsv_at_the_thresholds_extremes(s_min, v_min):
+    """s_min and v_min of exactly 0 and 1 are accepted; with 0 a grey or black pixel
+    (no hue, d = 0) still falls in the value bins, with 1 only fully saturated, full
+    value pixels are coloured."""
+    frame = _frame(9, 24, 24)
+    frame[0, :6] = [(0, 0, 0), (255, 255, 255), (7, 7, 7), (255, 0, 0), (0, 255, 1),
+                    (128, 0, 0)]
+    out = quantize_hsv(frame, 6, 5, 4, s_min, v_min)
+    np.testing.assert_array_equal(out, _reference_hsv(frame, 6, 5, 4, s_min, v_min))
+    assert out[0, 0] == 6 * 5 and out[0, 1] == 6 * 5 + 3 and out[0, 2] == 6 * 5
+
+
+@pytest.mark.parametrize("kwargs", [{"s_min": -0.1}, {"v_min": -1e-9}, {"s_min": 1.0 + 1e-9},
+                                    {"v_min": 2.0}, {"s_min": float("nan")}])
+def test_quantize_hsv_refuses_thresholds_outside_0_1(kwargs):
+    with pytest.raises(ValueError, match="must lie in \\[0, 1\\]"):
+        quantize_hsv(np.zeros((2, 2, 3), dtype=np.uint8), **kwargs)
