@@ -102,6 +102,40 @@ MODULES: dict[str, Module] = {
          "tests/trackers/test_particle.py", "tests/trackers/test_ps_weighting.py",
          "tests/trackers/test_stage_kernels.py"),
     ),
+    # The compiled stages of the particle filters' step: numpy's pairwise sum replicated,
+    # the AR2 propagation of each particle's stage object, the stage's boxes and
+    # log-weights, the group normalisation, the weighted resampling with its gathers (joint
+    # and placed scope), the DPS reassembly, the estimate and the diagnostics. Left out:
+    # the test-only wrappers numpy_sum and numpy_reduceat_sum, and the checks (_valid,
+    # normalise_groups_checked) that only send bad weights to numpy's path, which raises.
+    "stages": Module(
+        "trackers/kernels/stages.py",
+        ("_pairwise_block", "_pairwise", "_numpy_sum", "_numpy_reduceat_sum",
+         "_propagate_objects", "_state_boxes", "_stage_log_weights", "_normalise_groups",
+         "_gather_pair", "_gather_placed", "_weighted_resample_gather", "_scope",
+         "weighted_resample_gather", "_resample_propagate", "resample_propagate",
+         "_group_max_shift", "group_weights", "_reassemble_shift", "_reassemble_sums",
+         "_max_shift", "_divide_by_sum", "_final_log_weights", "reassemble",
+         "_weighted_mean_states", "_row_max_shift", "_normalise_rows", "_effective_uv",
+         "effective_uv"),
+        ("tests/trackers/test_stage_kernels.py", "tests/trackers/test_ps_weighting.py",
+         "tests/trackers/test_equivalences.py", "tests/trackers/filters/test_resampling.py",
+         "tests/trackers/filters/test_resampling_oracle.py", "tests/trackers/test_particle.py",
+         "tests/trackers/test_oracle_particle.py"),
+        # Out-of-bounds writes in compiled code are undefined behaviour, not errors.
+        {"NUMBA_BOUNDSCHECK": "1"},
+    ),
+    # The compiled inverse-CDF draws of every resampler (per group, the three schemes) and
+    # the distinct sub-states behind the DPS uniqueness diagnostic.
+    "sampling": Module(
+        "trackers/kernels/sampling.py",
+        ("_inverse_cdf_groups", "inverse_cdf_groups", "_count_distinct", "count_distinct"),
+        ("tests/trackers/filters/test_resampling.py",
+         "tests/trackers/filters/test_resampling_oracle.py",
+         "tests/trackers/test_stage_kernels.py", "tests/trackers/test_equivalences.py",
+         "tests/trackers/test_particle.py", "tests/trackers/test_oracle_particle.py"),
+        {"NUMBA_BOUNDSCHECK": "1"},
+    ),
     "meanshift": Module(
         "trackers/kernels/meanshift.py",
         ("_pixel_range", "_chord", "_row_weights", "_window", "_distance", "_clear", "_shift",
