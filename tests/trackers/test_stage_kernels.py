@@ -189,6 +189,24 @@ def test_invalid_weights_leave_the_kernels_for_the_checked_path():
     assert not finite
 
 
+def test_a_group_whose_weights_times_g_sum_to_zero_leaves_the_kernels():
+    # π and g are each finite and non-negative, but no particle of group 1 has both
+    # positive: π g sums to 0 there, nothing can be drawn, and the kernels must hand the
+    # set to the checked numpy path (which raises) instead of returning weights.
+    a, b = np.array([1.0, 2.0, 1.0, 0.0]), np.array([1.0, 1.0, 0.0, 3.0])
+    sizes = np.array([2, 2], dtype=np.int64)
+    uniforms = np.array([0.5, 0.5])
+    x, prev = np.zeros((4, 1, 3)), np.zeros((4, 1, 3))
+    ll, log_g = np.zeros((4, 1)), np.zeros(4)
+    assert weighted_resample_gather(a, b, sizes, uniforms, SYSTEMATIC, x, prev, ll,
+                                    log_g) is None
+    assert resample_propagate(a, b, sizes, uniforms, SYSTEMATIC, x, prev, ll, log_g,
+                              np.zeros(4, dtype=np.int64), np.zeros((4, 3)), np.zeros((1, 3)),
+                              np.ones(3), 2.0, -1.0) is None
+    with pytest.raises(ValueError, match="positive sum"):
+        weighted_resample_groups(a, b, sizes, rng=np.random.default_rng(0))
+
+
 def test_normalise_groups_checked_is_the_numpy_division():
     rng = np.random.default_rng(4)
     w = _values(rng, 300)
