@@ -26,11 +26,13 @@ from trackers.kernels.stages import (
     effective_uv,
     gather_pair,
     normalise_groups_checked,
+    normalise_rows,
     numpy_reduceat_sum,
     numpy_sum,
     propagate_objects,
     reassemble,
     resample_propagate,
+    row_max_shift,
     stage_log_weights,
     state_boxes,
     weighted_mean_states,
@@ -256,6 +258,23 @@ def test_weighted_mean_and_diagnostics_are_the_numpy_ones():
     x2, p2 = gather_pair(particles, particles * 2, np.array([3, 3, 0], dtype=np.int64))
     assert np.array_equal(x2, particles[[3, 3, 0]])
     assert np.array_equal(p2, (particles * 2)[[3, 3, 0]])
+
+
+def test_row_max_shift_and_normalise_rows_are_the_numpy_ones():
+    # The per-object weights of the bootstrap filter: each row minus its maximum, then
+    # numpy's exp, then each row over its sum. The maximum sits in the first column, in
+    # the last, inside, and alone (N = 1).
+    rng = np.random.default_rng(9)
+    x = rng.normal(0, 50, (5, 40))
+    x[0, 0], x[1, -1], x[2, 17] = 900.0, 900.0, 900.0
+    for logw in (x, x[:, :1]):
+        want = logw - logw.max(axis=1, keepdims=True)
+        assert np.array_equal(row_max_shift(logw), want)
+        e = np.exp(want)
+        got = normalise_rows(e)
+        assert np.array_equal(got, e / e.sum(axis=1, keepdims=True))
+        for row, w in zip(logw, got):
+            assert np.array_equal(w, normalised_weights(row))
 
 
 def _distinct_brute(p):
