@@ -273,7 +273,7 @@ def test_row_max_shift_and_normalise_rows_are_the_numpy_ones():
         e = np.exp(want)
         got = normalise_rows(e)
         assert np.array_equal(got, e / e.sum(axis=1, keepdims=True))
-        for row, w in zip(logw, got):
+        for row, w in zip(logw, got, strict=True):
             assert np.array_equal(w, normalised_weights(row))
 
 
