@@ -30,9 +30,9 @@ bench: $(STAMP)
 	$(BIN)/scenegen bench
 
 # Mutation score of the formula modules (cosmic-ray; long, not part of `make test`).
-# MODULES: a subset (resampling particle meanshift ms-trackers sok hybrid annealed shm
-# kalman metrics mot mot-io stats runner summary motion compose ground-truth quantize
-# profiles direct integral histogram);
+# MODULES: a subset (resampling particle stages sampling meanshift ms-trackers sok hybrid
+# annealed shm kalman metrics mot mot-io stats runner summary motion compose ground-truth
+# quantize profiles direct integral histogram);
 # SAMPLE: mutants per module (0: all). Results in build/mutate/<module>.txt.
 MODULES ?=
 SAMPLE ?= 60

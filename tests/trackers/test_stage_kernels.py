@@ -26,11 +26,13 @@ from trackers.kernels.stages import (
     effective_uv,
     gather_pair,
     normalise_groups_checked,
+    normalise_rows,
     numpy_reduceat_sum,
     numpy_sum,
     propagate_objects,
     reassemble,
     resample_propagate,
+    row_max_shift,
     stage_log_weights,
     state_boxes,
     weighted_mean_states,
@@ -189,6 +191,24 @@ def test_invalid_weights_leave_the_kernels_for_the_checked_path():
     assert not finite
 
 
+def test_a_group_whose_weights_times_g_sum_to_zero_leaves_the_kernels():
+    # π and g are each finite and non-negative, but no particle of group 1 has both
+    # positive: π g sums to 0 there, nothing can be drawn, and the kernels must hand the
+    # set to the checked numpy path (which raises) instead of returning weights.
+    a, b = np.array([1.0, 2.0, 1.0, 0.0]), np.array([1.0, 1.0, 0.0, 3.0])
+    sizes = np.array([2, 2], dtype=np.int64)
+    uniforms = np.array([0.5, 0.5])
+    x, prev = np.zeros((4, 1, 3)), np.zeros((4, 1, 3))
+    ll, log_g = np.zeros((4, 1)), np.zeros(4)
+    assert weighted_resample_gather(a, b, sizes, uniforms, SYSTEMATIC, x, prev, ll,
+                                    log_g) is None
+    assert resample_propagate(a, b, sizes, uniforms, SYSTEMATIC, x, prev, ll, log_g,
+                              np.zeros(4, dtype=np.int64), np.zeros((4, 3)), np.zeros((1, 3)),
+                              np.ones(3), 2.0, -1.0) is None
+    with pytest.raises(ValueError, match="positive sum"):
+        weighted_resample_groups(a, b, sizes, rng=np.random.default_rng(0))
+
+
 def test_normalise_groups_checked_is_the_numpy_division():
     rng = np.random.default_rng(4)
     w = _values(rng, 300)
@@ -238,6 +258,23 @@ def test_weighted_mean_and_diagnostics_are_the_numpy_ones():
     x2, p2 = gather_pair(particles, particles * 2, np.array([3, 3, 0], dtype=np.int64))
     assert np.array_equal(x2, particles[[3, 3, 0]])
     assert np.array_equal(p2, (particles * 2)[[3, 3, 0]])
+
+
+def test_row_max_shift_and_normalise_rows_are_the_numpy_ones():
+    # The per-object weights of the bootstrap filter: each row minus its maximum, then
+    # numpy's exp, then each row over its sum. The maximum sits in the first column, in
+    # the last, inside, and alone (N = 1).
+    rng = np.random.default_rng(9)
+    x = rng.normal(0, 50, (5, 40))
+    x[0, 0], x[1, -1], x[2, 17] = 900.0, 900.0, 900.0
+    for logw in (x, x[:, :1]):
+        want = logw - logw.max(axis=1, keepdims=True)
+        assert np.array_equal(row_max_shift(logw), want)
+        e = np.exp(want)
+        got = normalise_rows(e)
+        assert np.array_equal(got, e / e.sum(axis=1, keepdims=True))
+        for row, w in zip(logw, got, strict=True):
+            assert np.array_equal(w, normalised_weights(row))
 
 
 def _distinct_brute(p):

@@ -967,3 +967,54 @@ EQUIVALENT["histogram"] = [  # noqa: F821
      "bits) and 0 to the empty band's rho; they only make the support path or the "
      "integral's channels less likely, both bit-identical to the whole histogram"),
 ]
+
+# 2026-12-03, a seeded sample of 40 mutants of the compiled stages (key stages):
+_STAGES_1D = "the array is one-dimensional (the weights (N,), the group sizes (C,)): shape[-1] is shape[0]"
+EQUIVALENT["stages"] = [  # noqa: F821
+    ("n = w.shape[0]", "n = w.shape[ -1]", _STAGES_1D),
+    ("for g in range(sizes.shape[0]):", "for g in range(sizes.shape[ -1]):", _STAGES_1D),
+    ("f_lo = np.empty(64, dtype=np.int64)", "f_lo = np.empty( 63, dtype=np.int64)",
+     "the explicit stack of the pairwise recursion holds one frame per halving of N / 128: "
+     "63 frames would take N of about 2**69"),
+    ("n = logw.shape[0]", "n = logw.shape[ -1]", _STAGES_1D),
+    ("total = _numpy_sum(e, 0, e.shape[0])", "total = _numpy_sum(e, 0, e.shape[ -1])", _STAGES_1D),
+    ("out = np.empty(x.shape[0])", "out = np.empty(x.shape[ -1])", _STAGES_1D),
+    ("for i in range(x.shape[0]):", "for i in range(x.shape[ -1]):",
+     "in _max_shift, of a one-dimensional array (the same line in _row_max_shift, of a "
+     "(K, N) array, is killed: test_row_max_shift_and_normalise_rows_are_the_numpy_ones)"),
+    ("shifted = np.empty((2, n))", "shifted = np.empty(( 3, n))",
+     "a third row of the reassembly's shifted logs that nothing reads (the sums take rows 0 and 1)"),
+    ("NDArray[np.float64], NDArray[np.float64]] | None:",
+     "NDArray[np.float64], NDArray[np.float64]] & None:",
+     "an annotation: never evaluated (from __future__ import annotations)"),
+    ("for j in range(1, x.shape[1]):", "for j in range( 0, x.shape[1]):",
+     "the row's maximum starts at x[i, 0]: comparing x[i, 0] with it again changes nothing"),
+]
+
+# 2026-12-03, a seeded sample of 40 mutants of the compiled draws and distinct counts
+# (trackers/kernels/sampling.py, key sampling):
+_HASH = ("a constant of the hash of count_distinct's table: the hash only chooses where "
+         "a row's probe starts; whether a row is new is decided by comparing the rows")
+EQUIVALENT["sampling"] = [  # noqa: F821
+    *[("h = (h ^ np.uint64(bits[i, obj, c])) * np.uint64(1099511628211)",
+       f"h = (h ^ np.uint64(bits[i, obj, c])) * np.uint64( {m})", _HASH)
+      for m in ("1099511628212", "1099511628210")],
+    ("h = np.uint64(1469598103934665603)", "h = np.uint64( 1469598103934665604)", _HASH),
+    ("h = (h ^ np.uint64(bits[i, obj, c])) * np.uint64(1099511628211)",
+     "h = (h | np.uint64(bits[i, obj, c])) * np.uint64(1099511628211)",
+     "the hash's mixing, or for xor: a worse spread of the probes' starts; whether a row "
+     "is new is decided by comparing the rows"),
+    ("while size < 2 * n:", "while size < 3 * n:",
+     "a larger table (at most a third full instead of half): the probes end at a free slot "
+     "or at an equal row either way"),
+    ("for c in range(3):", "for c in range( 2):",
+     "the hash of (u, v) only: " + _HASH.split(": ", 1)[1]),
+    ("if u != u or v != v or a != a:", "if u != u and v != v or a != a:",
+     "a shortcut: a row whose NaN is in u or v alone then goes through the table, where "
+     "it equals no stored row (NaN != NaN) and so is counted once as new, as the shortcut "
+     "counts it; the table (at least 2 N slots) never fills"),
+    ("h ^= h >> np.uint64(29)", "h ^= h << np.uint64(29)", _HASH),
+    ("slot = (slot + np.uint64(1)) & mask", "slot = (slot - np.uint64(1)) & mask",
+     "linear probing downwards instead of upwards: modulo the power-of-two table size it "
+     "still visits every slot, and the table is never more than half full"),
+]
