@@ -206,8 +206,20 @@ def compare_root(root: Path, experiments: Sequence[str] | None = None) -> list[R
     ------
     DataError
         As :func:`load_records`, for a damaged or edited run record.
+    ConfigError
+        One line: an experiment asked for is not an experiment's name, or ``root`` has no
+        ``<experiment>/base`` and ``<experiment>/other`` folders for it.
     """
+    from scenegen.errors import ConfigError
+    from scenegen.lab.experiments import get
+
     root = Path(root)
+    for name in experiments or []:
+        get(name)  # an unknown name: one line listing the experiments
+        missing = [side for side in (BASE, OTHER) if not (root / name / side).is_dir()]
+        if missing:
+            raise ConfigError(f"experiment {name!r}: no {root / name / missing[0]} folder "
+                              f"(ROOT/<experiment>/{BASE} and {OTHER} are compared)")
     names = experiments or sorted(p.name for p in root.iterdir()
                                   if (p / BASE).is_dir() and (p / OTHER).is_dir())
     rows: list[Row] = []
@@ -270,8 +282,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     -------
     int
         The exit status: 0, or 1 (one line on stderr) for a damaged or edited run
-        record; bad arguments, a ``ROOT`` that is not a folder among them, exit 2
-        through argparse.
+        record; bad arguments (a ``ROOT`` that is not a folder, an ``--experiment``
+        that is not an experiment or has no base and other folders), exit 2 through
+        argparse.
     """
     p = argparse.ArgumentParser(prog="python -m scenegen.lab.kernel_quality",
                                 description=__doc__.split("\n\n")[0])
@@ -286,10 +299,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = p.parse_args(argv)
     if not args.root.is_dir():
         p.error(f"ROOT {args.root} is not a folder")
-    from scenegen.errors import DataError
+    from scenegen.errors import ConfigError, DataError
 
     try:
         rows = compare_root(args.root, args.experiment)
+    except ConfigError as err:
+        p.error(str(err))
     except DataError as err:
         print(f"{p.prog}: error: {err}", file=sys.stderr)
         return 1

@@ -280,6 +280,24 @@ def test_a_root_that_is_not_a_folder_is_a_usage_error(tmp_path, capsys):
     assert info.value.code == 2 and "is not a folder" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize(("name", "made", "says"), [
+    ("nosuch", [], "unknown experiment 'nosuch'; valid experiments: dps-synthetic"),
+    ("kams-accuracy", [], "experiment 'kams-accuracy': no "),
+    ("kams-accuracy", ["base"], "kams-accuracy/other folder"),
+])
+def test_an_experiment_asked_for_must_be_there(tmp_path, capsys, name, made, says):
+    """--experiment with an unknown name was a ConfigError traceback; a known one without
+    its folders printed an empty table and exit 0, as if nothing differed."""
+    for side in made:
+        (tmp_path / name / side).mkdir(parents=True)
+    with pytest.raises(SystemExit) as info:
+        kq.main([str(tmp_path), "--experiment", name])
+    err = capsys.readouterr().err
+    assert info.value.code == 2 and says in err and "Traceback" not in err
+    with pytest.raises(ConfigError, match=says.split(";")[0]):
+        kq.compare_root(tmp_path, [name])
+
+
 @pytest.mark.parametrize(("name", "plan", "options"), [
     ("shm-depth", {}, ""),
     ("dps-synthetic", {"quick": True}, "--quick"),
