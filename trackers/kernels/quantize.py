@@ -163,7 +163,8 @@ def quantize_hsv(
 
     Pixels with saturation ≥ ``s_min`` and value ≥ ``v_min`` fall in an ``h_bins`` ×
     ``s_bins`` hue–saturation histogram; the others (greyish or dark, where hue is
-    unreliable) fall in a value-only histogram of ``v_bins`` bins placed after it.
+    unreliable) fall in a value-only histogram of ``v_bins`` bins placed after it. A grey
+    pixel (S = 0, no hue) is never coloured, even with ``s_min`` = 0.
 
     HSV is the hexcone model of the 8-bit RGB values (as ``skimage.color.rgb2hsv``):
     V = max / 255, S = (max − min) / max, H in [0, 1) of the colour circle; a bin is
