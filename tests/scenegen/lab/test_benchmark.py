@@ -678,6 +678,7 @@ def test_pages_write_json_cells_and_escape_a_pipe_in_a_trackers_name(reference):
 # --keep-tracks: the tracker outputs and the ground truth as TrackEval reads them.
 
 ORACLE = Path(__file__).resolve().parents[2] / "data" / "trackeval_benchmark"
+TOOL = Path(__file__).resolve().parents[3] / "tools" / "trackeval" / "make_benchmark_inputs.py"
 _REDO = "run the same `scenegen benchmark ... --keep-tracks` command again to rewrite it"
 
 
@@ -846,17 +847,14 @@ def _oracle_diffs(summary, case):
     return out
 
 
-def test_kept_tracks_score_as_trackeval_does(kept, tmp_path):
+def test_kept_tracks_score_as_trackeval_does(kept, tool, tmp_path):
     """TrackEval (tools/trackeval/score_benchmark.py, run on the committed kept folders)
     gives the leaderboard's combined columns and every multi-target run's scores, to
     their rounding: on this module's benchmark and a mixed one (one single-target
     sequence, left out of the combined columns) regenerated here, and on the committed
     output of a built-in family (seven targets)."""
-    from conftest import load_tool
-
     from scenegen.lab.benchmark_tracks import file_digest
 
-    tool = load_tool("trackeval/make_benchmark_inputs.py")
     oracle = json.loads((ORACLE / "oracle.json").read_text())["cases"]
     assert tool.CASES["two"] == {"family": FAMILY, "trackers": TRACKERS, "params": PARAMS}
     diffs = []
@@ -877,11 +875,8 @@ def test_kept_tracks_score_as_trackeval_does(kept, tmp_path):
     assert len(diffs) == 30 + 12 + 24 and max(diffs) <= 5.1e-7
 
 
-@pytest.mark.slow
-def test_the_committed_built_in_benchmark_is_the_benchmarks_output(tmp_path):
-    from conftest import load_tool
-
-    tool = load_tool("trackeval/make_benchmark_inputs.py")
+def test_the_committed_built_in_benchmark_is_the_benchmarks_output(tool, tmp_path):
+    """The committed dps-synthetic case (scored by TrackEval) is what the benchmark writes."""
     results = tool.run_case("dps-synthetic", tmp_path)
     case = ORACLE / "dps-synthetic"
     assert files(tmp_path / "benchmark" / "trackeval") == files(case / "trackeval")
