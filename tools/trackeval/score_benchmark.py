@@ -14,13 +14,19 @@ several targets, which the leaderboard's "(combined)" columns take as one). It w
 ``tests/data/trackeval_benchmark/oracle.json``: per case, tracker and sequence TrackEval's
 HOTA, MOTA and IDF1 (and the counts behind them), and its ``COMBINED_SEQ`` row of each
 seqmap (``combined_all``, ``combined_multi``), as fractions (TrackEval prints percents).
-This script does not import scenegen.
+With ``--script PATH/TO/scripts/run_mot_challenge.py`` it also runs TrackEval's command
+line as the docs give it, on a copy of each kept folder (every sequence, then the
+multi-target ones through ``--SEQ_INFO``), and checks that the ``COMBINED`` HOTA, MOTA and
+IDF1 of each tracker's ``pedestrian_summary.txt`` (percents, 3 decimals) are those of the
+API above. This script does not import scenegen.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import shutil
+import subprocess
 import sys
 import tempfile
 from pathlib import Path
@@ -86,10 +92,37 @@ def score(folder: Path, split: str) -> tuple[dict, dict]:
     return table, combined
 
 
+def check_command_line(script: Path, folder: Path, split: str, combined: dict) -> None:
+    """Run TrackEval's ``run_mot_challenge.py`` as the docs give it on a copy of the kept
+    ``folder`` (the sequences of ``split``) and check its summaries against ``combined``
+    (:func:`score`'s second value); exit with a message on a difference."""
+    with tempfile.TemporaryDirectory() as tmp:
+        kept = Path(tmp) / "trackeval"
+        shutil.copytree(folder, kept)
+        cmd = [sys.executable, str(script), "--BENCHMARK", "scenegen", "--SPLIT_TO_EVAL", "all",
+               "--GT_FOLDER", str(kept / "gt" / "mot_challenge"),
+               "--TRACKERS_FOLDER", str(kept / "trackers" / "mot_challenge"),
+               "--DO_PREPROC", "True", "--USE_PARALLEL", "False", "--PLOT_CURVES", "False",
+               "--PRINT_RESULTS", "False", "--PRINT_CONFIG", "False"]  # fmt: skip
+        if split != "all":
+            cmd += ["--SEQ_INFO", *seqmap(folder, split)]
+        subprocess.run(cmd, check=True, capture_output=True, cwd=tmp)
+        for tracker, want in combined.items():
+            summary = kept / "trackers" / "mot_challenge" / "scenegen-all" / tracker
+            head, values = (summary / "pedestrian_summary.txt").read_text().splitlines()[:2]
+            got = dict(zip(head.split(), map(float, values.split()), strict=True))
+            for field in ("HOTA", "MOTA", "IDF1"):
+                if abs(got[field] - 100 * want[field]) > 5e-4:
+                    raise SystemExit(f"{folder} {split} {tracker}: the command line gives "
+                                     f"{field} {got[field]}, the API {100 * want[field]}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description="Score the kept tracks with TrackEval.")
     parser.add_argument("--commit", help="TrackEval commit installed (when pip copied it)")
     parser.add_argument("--out", type=Path, default=DATA / "oracle.json", help="output file")
+    parser.add_argument("--script", type=Path, help="TrackEval's run_mot_challenge.py: also "
+                        "check its command line")  # fmt: skip
     args = parser.parse_args()
     oracle: dict = {
         "tool": "TrackEval",
@@ -104,6 +137,11 @@ def main() -> None:
         entry = {"sequences": table, "combined_all": combined, "combined_multi": None}
         if seqmap(folder, "multi"):
             entry["combined_multi"] = score(folder, "multi")[1]
+        if args.script:
+            check_command_line(args.script, folder, "all", combined)
+            if entry["combined_multi"]:
+                check_command_line(args.script, folder, "multi", entry["combined_multi"])
+            print(f"{case.name}: the command line agrees")
         oracle["cases"][case.name] = entry
     args.out.write_text(json.dumps(oracle, indent=1, sort_keys=True) + "\n")
     print(f"wrote {args.out}")
