@@ -33,6 +33,11 @@ def register(sub: argparse._SubParsersAction) -> None:
                        help="dask.distributed scheduler, e.g. tcp://host:8786 (its workers "
                        "read DIR; this process writes OUT)")  # fmt: skip
     p.add_argument("-o", "--output", type=Path, required=True, help="output folder OUT")
+    p.add_argument("--keep-tracks", action="store_true",
+                   help="also write OUT/trackeval/: every tracker's output as MOTChallenge "
+                   "tracker files and the dataset's ground truth (amodal), laid out for "
+                   "TrackEval's run_mot_challenge.py (see docs/evaluation.md); on an OUT "
+                   "made without it, runs the finished pairs again for their tracks")  # fmt: skip
     p.set_defaults(func=cmd_benchmark)
 
 
@@ -57,6 +62,7 @@ def cmd_benchmark(args: argparse.Namespace) -> int:
         jobs=args.jobs,
         scheduler=args.scheduler,
         progress=sys.stderr.isatty(),
+        keep_tracks=args.keep_tracks,
     )
     board = res["leaderboard"]
     if not scored(board):

@@ -37,7 +37,7 @@ from scenegen.io.atomic import clean_temp_files, temp_prefix
 from scenegen.io.mot import gt_rows, writable
 from scenegen.sequence import Sequence
 
-__all__ = ["IMAGE_FORMATS", "encode_frame", "export_mot", "write_folder"]
+__all__ = ["IMAGE_FORMATS", "encode_frame", "export_mot", "seqinfo_text", "write_folder"]
 
 IMAGE_FORMATS = ("png", "jpg")
 """Frame formats of the exports: lossless PNG, or JPEG (quality 95)."""
@@ -184,6 +184,31 @@ def write_folder(out_dir: str | Path, fill: Callable[[Path], None]) -> None:
             raise
 
 
+def seqinfo_text(seq: Sequence, frame_rate: int = 25, image_format: str = "png") -> str:
+    """The ``seqinfo.ini`` of ``seq`` in a MOTChallenge sequence folder.
+
+    Parameters
+    ----------
+    seq : Sequence
+        The sequence (its ``name``, ``n_frames``, ``width`` and ``height`` are used).
+    frame_rate : int
+        Written as ``frameRate``.
+    image_format : {"png", "jpg"}
+        Written as ``imExt`` (the frames' extension in ``img1/``).
+
+    Returns
+    -------
+    str
+        The ``[Sequence]`` section: ``name``, ``imDir``, ``frameRate``, ``seqLength``,
+        ``imWidth``, ``imHeight`` and ``imExt``, one per line.
+    """
+    return (
+        "[Sequence]\n"
+        f"name={seq.name}\nimDir=img1\nframeRate={frame_rate}\nseqLength={seq.n_frames}\n"
+        f"imWidth={seq.width}\nimHeight={seq.height}\nimExt=.{image_format}\n"
+    )
+
+
 def export_mot(
     seq: Sequence,
     out_dir: str | Path,
@@ -228,11 +253,7 @@ def export_mot(
     def fill(tmp: Path) -> None:
         (tmp / "gt").mkdir()
         (tmp / "img1").mkdir()
-        (tmp / "seqinfo.ini").write_text(
-            "[Sequence]\n"
-            f"name={seq.name}\nimDir=img1\nframeRate={frame_rate}\nseqLength={seq.n_frames}\n"
-            f"imWidth={seq.width}\nimHeight={seq.height}\nimExt=.{image_format}\n"
-        )
+        (tmp / "seqinfo.ini").write_text(seqinfo_text(seq, frame_rate, image_format))
         with open(tmp / "gt" / "gt.txt", "w") as gt_file:
             for t in range(seq.n_frames):
                 for row in gt_rows(seq, t, gt_mode, visibility_threshold):

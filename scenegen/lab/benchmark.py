@@ -39,8 +39,8 @@ from typing import Any
 
 import numpy as np
 
-from scenegen.errors import ConfigError
-from scenegen.io.sealed import SEAL, seal, write_sealed_json
+from scenegen.errors import ConfigError, DataError
+from scenegen.io.sealed import SEAL, content_digest, seal, write_sealed_json
 from scenegen.lab.experiments.runner import _round, derive_seed
 
 __all__ = [
@@ -56,6 +56,7 @@ __all__ = [
     "run_benchmark",
     "run_file",
     "run_pair",
+    "run_pair_tracks",
     "scored",
     "texts",
     "write_outputs",
@@ -220,6 +221,25 @@ def run_pair(task: BenchTask) -> dict[str, Any]:
         ``sequence_params`` and ``deterministic``; on a sequence with several targets
         also ``mot_counts`` (:func:`scenegen.evaluation.mot.mot_counts`, floats rounded).
     """
+    return run_pair_tracks(task)[0]
+
+
+def run_pair_tracks(task: BenchTask) -> tuple[dict[str, Any], Any]:
+    """:func:`run_pair`, with the tracker's result (what ``--keep-tracks`` writes).
+
+    Parameters
+    ----------
+    task : BenchTask
+        The tracker, its parameters and the sequence (read lazily from its shard).
+
+    Returns
+    -------
+    record : dict
+        :func:`run_pair`'s record.
+    result : scenegen.io.TrackerResult or None
+        The tracker's boxes (``boxes``, ``target_ids``); None when no target is present at
+        frame 0 (the tracker is not run).
+    """
     from scenegen.evaluation import evaluate
     from scenegen.evaluation.mot import mot_counts
     from scenegen.io import read
@@ -232,7 +252,7 @@ def run_pair(task: BenchTask) -> dict[str, Any]:
         return _round({"key": task.key(), "tracker_seed": task.tracker_seed(), "targets": 0,
                        "n_frames": int(seq.n_frames), "scores": dict.fromkeys(METRICS),
                        "sequence_params": json.loads(task.sequence_params),
-                       "deterministic": True})  # fmt: skip
+                       "deterministic": True}), None  # fmt: skip
     done = run(seq, task.tracker, dict(task.params), task.tracker_seed(), single_thread=True)
     res = done.result
     report = evaluate(
@@ -274,7 +294,7 @@ def run_pair(task: BenchTask) -> dict[str, Any]:
             "deterministic": bool(getattr(done.tracker, "deterministic", True)),
             **counts,
         }
-    )
+    ), res
 
 
 def _accepted(tracker: str, params: dict[str, Any]) -> set[str]:
@@ -708,6 +728,7 @@ def run_benchmark(
     scheduler: str | None = None,
     progress: bool = False,
     on_done: Callable[[BenchTask], None] | None = None,
+    keep_tracks: bool = False,
 ) -> dict[str, Any]:
     """Run every tracker on every sequence of ``dataset`` (resumably) and write the report.
 
@@ -734,7 +755,14 @@ def run_benchmark(
     progress : bool, default False
         Show a tqdm bar on stderr.
     on_done : callable, optional
-        Called with each task whose record was just stored.
+        Called with each task whose record was just stored (or, run again for its tracks
+        only, whose tracker file was).
+    keep_tracks : bool, default False
+        Also write ``out/trackeval/``: the tracker outputs and the dataset's ground truth
+        as TrackEval reads them, listed under ``tracks`` in ``results.json``
+        (:mod:`scenegen.lab.benchmark_tracks`). A pair whose stored run has no sound
+        tracker file is run again; its record must come out the same. An ``out`` whose
+        ``results.json`` lists kept tracks keeps them up to date without it.
 
     Returns
     -------
@@ -749,13 +777,16 @@ def run_benchmark(
         holding a dataset (its ``manifest.json``), an experiment's results or a report of
         ``scenegen experiment all``, or that cannot be created.
     DataError
-        ``dataset`` is not a dataset folder, or a shard is damaged.
+        ``dataset`` is not a dataset folder, or a shard is damaged; with kept tracks, a
+        deterministic tracker run again for its tracks gave another record than the
+        stored one.
     """
     from tqdm import tqdm
 
     from scenegen.datasets.build import make_output_folder
     from scenegen.datasets.executor import check_executor, probe, run_tasks
     from scenegen.lab.benchmark_outputs import listed_digests, load_record
+    from scenegen.lab.experiments.outputs import warn
 
     check_executor(jobs, scheduler)
     root = Path(dataset)
@@ -777,32 +808,64 @@ def run_benchmark(
     make_output_folder(outp)
     meta = dataset_meta(man, root)
     listed = listed_digests(outp, meta)
+    from scenegen.lab import benchmark_tracks as bt
+
+    listed_t = bt.listed_tracks(outp, meta)
+    keep = keep_tracks or bool(listed_t)
+    names = bt.sequence_names((e["index"], e["name"]) for e in man["sequences"])
     records: dict[tuple[str, int], dict[str, Any]] = {}
     todo = []
     for t in tasks:
         rec = load_record(outp / t.filename(), t, listed.get(t.filename()))
         if rec is None:
             todo.append(t)
-        else:
-            records[(t.tracker, t.index)] = rec
+            continue
+        records[(t.tracker, t.index)] = rec
+        if keep and not (listed.get(t.filename(), ("",))[0] == content_digest(rec) and
+                         bt.sound_file(outp, bt.track_file(t.tracker, names[t.index]),
+                                       listed_t)):  # fmt: skip
+            todo.append(t)  # run again for its tracks only
     bar = tqdm(total=len(tasks), initial=len(records), disable=not progress, unit="run",
                desc="benchmark", leave=False)  # fmt: skip
 
-    def store(t: BenchTask, rec: dict[str, Any]) -> None:
-        write_sealed_json(outp / t.filename(), rec, parents=True)
-        records[(t.tracker, t.index)] = _content(rec)
-        bar.update(1)
+    def store(t: BenchTask, done: Any) -> None:
+        rec = done[0] if keep else done
+        old = records.get((t.tracker, t.index))
+        if keep:
+            if old is not None and old != _content(rec):
+                path = outp / t.filename()
+                if old["deterministic"]:
+                    raise DataError(f"{path}: running it again for its tracks gave another "
+                                    "record than the stored one (the tracker did not "
+                                    "reproduce its run); nothing was rewritten")  # fmt: skip
+                warn(f"{path}: running it again for its tracks gave another record (a "
+                     "tracker that is not deterministic); both are rewritten")  # fmt: skip
+                old = None
+            bt.write_tracks(outp / bt.track_file(t.tracker, names[t.index]), rec["n_frames"],
+                            done[1], done[2])  # fmt: skip
+        if old is None:
+            write_sealed_json(outp / t.filename(), rec, parents=True)
+            records[(t.tracker, t.index)] = _content(rec)
+            bar.update(1)
         if on_done is not None:
             on_done(t)
 
     try:
-        run_tasks(run_pair, todo, store, jobs=jobs, scheduler=scheduler,
+        run_tasks(bt.pair_with_tracks if keep else run_pair, todo, store, jobs=jobs,
+                  scheduler=scheduler,
                   key=lambda t: f"{_slug(t.tracker)}-{t.index}", name="scenegen-benchmark",
                   label=lambda t: f"running {t.tracker!r} on sequence {t.index} ({t.name})")
     finally:  # fmt: skip
         bar.close()
     ordered = [records[(t.tracker, t.index)] for t in tasks]
-    return write_outputs(outp, meta, list(trackers), ordered)
+    tracks = None
+    if keep:
+        multi = [t.index for t in tasks if t.tracker == tasks[0].tracker
+                 and records[(t.tracker, t.index)]["targets"] > 1]  # fmt: skip
+        sound = {n for n in listed_t if bt.sound_file(outp, n, listed_t)}
+        bt.write_gt(outp, root, man["sequences"], names, multi, sound)
+        tracks = [f"{n} {bt.file_digest(outp / n)}" for n in bt.kept_files(list(trackers), names)]
+    return write_outputs(outp, meta, list(trackers), ordered, tracks)
 
 
 def _content(rec: dict[str, Any]) -> dict[str, Any]:
@@ -983,7 +1046,8 @@ def texts(results: dict[str, Any]) -> dict[str, str]:
 
 
 def write_outputs(
-    out: Path, meta: dict[str, Any], trackers: list[str], records: list[dict[str, Any]]
+    out: Path, meta: dict[str, Any], trackers: list[str], records: list[dict[str, Any]],
+    tracks: list[str] | None = None,
 ) -> dict[str, Any]:
     """Write the figures, ``results.json`` (sealed), ``scores.csv``, ``leaderboard.md`` and
     ``index.html`` of ``records`` (see :func:`results_document`) into ``out``; return the
@@ -1001,6 +1065,9 @@ def write_outputs(
         In the order given on the command line.
     records : list of dict
         Every run record, trackers x sequences in task order.
+    tracks : list of str, optional
+        The kept tracks' listing (``"trackeval/... SHA256"`` per file,
+        :mod:`scenegen.lab.benchmark_tracks`), stored as ``tracks``; None: no such key.
 
     Returns
     -------
@@ -1009,7 +1076,8 @@ def write_outputs(
     """
     from scenegen.io import atomic_path
 
-    results = _content(results_document(meta, trackers, records))
+    doc = results_document(meta, trackers, records)
+    results = _content(doc if tracks is None else {**doc, "tracks": tracks})
     for name, _, curve in figure_list(results):
         _figure(curve, out / name)
     write_sealed_json(out / "results.json", results, indent=1)

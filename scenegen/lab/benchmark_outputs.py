@@ -21,6 +21,10 @@ every run file it was computed from with that file's digest, as an experiment's 
   ``results.json``; every figure it names is a PNG file. With ``deep``, every record's
   key is checked against the manifest of the dataset (found at the path ``results.json``
   names) and its run computed again from it and compared with the record.
+- With kept tracks (``--keep-tracks``), every file of ``OUT/trackeval/`` that
+  ``results.json`` lists under ``tracks`` is there with its digest, and no other tracker
+  file or sequence folder is (:func:`scenegen.lab.benchmark_tracks.check_tracks`); with
+  ``deep`` each tracker file is also compared with the boxes of its run computed again.
 """
 
 from __future__ import annotations
@@ -179,6 +183,8 @@ def _results_problem(data: dict[str, Any]) -> str | None:
         return "'trackers' is not a list of tracker names"
     if parse_listing(data["records"]) is None:
         return "'records' is not a listing of run files"
+    if "tracks" in data and parse_listing(data["tracks"]) is None:
+        return "'tracks' is not a listing of files"
     return None
 
 
@@ -343,6 +349,7 @@ def check_benchmark(folder: str | Path, *, deep: bool = False,
         Each line names the file at fault (at most a few per kind, then a count).
     """
     from scenegen.lab.benchmark import figure_list, results_document, texts
+    from scenegen.lab.benchmark_tracks import check_tracks
 
     root = Path(folder)
     res_path = root / RESULTS
@@ -372,6 +379,8 @@ def check_benchmark(folder: str | Path, *, deep: bool = False,
         return _more(problems)
     try:
         fresh = results_document(results["dataset"], results["trackers"], records)
+        if "tracks" in results:  # checked against the files by check_tracks
+            fresh["tracks"] = results["tracks"]
         fresh = json.loads(json.dumps(fresh, sort_keys=True))
     except Exception as err:  # noqa: BLE001 - sound digests, yet contents no summary expects
         return [f"{res_path}: its runs cannot be summarised ({type(err).__name__}: "
@@ -386,6 +395,7 @@ def check_benchmark(folder: str | Path, *, deep: bool = False,
     problems = _pair_problems(root, results, records)
     if problems:
         return _more(problems)
+    problems = check_tracks(root, results, records)
     for name, text in texts(results).items():
         path = root / name
         try:
@@ -468,8 +478,16 @@ def _check_deep(root: Path, results: dict[str, Any], records: list[dict[str, Any
     """Every record against the dataset ``results`` names: its key and sequence
     parameters those of the manifest's sequence (with the tracker's parameters), and its
     run computed again on that sequence."""
+    import tempfile
+
     from scenegen.datasets import read_manifest
     from scenegen.lab.benchmark import _tasks, run_pair
+    from scenegen.lab.benchmark_tracks import (
+        pair_with_tracks,
+        sequence_names,
+        track_file,
+        write_tracks,
+    )
 
     meta = results["dataset"]
     data = Path(str(meta["path"]))
@@ -508,7 +526,18 @@ def _check_deep(root: Path, results: dict[str, Any], records: list[dict[str, Any
         if not rec["deterministic"]:
             skipped.append(_run_file(rec["key"]))
             continue
-        again = json.loads(json.dumps(run_pair(task), sort_keys=True))
-        if again != rec:
+        if "tracks" not in results:
+            again = json.loads(json.dumps(run_pair(task), sort_keys=True))
+            if again != rec:
+                problems.append(f"{path}: differs from the run computed again")
+            continue
+        done = pair_with_tracks(task)
+        if json.loads(json.dumps(done[0], sort_keys=True)) != rec:
             problems.append(f"{path}: differs from the run computed again")
+        names = sequence_names((r["key"]["index"], r["key"]["name"]) for r in records)
+        kept = root / track_file(task.tracker, names[task.index])
+        with tempfile.TemporaryDirectory() as tmp:
+            write_tracks(Path(tmp) / "t.txt", rec["n_frames"], done[1], done[2])
+            if (Path(tmp) / "t.txt").read_bytes() != kept.read_bytes():
+                problems.append(f"{kept}: differs from the tracks of the run computed again")
     return problems

@@ -492,6 +492,15 @@ def test_a_sequence_with_no_target_at_frame_0_is_recorded_unscored(tmp_path, cap
     assert board["sequences"] == 3  # the scored ones
     assert main(["validate", str(tmp_path / "b"), "--deep"]) == 0
     assert "valid benchmark folder" in capsys.readouterr().out
+    # Kept tracks: an empty tracker file where the tracker did not run; only the sequence
+    # with two targets at frame 0 in the seqmap of the combined columns.
+    from scenegen.lab.benchmark_tracks import seqmap_file, track_file
+
+    run_benchmark(data, ["kalman"], tmp_path / "b", jobs=1, keep_tracks=True)
+    assert (tmp_path / "b" / track_file("kalman", "late-00003")).read_text() == ""
+    assert (tmp_path / "b" / track_file("kalman", "late-00001")).read_text() != ""
+    assert (tmp_path / "b" / seqmap_file("multi")).read_text() == "name\nlate-00000\n"
+    assert main(["validate", str(tmp_path / "b"), "--deep"]) == 0
 
 
 def _forged(reference, out, forge):
@@ -664,3 +673,211 @@ def test_pages_write_json_cells_and_escape_a_pipe_in_a_trackers_name(reference):
     table = [ln for ln in got["leaderboard.md"].splitlines() if ln.startswith("|")]
     assert "| my\\|t.py:make |" in table[2]
     assert len({ln.replace("\\|", "").count("|") for ln in table}) == 1  # one column count
+
+
+# --keep-tracks: the tracker outputs and the ground truth as TrackEval reads them.
+
+ORACLE = Path(__file__).resolve().parents[2] / "data" / "trackeval_benchmark"
+TOOL = Path(__file__).resolve().parents[3] / "tools" / "trackeval" / "make_benchmark_inputs.py"
+_REDO = "run the same `scenegen benchmark ... --keep-tracks` command again to rewrite it"
+
+
+@pytest.fixture(scope="module")
+def kept(dataset, tmp_path_factory):
+    out = tmp_path_factory.mktemp("bench") / "kept"
+    run_benchmark(dataset, TRACKERS, out, params=PARAMS, jobs=1, keep_tracks=True)
+    return out
+
+
+def _track(out, tracker, index):
+    from scenegen.lab.benchmark_tracks import track_file
+
+    return out / track_file(tracker, f"two-{index:05d}")
+
+
+def test_kept_tracks_are_the_boxes_each_run_produced(dataset, reference, kept):
+    """Each tracker file reads back as the boxes of its pair's run (ids sorted, 1-based
+    pixels undone); the records and pages are those of a benchmark without the option,
+    which writes no kept folder and no ``tracks`` key."""
+    import numpy as np
+
+    from scenegen.io.mot import read_mot_tracker
+    from scenegen.lab.benchmark import plan_benchmark, run_pair_tracks
+    from scenegen.lab.benchmark_outputs import check_benchmark
+
+    _, tasks = plan_benchmark(dataset, TRACKERS, PARAMS)
+    for task in tasks:
+        rec, res = run_pair_tracks(task)
+        ids, boxes = read_mot_tracker(_track(kept, task.tracker, task.index), rec["n_frames"])
+        order = np.argsort(res.target_ids)
+        assert ids.tolist() == sorted(res.target_ids.tolist()) and len(ids) == 2
+        np.testing.assert_allclose(boxes, res.boxes[:, order], rtol=0, atol=1e-9)
+    mine, theirs = files(kept), files(reference)
+    assert {n: b for n, b in mine.items() if not n.startswith("trackeval/")
+            and n != "results.json"} == {n: b for n, b in theirs.items()
+                                         if n != "results.json"}  # fmt: skip
+    res, ref = (json.loads((f / "results.json").read_text()) for f in (kept, reference))
+    assert set(res) - set(ref) == {"tracks"} and len(res["tracks"]) == 2 + 2 * 4 + 2 * 4
+    assert {k: v for k, v in res.items() if k not in ("tracks", "sha256")} == {
+        k: v for k, v in ref.items() if k != "sha256"}
+    assert not (reference / "trackeval").exists()
+    assert check_benchmark(kept) == []
+    gt = (kept / "trackeval/gt/mot_challenge/scenegen-all/two-00000/gt/gt.txt").read_text()
+    assert gt.splitlines()[0].endswith(",1,1,1.000000") and len(gt.splitlines()) == 10
+    seqmap = (kept / "trackeval/gt/mot_challenge/seqmaps/scenegen-all.txt").read_text()
+    assert seqmap == "name\n" + "".join(f"two-{i:05d}\n" for i in range(4))
+
+
+def test_resume_writes_the_missing_tracks_and_keeps_the_records(dataset, reference, kept,
+                                                                tmp_path):  # fmt: skip
+    """--keep-tracks on a folder made without it runs every pair again for its tracks, the
+    records staying byte for byte; a lost tracker file is run again, even without the
+    option (results.json lists kept tracks), and nothing else."""
+    out = tmp_path / "b"
+    shutil.copytree(reference, out)
+    before = files(out / "runs")
+    ran = []
+    run_benchmark(dataset, TRACKERS, out, params=PARAMS, jobs=1, keep_tracks=True,
+                  on_done=ran.append)  # fmt: skip
+    assert len(ran) == 8 and files(out / "runs") == before
+    assert files(out) == files(kept)
+    lost = _track(out, "annealed", 2)
+    lost.unlink()
+    ran.clear()
+    run_benchmark(dataset, TRACKERS, out, params=PARAMS, jobs=1, on_done=ran.append)
+    assert [(t.tracker, t.index) for t in ran] == [("annealed", 2)]
+    assert files(out) == files(kept)
+    ran.clear()
+    run_benchmark(dataset, TRACKERS, out, params=PARAMS, jobs=1, keep_tracks=True,
+                  on_done=ran.append)  # fmt: skip
+    assert ran == [] and files(out) == files(kept)
+
+
+def test_a_run_that_does_not_come_out_the_same_is_not_rewritten(dataset, reference, tmp_path,
+                                                                monkeypatch):  # fmt: skip
+    from scenegen.errors import DataError
+    from scenegen.lab import benchmark_tracks
+
+    real = benchmark_tracks.pair_with_tracks
+
+    def drifting(task):
+        rec, ids, boxes = real(task)
+        rec["scores"]["auc"] = 0.0
+        return rec, ids, boxes
+
+    out = tmp_path / "b"
+    shutil.copytree(reference, out)
+    monkeypatch.setattr(benchmark_tracks, "pair_with_tracks", drifting)
+    with pytest.raises(DataError, match="running it again for its tracks gave another record"):
+        run_benchmark(dataset, TRACKERS, out, params=PARAMS, jobs=1, keep_tracks=True)
+    assert files(out / "runs") == files(reference / "runs")
+
+
+def test_damaged_missing_or_extra_track_files_are_named(reference, kept, tmp_path, capsys):
+    from scenegen.cli import main
+    from scenegen.lab.benchmark_outputs import check_benchmark
+
+    out = tmp_path / "b"
+    shutil.copytree(kept, out)
+    f = _track(out, "sok", 1)
+    text = f.read_bytes()
+    f.write_bytes(text + b"1,9,1,1,2,2,1,-1,-1,-1\n")
+    want = f"{f}: is not the file results.json lists (damaged or edited: {_REDO})"
+    assert check_benchmark(out) == [want]
+    assert main(["validate", str(out)]) == 1
+    assert capsys.readouterr().err.strip() == want
+    f.unlink()
+    assert check_benchmark(out) == [f"{f}: missing ({_REDO})"]
+    f.write_bytes(text)
+    extra = f.parent / "two-00009.txt"
+    extra.write_text("")
+    other = out / "trackeval/trackers/mot_challenge/scenegen-all/other"
+    (other / "data").mkdir(parents=True)
+    assert check_benchmark(out) == [
+        f"{p}: a {what} the benchmark did not write (TrackEval would read it: remove it)"
+        for p, what in ((other, "folder"), (extra, "file"))]  # fmt: skip
+    extra.unlink()
+    shutil.rmtree(other)
+    # What TrackEval writes beside a tracker's data/ folder is allowed.
+    (f.parents[1] / "pedestrian_summary.txt").write_text("HOTA\n")
+    assert check_benchmark(out) == []
+    # Kept tracks that results.json does not list (an unfinished first run).
+    plain = tmp_path / "plain"
+    shutil.copytree(reference, plain)
+    shutil.copytree(out / "trackeval", plain / "trackeval")
+    assert check_benchmark(plain) == [
+        f"{plain / 'trackeval'}: kept tracks that results.json does not list (written by an "
+        f"unfinished run: {_REDO})"]  # fmt: skip
+
+
+def test_deep_compares_each_tracker_file_with_its_run_again(kept, tmp_path):
+    """A tracker file replaced and its digest listed again (results.json resealed) is
+    found only by the runs computed again."""
+    from scenegen.io.sealed import read_sealed_json, write_sealed_json
+    from scenegen.lab.benchmark_tracks import file_digest
+
+    out = tmp_path / "b"
+    shutil.copytree(kept, out)
+    f = _track(out, "sok", 3)
+    f.write_text(f.read_text().replace(",1,-1,-1,-1", ",1.0,-1,-1,-1", 1))
+    doc = read_sealed_json(out / "results.json")
+    name = f.relative_to(out).as_posix()
+    doc["tracks"] = [f"{name} {file_digest(f)}" if e.startswith(name + " ") else e
+                     for e in doc["tracks"]]  # fmt: skip
+    write_sealed_json(out / "results.json", doc, indent=1)
+    from scenegen.lab.benchmark_outputs import check_benchmark
+
+    assert check_benchmark(out) == []
+    assert check_benchmark(out, deep=True) == [
+        f"{f}: differs from the tracks of the run computed again"]
+
+
+def _oracle_diffs(summary, case):
+    """|ours - TrackEval's| of every combined column (the multi-target seqmap) and every
+    multi-target run's MOTA, IDF1 and HOTA."""
+    te = {"mota": "MOTA", "idf1": "IDF1", "hota": "HOTA"}
+    out = []
+    for tracker, cols in summary["combined"].items():
+        for m, name in te.items():
+            out.append(abs(cols[f"{m}_combined"] - case["combined_multi"][tracker][name]))
+    for row in summary["scores"]:
+        if row["targets"] > 1:
+            seq = case["sequences"][row["tracker"]][row["name"]]
+            out += [abs(row[m] - seq[name]) for m, name in te.items()]
+    return out
+
+
+def test_kept_tracks_score_as_trackeval_does(kept, tool, tmp_path):
+    """TrackEval (tools/trackeval/score_benchmark.py, run on the committed kept folders)
+    gives the leaderboard's combined columns and every multi-target run's scores, to
+    their rounding: on this module's benchmark and a mixed one (one single-target
+    sequence, left out of the combined columns) regenerated here, and on the committed
+    output of a built-in family (seven targets)."""
+    from scenegen.lab.benchmark_tracks import file_digest
+
+    oracle = json.loads((ORACLE / "oracle.json").read_text())["cases"]
+    assert tool.CASES["two"] == {"family": FAMILY, "trackers": TRACKERS, "params": PARAMS}
+    diffs = []
+    for name, folder in (("two", kept), ("mixed", tmp_path / "benchmark")):
+        if name == "mixed":
+            tool.run_case(name, tmp_path)
+        assert files(folder / "trackeval") == files(ORACLE / name / "trackeval")
+        summary = tool.summary(json.loads((folder / "results.json").read_text()))
+        assert summary == json.loads((ORACLE / name / "benchmark.json").read_text())
+        diffs += _oracle_diffs(summary, oracle[name])
+    mixed = json.loads((ORACLE / "mixed" / "benchmark.json").read_text())
+    assert sorted({r["targets"] for r in mixed["scores"]}) == [1, 2]
+    committed = json.loads((ORACLE / "dps-synthetic" / "benchmark.json").read_text())
+    for entry in committed["tracks"]:
+        rel, digest = entry.split(" ")
+        assert file_digest(ORACLE / "dps-synthetic" / rel) == digest
+    diffs += _oracle_diffs(committed, oracle["dps-synthetic"])
+    assert len(diffs) == 30 + 12 + 24 and max(diffs) <= 5.1e-7
+
+
+def test_the_committed_built_in_benchmark_is_the_benchmarks_output(tool, tmp_path):
+    """The committed dps-synthetic case (scored by TrackEval) is what the benchmark writes."""
+    results = tool.run_case("dps-synthetic", tmp_path)
+    case = ORACLE / "dps-synthetic"
+    assert files(tmp_path / "benchmark" / "trackeval") == files(case / "trackeval")
+    assert tool.summary(results) == json.loads((case / "benchmark.json").read_text())
