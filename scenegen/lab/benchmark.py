@@ -864,7 +864,11 @@ def run_benchmark(
                  and records[(t.tracker, t.index)]["targets"] > 1]  # fmt: skip
         sound = {n for n in listed_t if bt.sound_file(outp, n, listed_t)}
         bt.write_gt(outp, root, man["sequences"], names, multi, sound)
-        tracks = [f"{n} {bt.file_digest(outp / n)}" for n in bt.kept_files(list(trackers), names)]
+        kept = bt.kept_files(list(trackers), names)
+        for gone in bt.remove_unlisted(outp, set(kept)):
+            warn(f"{gone}: removed from the kept tracks (not a tracker or sequence of this "
+                 "benchmark; TrackEval would read it)")  # fmt: skip
+        tracks = [f"{n} {bt.file_digest(outp / n)}" for n in kept]
     return write_outputs(outp, meta, list(trackers), ordered, tracks)
 
 

@@ -50,11 +50,13 @@ __all__ = [
     "kept_files",
     "listed_tracks",
     "pair_with_tracks",
+    "remove_unlisted",
     "seqmap_file",
     "seqmap_text",
     "sound_file",
     "sequence_names",
     "track_file",
+    "unlisted",
     "write_gt",
     "write_tracks",
 ]
@@ -362,7 +364,33 @@ def check_tracks(root: Path, results: dict[str, Any], records: list[dict[str, An
 
 
 def _extra_files(root: Path, want: set[str]) -> list[str]:
-    """Folders and files of the kept folder TrackEval would read that are not listed."""
+    """One line per folder or file of the kept folder TrackEval would read that is not
+    listed."""
+    out = []
+    for p in unlisted(root, want):
+        what = "folder" if p.is_dir() else "file"
+        out.append(f"{p}: a {what} the benchmark did not write (TrackEval would read it: "
+                   "remove it)")  # fmt: skip
+    return out
+
+
+def unlisted(root: Path, want: set[str]) -> list[Path]:
+    """The folders and files of the kept folder that TrackEval would read and that are not
+    among ``want``: tracker folders and their files, sequence folders and their ``gt/``
+    files, and seqmaps (temporary files of an interrupted write are not counted).
+
+    Parameters
+    ----------
+    root : pathlib.Path
+        The benchmark's output folder.
+    want : set of str
+        The kept files (:func:`kept_files`), relative to ``root``.
+
+    Returns
+    -------
+    list of pathlib.Path
+        Each folder before the files in it, in sorted order.
+    """
     from scenegen.io.atomic import describe_temp_file
 
     def rel(p: Path) -> str:
@@ -370,7 +398,7 @@ def _extra_files(root: Path, want: set[str]) -> list[str]:
 
     dirs = {str(Path(w).parent) for w in want} | {
         str(p) for w in want for p in Path(w).parents}  # fmt: skip
-    out = []
+    out: list[Path] = []
     seqmaps = root / Path(seqmap_file()).parent
     gts = root / _GT / f"{BENCHMARK}-{SPLIT}"
     trackers = root / _TRACKERS
@@ -384,10 +412,39 @@ def _extra_files(root: Path, want: set[str]) -> list[str]:
         r = rel(p)
         if r in want or r in dirs or describe_temp_file(p) is not None:
             continue
-        what = "folder" if p.is_dir() else "file"
-        out.append(f"{p}: a {what} the benchmark did not write (TrackEval would read it: "
-                   "remove it)")  # fmt: skip
+        out.append(p)
     return out
+
+
+def remove_unlisted(root: Path, want: set[str]) -> list[Path]:
+    """Remove what :func:`unlisted` finds (a tracker the benchmark no longer runs, a
+    sequence of an earlier dataset), so that the kept folder holds only what
+    ``results.json`` lists; return what was removed (folders, then loose files).
+
+    Parameters
+    ----------
+    root : pathlib.Path
+        The benchmark's output folder.
+    want : set of str
+        The kept files (:func:`kept_files`), relative to ``root``.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The folders and files removed (a folder's files are not listed apart).
+    """
+    import shutil
+
+    removed: list[Path] = []
+    for p in unlisted(root, want):
+        if any(d in p.parents for d in removed):
+            continue
+        if p.is_dir() and not p.is_symlink():
+            shutil.rmtree(p)
+        else:
+            p.unlink(missing_ok=True)
+        removed.append(p)
+    return removed
 
 
 def listed_tracks(out: Path, meta: dict[str, Any]) -> dict[str, str]:

@@ -753,6 +753,36 @@ def test_resume_writes_the_missing_tracks_and_keeps_the_records(dataset, referen
     assert ran == [] and files(out) == files(kept)
 
 
+def test_a_tracker_dropped_from_a_benchmark_leaves_its_kept_tracks(dataset, kept, tmp_path,
+                                                                  capsys):  # fmt: skip
+    """The same OUT run again with fewer trackers stays a valid folder: the dropped
+    tracker's run records stay (as without kept tracks), its TrackEval folder and stray
+    files TrackEval would read are removed, one warning each, and nothing else changes."""
+    from scenegen.lab.benchmark_outputs import check_benchmark
+
+    out = tmp_path / "b"
+    shutil.copytree(kept, out)
+    stray = _track(out, "annealed", 9)
+    stray.write_text("")
+    summary = _track(out, "annealed", 0).parents[1] / "pedestrian_summary.txt"
+    summary.write_text("HOTA\n")
+    before = files(out)
+    capsys.readouterr()
+    ran = []
+    run_benchmark(dataset, ["annealed"], out, params=PARAMS, jobs=1, on_done=ran.append)
+    assert ran == [] and check_benchmark(out) == []
+    dropped = _track(out, "sok", 0).parents[1]
+    assert not dropped.exists() and not stray.exists() and summary.exists()
+    assert capsys.readouterr().err.splitlines() == [
+        f"scenegen: warning: {p}: removed from the kept tracks (not a tracker or sequence "
+        "of this benchmark; TrackEval would read it)" for p in (dropped, stray)]  # fmt: skip
+    after = files(out)
+    assert {k for k in before if k not in after} == {
+        k for k in before if k.startswith(("trackeval/trackers/mot_challenge/scenegen-all/"
+                                           "sok/", stray.relative_to(out).as_posix()))}
+    assert all(after[k] == before[k] for k in after if k.startswith(("runs/", "trackeval/")))
+
+
 def test_a_run_that_does_not_come_out_the_same_is_not_rewritten(dataset, reference, tmp_path,
                                                                 monkeypatch):  # fmt: skip
     from scenegen.errors import DataError
