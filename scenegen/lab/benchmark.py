@@ -761,8 +761,9 @@ def run_benchmark(
         Also write ``out/trackeval/``: the tracker outputs and the dataset's ground truth
         as TrackEval reads them, listed under ``tracks`` in ``results.json``
         (:mod:`scenegen.lab.benchmark_tracks`). A pair whose stored run has no sound
-        tracker file is run again; its record must come out the same. An ``out`` whose
-        ``results.json`` lists kept tracks keeps them up to date without it.
+        tracker file is run again; its record must come out the same. An ``out`` that
+        holds kept tracks (``results.json`` lists them, or ``out/trackeval/`` is there) keeps
+        them up to date without it.
 
     Returns
     -------
@@ -811,7 +812,7 @@ def run_benchmark(
     from scenegen.lab import benchmark_tracks as bt
 
     listed_t = bt.listed_tracks(outp, meta)
-    keep = keep_tracks or bool(listed_t)
+    keep = keep_tracks or bool(listed_t) or (outp / bt.FOLDER).is_dir()
     names = bt.sequence_names((e["index"], e["name"]) for e in man["sequences"])
     records: dict[tuple[str, int], dict[str, Any]] = {}
     todo = []

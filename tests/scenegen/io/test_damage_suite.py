@@ -357,39 +357,57 @@ BENCH_FAMILY = {"name": "small", "base": SCENE, "sweep": {"clutter[0].count": [0
 BENCH_TRACKERS = ["--tracker", "meanshift", "--tracker", "sok", "--jobs", "1"]
 
 
+def _benchmark_folder(base, extra: list[str]):
+    """A small benchmark folder made with the options ``extra``: its dataset, the folder,
+    its content, its results.json and its layout (with kept tracks, their files are text
+    files of the layout)."""
+    from scenegen.cli import main
+    from scenegen.datasets import build_dataset
+
+    build_dataset(BENCH_FAMILY, base / "data", jobs=1)
+    d = base / "bench"
+    assert main(["benchmark", str(base / "data"), *BENCH_TRACKERS, "-o", str(d), *extra]) == 0
+    assert main(["validate", str(d)]) == 0
+    kept = sorted(p.relative_to(d).as_posix() for p in (d / "trackeval").rglob("*")
+                  if p.is_file())  # fmt: skip
+    layout = (BENCHMARK_FILES[0], (*BENCHMARK_FILES[1], *kept))
+    return (base / "data", d, folder_content(str(d), layout),
+            (d / "results.json").read_bytes(), layout)  # fmt: skip
+
+
 @pytest.fixture(scope="module")
 def benchmark(tmp_path_factory):
     """A small benchmark folder (4 sealed runs, results.json, three pages), its dataset
     and its content."""
-    from scenegen.cli import main
-    from scenegen.datasets import build_dataset
-
-    base = tmp_path_factory.mktemp("benchmark")
-    build_dataset(BENCH_FAMILY, base / "data", jobs=1)
-    d = base / "bench"
-    assert main(["benchmark", str(base / "data"), *BENCH_TRACKERS, "-o", str(d)]) == 0
-    assert main(["validate", str(d)]) == 0
-    return (base / "data", d, folder_content(str(d), BENCHMARK_FILES),
-            (d / "results.json").read_bytes())  # fmt: skip
+    return _benchmark_folder(tmp_path_factory.mktemp("benchmark"), [])
 
 
-def judge_benchmark(tally, v, dst, results, original, original_results):
+@pytest.fixture(scope="module")
+def kept_benchmark(tmp_path_factory):
+    """The same benchmark made with ``--keep-tracks`` (11 more files under trackeval/)."""
+    return _benchmark_folder(tmp_path_factory.mktemp("kept"), ["--keep-tracks"])
+
+
+def judge_benchmark(tally, v, dst, results, original, original_results,
+                    layout=BENCHMARK_FILES):  # fmt: skip
     """Classify one benchmark-folder variant's outcome into ``tally``: validate reports it
     (or it changed nothing readable); a resumed benchmark exits 0, warns in one line for a
-    damaged run record and ends with the original ``results.json``."""
+    damaged run record and ends with the original ``results.json`` (and, with kept tracks,
+    the original kept files)."""
     (vcode, _), *others = results
-    if not judge_validate(tally, v, str(dst), results[0], original, BENCHMARK_FILES):
+    if not judge_validate(tally, v, str(dst), results[0], original, layout):
         return
     for code, err in others:
         lines = [ln for ln in err.splitlines() if not ln.startswith("benchmark: ")]
-        wrong = code != 0 or "Traceback" in err or len(lines) > 1
+        wrong = (code != 0 or "Traceback" in err or len(lines) > 1
+                 or folder_content(str(dst), layout) != original)  # fmt: skip
         judge_resume(tally, v, dst, vcode, (code, err), lines, wrong, original_results)
 
 
 def _bench_variants(benchmark, tmp_path, n: int, seed: int, run) -> Tally:
-    data, src, original, original_results = benchmark
+    data, src, original, original_results, layout = benchmark
     tally = Tally()
-    for i, v in enumerate(folder_variants(src, n, seed=seed, layout=BENCHMARK_FILES)):
+    for i, v in enumerate(folder_variants(src, n, seed=seed, layout=layout)):
         dst = tmp_path / f"b{i}"
         shutil.rmtree(dst, ignore_errors=True)
         v.apply(dst)
@@ -398,7 +416,7 @@ def _bench_variants(benchmark, tmp_path, n: int, seed: int, run) -> Tally:
             argvs.append(["benchmark", str(data), *BENCH_TRACKERS, "-o", str(dst)])
         results = run(argvs, v, dst)
         if results is not None:
-            judge_benchmark(tally, v, dst, results, original, original_results)
+            judge_benchmark(tally, v, dst, results, original, original_results, layout)
     return tally
 
 
@@ -410,6 +428,21 @@ def test_fast_damaged_benchmark_outputs(benchmark, tmp_path):
                                          "change)")) == 26  # fmt: skip
     assert tally.counts["reported by validate"] >= 22
     assert tally.counts["resumed: damaged runs recomputed, same results.json"] == 13
+
+
+def test_fast_damaged_kept_tracks(kept_benchmark, tmp_path):
+    """26 variants of a benchmark folder with kept tracks (a byte-damaged or deleted file
+    may be a tracker file, a gt.txt, a seqinfo.ini or a seqmap): validate reports each, and
+    the same command without --keep-tracks repairs it, results.json and every kept file
+    as before, even when results.json itself was the damaged file."""
+    tally = _bench_variants(kept_benchmark, tmp_path, 26, 13,
+                            lambda a, v, d: run_case(a, 3.0))  # fmt: skip
+    assert tally.failures == []
+    assert tally.counts["reported by validate"] + tally.counts[
+        "harmless (no readable change)"] == 26  # fmt: skip
+    assert tally.counts["reported by validate"] >= 22
+    assert tally.counts["resumed: damaged runs recomputed, same results.json"] == 13
+    assert sum(tally.by_kind[k] for k in tally.by_kind if not k.endswith("(harmless)")) >= 22
 
 
 @pytest.mark.slow

@@ -783,6 +783,21 @@ def test_a_tracker_dropped_from_a_benchmark_leaves_its_kept_tracks(dataset, kept
     assert all(after[k] == before[k] for k in after if k.startswith(("runs/", "trackeval/")))
 
 
+def test_a_damaged_results_json_does_not_drop_the_kept_tracks(dataset, kept, tmp_path):
+    """results.json (the listing of the kept files) truncated: the command run again
+    without --keep-tracks still keeps the tracks (OUT/trackeval/ is there), so the folder
+    comes back as it was and valid, not with tracks its results.json does not list."""
+    from scenegen.lab.benchmark_outputs import check_benchmark
+
+    out = tmp_path / "b"
+    shutil.copytree(kept, out)
+    res = out / "results.json"
+    res.write_bytes(res.read_bytes()[:100])
+    assert check_benchmark(out) != []
+    run_benchmark(dataset, TRACKERS, out, params=PARAMS, jobs=1)
+    assert check_benchmark(out) == [] and files(out) == files(kept)
+
+
 def test_a_run_that_does_not_come_out_the_same_is_not_rewritten(dataset, reference, tmp_path,
                                                                 monkeypatch):  # fmt: skip
     from scenegen.errors import DataError
