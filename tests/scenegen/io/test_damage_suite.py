@@ -446,10 +446,12 @@ def test_fast_damaged_kept_tracks(kept_benchmark, tmp_path):
 
 
 @pytest.mark.slow
-def test_slow_damaged_benchmark_outputs(benchmark, tmp_path, capsys):
-    """260 variants of a benchmark folder (13 kinds x 20), each in a guarded child with a
-    120 s deadline: validate reports each, a resumed benchmark repairs it; no hang, no
-    traceback, no wrong "valid"."""
+@pytest.mark.parametrize("folder", ["benchmark", "kept_benchmark"])
+def test_slow_damaged_benchmark_outputs(folder, request, tmp_path, capsys):
+    """260 variants of a benchmark folder (13 kinds x 20), and of the same folder with kept
+    tracks, each in a guarded child with a 120 s deadline: validate reports each, a
+    resumed benchmark repairs it; no hang, no traceback, no wrong "valid"."""
+    benchmark = request.getfixturevalue(folder)
     n = int(os.environ.get("SCENEGEN_FOLDER_DAMAGE", "260"))
     hung: list[str] = []
 
@@ -462,5 +464,5 @@ def test_slow_damaged_benchmark_outputs(benchmark, tmp_path, capsys):
 
     tally = _bench_variants(benchmark, tmp_path, n, 2027, run)
     with capsys.disabled():
-        print_folder_tally("benchmark", n, tally, hung)
+        print_folder_tally(folder.replace("_", " "), n, tally, hung)
     assert hung == [] and tally.failures == []
