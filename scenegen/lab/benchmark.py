@@ -814,6 +814,10 @@ def run_benchmark(
     listed_t = bt.listed_tracks(outp, meta)
     keep = keep_tracks or bool(listed_t) or (outp / bt.FOLDER).is_dir()
     names = bt.sequence_names((e["index"], e["name"]) for e in man["sequences"])
+    if keep:
+        for link in bt.prepare_folder(outp, bt.kept_files(list(trackers), names)):
+            warn(f"{link}: a link removed from the kept tracks (the benchmark writes its "
+                 "own files there, not through links)")  # fmt: skip
     records: dict[tuple[str, int], dict[str, Any]] = {}
     todo = []
     for t in tasks:

@@ -50,6 +50,7 @@ __all__ = [
     "kept_files",
     "listed_tracks",
     "pair_with_tracks",
+    "prepare_folder",
     "remove_unlisted",
     "seqmap_file",
     "seqmap_text",
@@ -353,14 +354,79 @@ def check_tracks(root: Path, results: dict[str, Any], records: list[dict[str, An
         if not problems:
             problems.append(f"{root / 'results.json'}: tracks lists the files out of order")
         return problems
+    blocked: set[Path] = set()
     for name, digest in listed:
         path = root / name
-        if not path.is_file():
+        up = _file_in_the_way(root, name)
+        if up is not None:
+            if up not in blocked:
+                blocked.add(up)
+                problems.append(f"{up}: a file where the kept tracks have a folder (remove "
+                                f"it, then {rerun})")  # fmt: skip
+        elif path.is_dir():
+            problems.append(f"{path}: a folder where the kept tracks have a file (remove it, "
+                            f"then {rerun})")  # fmt: skip
+        elif not path.is_file():
             problems.append(f"{path}: missing ({rerun})")
         elif file_digest(path) != digest:
             problems.append(f"{path}: is not the file results.json lists (damaged or edited: "
                             f"{rerun})")  # fmt: skip
     return problems + _extra_files(root, set(want))
+
+
+def _file_in_the_way(root: Path, name: str) -> Path | None:
+    """The first folder of the kept file ``name`` (from ``trackeval/`` down) that is there
+    as something else than a folder, or None."""
+    for part in reversed(Path(name).parents[:-1]):
+        p = root / part
+        if p.exists() and not p.is_dir():
+            return p
+    return None
+
+
+def prepare_folder(root: Path, want: list[str]) -> list[Path]:
+    """Make the kept folder ready to be written: remove the symbolic links in it (a link
+    would have the benchmark write one tracker's boxes through it, into another file), and
+    refuse a file where a kept file needs a folder, or a folder where it needs a file.
+
+    Parameters
+    ----------
+    root : pathlib.Path
+        The benchmark's output folder.
+    want : list of str
+        The kept files (:func:`kept_files`), relative to ``root``.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The links removed.
+
+    Raises
+    ------
+    scenegen.errors.ConfigError
+        ``"PATH: is a file, not a folder"`` or ``"PATH: is a folder, expected a file
+        name"``, before anything is written.
+    """
+    import os
+
+    from scenegen.errors import ConfigError
+
+    removed = []
+    kept = root / FOLDER
+    if kept.is_dir():
+        for folder, dirs, files in os.walk(kept):
+            for n in sorted(dirs + files):
+                p = Path(folder) / n
+                if p.is_symlink():
+                    p.unlink()
+                    removed.append(p)
+    for name in want:
+        up = _file_in_the_way(root, name)
+        if up is not None:
+            raise ConfigError(f"{up}: is a file, not a folder")
+        if (root / name).is_dir():
+            raise ConfigError(f"{root / name}: is a folder, expected a file name")
+    return removed
 
 
 def _extra_files(root: Path, want: set[str]) -> list[str]:
@@ -407,7 +473,8 @@ def unlisted(root: Path, want: set[str]) -> list[Path]:
         if folder.is_dir():
             candidates += sorted(folder.iterdir())
     for folder in sorted(trackers.glob("*/data")) + sorted(gts.glob("*/gt")):
-        candidates += sorted(folder.iterdir())
+        if folder.is_dir():
+            candidates += sorted(folder.iterdir())
     for p in candidates:
         r = rel(p)
         if r in want or r in dirs or describe_temp_file(p) is not None:

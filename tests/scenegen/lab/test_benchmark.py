@@ -855,6 +855,74 @@ def test_damaged_missing_or_extra_track_files_are_named(reference, kept, tmp_pat
         f"unfinished run: {_REDO})"]  # fmt: skip
 
 
+def test_a_file_or_folder_in_the_way_of_a_kept_file_is_one_line(dataset, kept, tmp_path,
+                                                              capsys):  # fmt: skip
+    """A file where the kept folders hold a folder (a tracker's data/, trackeval/gt/), or
+    a folder where they hold a file: validate names it in one line (it crashed on the
+    file), and the command run again refuses in one line naming it (it crashed on
+    mkdir); once it is removed, the command restores the folder."""
+    from scenegen.cli import main
+    from scenegen.errors import ConfigError
+    from scenegen.lab.benchmark_outputs import check_benchmark
+
+    out = tmp_path / "b"
+    shutil.copytree(kept, out)
+    data = _track(out, "sok", 0).parent
+    shutil.rmtree(data)
+    data.write_text("")
+    want = (f"{data}: a file where the kept tracks have a folder (remove it, then {_REDO})")
+    assert check_benchmark(out) == [want]
+    assert main(["validate", str(out)]) == 1
+    assert capsys.readouterr().err.strip() == want
+    with pytest.raises(ConfigError, match=f"^{data}: is a file, not a folder"):
+        run_benchmark(dataset, TRACKERS, out, params=PARAMS, jobs=1)
+    data.unlink()
+    shutil.copytree(_track(kept, "sok", 0).parent, data)
+    gt = out / "trackeval" / "gt"
+    shutil.rmtree(gt)
+    gt.write_text("")
+    with pytest.raises(ConfigError, match=f"^{gt}: is a file, not a folder"):
+        run_benchmark(dataset, TRACKERS, out, params=PARAMS, jobs=1)
+    gt.unlink()
+    shutil.copytree(kept / "trackeval" / "gt", gt)
+    f = _track(out, "annealed", 1)
+    f.unlink()
+    f.mkdir()
+    want = f"{f}: a folder where the kept tracks have a file (remove it, then {_REDO})"
+    assert check_benchmark(out) == [want]
+    with pytest.raises(ConfigError, match=f"^{f}: is a folder, expected a file name"):
+        run_benchmark(dataset, TRACKERS, out, params=PARAMS, jobs=1)
+    f.rmdir()
+    run_benchmark(dataset, TRACKERS, out, params=PARAMS, jobs=1)
+    assert check_benchmark(out) == [] and files(out) == files(kept)
+
+
+def test_a_kept_file_made_a_link_is_not_written_through(dataset, kept, tmp_path, capsys):
+    """A tracker file replaced by a link to another tracker's file (or a tracker's folder
+    by a link to another's): the command run again writes the file in place of the link;
+    it wrote through it, so the other tracker's file took these boxes and the folder was
+    valid with one tracker's boxes under the other's name."""
+    from scenegen.lab.benchmark_outputs import check_benchmark
+
+    out = tmp_path / "b"
+    shutil.copytree(kept, out)
+    f, other = _track(out, "annealed", 1), _track(out, "sok", 1)
+    f.unlink()
+    f.symlink_to(other)
+    run_benchmark(dataset, TRACKERS, out, params=PARAMS, jobs=1)
+    assert not f.is_symlink()
+    assert capsys.readouterr().err.splitlines() == [
+        f"scenegen: warning: {f}: a link removed from the kept tracks (the benchmark writes "
+        "its own files there, not through links)"]  # fmt: skip
+    assert check_benchmark(out) == [] and files(out) == files(kept)
+    folder, sok = f.parents[1], other.parents[1]
+    shutil.rmtree(folder)
+    folder.symlink_to(sok, target_is_directory=True)
+    run_benchmark(dataset, TRACKERS, out, params=PARAMS, jobs=1)
+    assert not folder.is_symlink()
+    assert check_benchmark(out) == [] and files(out) == files(kept)
+
+
 def test_deep_compares_each_tracker_file_with_its_run_again(kept, tmp_path):
     """A tracker file replaced and its digest listed again (results.json resealed) is
     found only by the runs computed again."""
