@@ -33,7 +33,8 @@ bench: $(STAMP)
 # MODULES: a subset (resampling particle stages sampling meanshift ms-trackers sok hybrid
 # annealed shm kalman metrics mot mot-io stats runner summary motion compose ground-truth
 # quantize profiles direct integral histogram);
-# SAMPLE: mutants per module (0: all). Results in build/mutate/<module>.txt.
+# SAMPLE: mutants per module (0: all). Results in build/mutate/<module>.txt. Some
+# functions of one module only: tools/mutation/mutate.py MODULE --only FUNCTION ...
 MODULES ?=
 SAMPLE ?= 60
 mutate: $(STAMP)

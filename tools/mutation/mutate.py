@@ -2,7 +2,8 @@
 
 Usage::
 
-    python tools/mutation/mutate.py [MODULE ...] [--count] [--report]
+    python tools/mutation/mutate.py [MODULE ...] [--count] [--report] [--retest]
+        [--sample N] [--only ITEM ...]
 
 MODULE is a key of ``MODULES`` (default: all, one after another). For each module:
 
@@ -16,12 +17,18 @@ MODULE is a key of ``MODULES`` (default: all, one after another). For each modul
    a * b -> a / b, a < b -> a <= b, ...; as mutmut does, instead of cosmic-ray's every
    operator for every operator);
 3. at most ``--sample`` of them (default 25, a seeded choice that depends only on the
-   source) are run, to keep a module's run within minutes; ``--sample 0`` runs all;
+   source) are run, to keep a module's run within minutes; ``--sample 0`` runs all.
+   ``--only`` (one module) narrows the choice to some functions of the scope and line
+   ranges of the file, e.g. the functions added since the module's last full run;
 4. the module's test command (the fast tests that guard it, selected by path) must pass
    on the unmutated copy; then ``cosmic-ray exec`` runs it once per mutant, stopping at
    the first failure (``-x``); a mutant is killed if a test fails or times out;
 5. the score and the surviving mutants (with their diffs) are written to
-   ``build/mutate/<module>.txt`` and printed.
+   ``build/mutate/<module>.txt`` and printed. A surviving mutant listed in
+   ``equivalent.py`` is reported as equivalent: an entry names its line by text, and
+   when that line occurs more than once in the scope, by its function too (and the line
+   above it, if the function holds it twice); the module is refused otherwise
+   (``ambiguities``), so that an entry never excuses a copy it was not meant for.
 
 cosmic-ray rather than mutmut: mutmut 3 does not mutate decorated functions (its
 trampolines cannot wrap them), so every ``@njit`` kernel of the mean shift would be left
@@ -31,8 +38,10 @@ NUMBA_DISABLE_JIT is not needed: recompiling the mean-shift kernels costs about 
 mutant, less than running its tests in the interpreter).
 
 A session database per module (``build/mutate/<module>.sqlite``) keeps the results:
-running again resumes with the mutants not yet run. ``--count`` only initialises and
-prints how many mutants would run; ``--report`` only prints the stored results.
+running again resumes with the mutants not yet run (a wider ``--sample`` or ``--only``
+adds the mutants it newly selects). ``--count`` only initialises and prints how many
+mutants would run; ``--report`` only prints the stored results; ``--retest`` runs the
+survivors again.
 """
 
 from __future__ import annotations
@@ -372,25 +381,53 @@ def canonical(operator: str) -> bool:
     return CANONICAL.get(family, {}).get(source) == target
 
 
-def scope_lines(path: Path, names: tuple[str, ...]) -> list[tuple[int, int]]:
-    """Line spans (first, last) of the named functions and methods in ``path``."""
+def scope_spans(path: Path, names: tuple[str, ...]) -> dict[str, tuple[int, int]]:
+    """Line span (first, last) of each named function and method in ``path``."""
     tree = ast.parse(path.read_text())
-    spans, found = [], set()
+    spans = {}
 
     def visit(node, prefix):
         for child in ast.iter_child_nodes(node):
             if isinstance(child, (ast.FunctionDef, ast.ClassDef)):
                 qual = f"{prefix}{child.name}"
                 if isinstance(child, ast.FunctionDef) and qual in names:
-                    spans.append((child.lineno, child.end_lineno))
-                    found.add(qual)
+                    spans[qual] = (child.lineno, child.end_lineno)
                 visit(child, f"{qual}.")
 
     visit(tree, "")
-    missing = set(names) - found
+    missing = set(names) - set(spans)
     if missing:
         raise SystemExit(f"{path}: scope names not found: {sorted(missing)}")
     return spans
+
+
+def scope_lines(path: Path, names: tuple[str, ...]) -> list[tuple[int, int]]:
+    """Line spans (first, last) of the named functions and methods in ``path``."""
+    return list(scope_spans(path, names).values())
+
+
+@dataclass(frozen=True)
+class Site:
+    """A line of a module's formula scope, as an equivalent mutant's entry names it."""
+    function: str                   # the innermost function of the scope holding it
+    text: str                       # the line, stripped
+    before: str                     # the nearest non-blank line above it, stripped
+
+
+def scope_sites(path: Path, names: tuple[str, ...]) -> dict[int, Site]:
+    """Every line (by number) of the named functions and methods in ``path``."""
+    owner: dict[int, str] = {}
+    # Outer functions first, so that a nested function of the scope owns its lines.
+    for qual, (a, b) in sorted(scope_spans(path, names).items(),
+                               key=lambda item: item[1][0] - item[1][1]):
+        owner.update(dict.fromkeys(range(a, b + 1), qual))
+    sites, before = {}, ""
+    for row, line in enumerate(path.read_text().splitlines(), start=1):
+        if row in owner:
+            sites[row] = Site(owner[row], line.strip(), before)
+        if line.strip():
+            before = line.strip()
+    return sites
 
 
 def make_tree() -> None:
@@ -435,14 +472,48 @@ def cosmic(*args: str) -> None:
                    env={**os.environ, "PYTHONDONTWRITEBYTECODE": "1"})
 
 
-def filter_session(session: Path, mod: Module, sample: int) -> int:
+def only_spans(path: Path, mod: Module, only: tuple[str, ...]) -> list[tuple[int, int]]:
+    """The line spans ``--only`` selects: functions of the module's scope (qualified names)
+    and line ranges of its file (``FIRST-LAST`` or ``LINE``)."""
+    spans = []
+    for item in only:
+        m = re.fullmatch(r"(\d+)(?:-(\d+))?", item)
+        if m:
+            spans.append((int(m[1]), int(m[2] or m[1])))
+        elif item in mod.scope:
+            spans += scope_lines(path, (item,))
+        else:
+            raise SystemExit(f"--only {item!r}: neither a line range nor a function of the "
+                             f"scope ({', '.join(mod.scope)})")
+    return spans
+
+
+def _in_spans(row: int, spans: list[tuple[int, int]]) -> bool:
+    return any(a <= row <= b for a, b in spans)
+
+
+def filter_session(session: Path, mod: Module, sample: int,
+                   only: tuple[str, ...] = ()) -> int:
     """Skip the mutations outside the scope and the non-canonical ones, and all but a
-    seeded sample of ``sample`` of the rest (0: keep all); return how many are kept."""
+    seeded sample of ``sample`` of the rest (0: keep all); with ``only``, also those
+    outside its functions and line ranges. Return how many are kept. The skips of a
+    previous call are undone first, so a wider choice runs the mutants it adds."""
+    import sqlite3
+
     import numpy as np
     from cosmic_ray.work_db import use_db
     from cosmic_ray.work_item import WorkerOutcome, WorkResult
 
+    con = sqlite3.connect(session)
+    with con:
+        con.execute("DELETE FROM work_results WHERE worker_outcome = 'SKIPPED'")
+    con.close()
     spans = scope_lines(TREE / mod.path, mod.scope)
+    if only:
+        chosen = only_spans(TREE / mod.path, mod, only)
+        spans = [(a, b) for a, b in chosen if any(c <= a and b <= d for c, d in spans)]
+        if len(spans) < len(chosen):
+            raise SystemExit(f"--only {' '.join(only)}: a line range outside the scope")
     with use_db(str(session)) as db:
         done = {job for job, _ in db.results}
         items = list(db.work_items)
@@ -450,7 +521,7 @@ def filter_session(session: Path, mod: Module, sample: int) -> int:
         for item in items:
             spec = item.mutations[0]
             row = spec.start_pos[0]
-            if any(a <= row <= b for a, b in spans) and canonical(spec.operator_name):
+            if _in_spans(row, spans) and canonical(spec.operator_name):
                 candidates.append(item)
         # Job ids are random; sort by the mutation itself so the sample depends only on
         # the source and the seed.
@@ -470,12 +541,85 @@ def filter_session(session: Path, mod: Module, sample: int) -> int:
 
 
 # Surviving mutants that cannot change any result, by module: (original line, mutated
-# line, reason), lines stripped. They are listed in the report and left out of the score.
-EQUIVALENT: dict[str, list[tuple[str, str, str]]] = {}
+# line, reason[, where[, after]]), lines stripped (equivalent.py). They are listed in the
+# report and left out of the score.
+EQUIVALENT: dict[str, list[tuple]] = {}
 EQUIVALENT_FILE = Path(__file__).with_name("equivalent.py")
 if EQUIVALENT_FILE.exists():
     exec(compile(EQUIVALENT_FILE.read_text(), str(EQUIVALENT_FILE), "exec"),  # noqa: S102
          {"EQUIVALENT": EQUIVALENT})
+
+
+@dataclass(frozen=True)
+class Equivalent:
+    """An entry of equivalent.py. A line can occur several times in a module's scope, and
+    a mutation equivalent at one copy need not be at another: an entry whose line is not
+    unique in the scope must name the functions it is meant for (``where``), and the line
+    above it (``after``) if the line is not unique in one of them (``ambiguities``)."""
+    original: str
+    mutated: str
+    reason: str
+    where: tuple[str, ...] = ()     # the functions (qualified names) it covers; () all
+    after: str | None = None        # the nearest non-blank line above the original
+
+    @classmethod
+    def of(cls, entry: tuple) -> Equivalent:
+        where = entry[3] if len(entry) > 3 else ()
+        return cls(*entry[:3], (where,) if isinstance(where, str) else tuple(where),
+                   entry[4] if len(entry) > 4 else None)
+
+    def covers(self, site: Site | None) -> bool:
+        """Whether the entry is meant for a mutation of the line at ``site``."""
+        if not self.where:
+            return True
+        return (site is not None and site.function in self.where
+                and (self.after is None or site.before == self.after))
+
+
+def ambiguities(entries: list[Equivalent], sites: dict[int, Site]) -> list[str]:
+    """What is wrong with the entries: a line that occurs more than once in the scope,
+    without the functions it is meant for; a named function that does not hold the line
+    once (after ``after``, if given). An entry whose line occurs nowhere matches nothing
+    (a line since changed) and is not an error."""
+    errors = []
+    for e in entries:
+        at = [s for s in sites.values() if s.text == e.original]
+        name = f"{e.original!r} -> {e.mutated!r}"
+        if not e.where:
+            if len(at) > 1:
+                errors.append(f"{name}: the line occurs {len(at)} times in the scope (in "
+                              f"{', '.join(sorted({s.function for s in at}))}): name the "
+                              f"functions the entry is meant for")
+            continue
+        for f in e.where:
+            here = [s for s in at if s.function == f and e.covers(s)]
+            if len(here) != 1:
+                hint = ("; give the line above it (after)" if here and e.after is None
+                        else "")
+                errors.append(f"{name}: the line occurs {len(here)} times in {f}"
+                              + (f" after {e.after!r}" if e.after is not None else "")
+                              + hint)
+    return errors
+
+
+def equivalents(name: str, mod: Module) -> tuple[list[Equivalent], dict[int, Site]]:
+    """The module's entries and its scope's lines; refuses ambiguous entries."""
+    entries = [Equivalent.of(e) for e in EQUIVALENT.get(name, [])]
+    sites = scope_sites(ROOT / mod.path, mod.scope)
+    errors = ambiguities(entries, sites)
+    if errors:
+        raise SystemExit(f"{EQUIVALENT_FILE.name}[{name!r}]: ambiguous entries:\n  "
+                         + "\n  ".join(errors))
+    return entries, sites
+
+
+def equivalent_reason(entries: list[Equivalent], sites: dict[int, Site], row: int,
+                      original: str, mutated: str) -> str | None:
+    """The reason of the entry covering a surviving mutant of line ``row``, if any."""
+    for e in entries:
+        if (e.original, e.mutated) == (original, mutated) and e.covers(sites.get(row)):
+            return e.reason
+    return None
 
 
 def _changed_lines(diff: str) -> tuple[str, str]:
@@ -486,21 +630,26 @@ def _changed_lines(diff: str) -> tuple[str, str]:
     return " ".join(minus), " ".join(plus)
 
 
-def report(name: str, mod: Module, session: Path) -> tuple[int, int, int]:
+def report(name: str, mod: Module, session: Path,
+           rows: list[tuple[int, int]] | None = None) -> tuple[int, int, int]:
+    """Print and write the score of the mutants run (with ``rows``, of those in its
+    line spans only)."""
     from cosmic_ray.work_db import use_db
     from cosmic_ray.work_item import TestOutcome, WorkerOutcome
 
     killed = survived = incompetent = equivalent = 0
     lines, eq_lines = [], []
-    known = {(a, b): why for a, b, why in EQUIVALENT.get(name, [])}
+    entries, sites = equivalents(name, mod)
     with use_db(str(session)) as db:
         specs = {item.job_id: item.mutations[0] for item in db.work_items}
         for job, result in db.results:
-            if result.worker_outcome == WorkerOutcome.SKIPPED:
+            if result.worker_outcome == WorkerOutcome.SKIPPED or (
+                    rows is not None and not _in_spans(specs[job].start_pos[0], rows)):
                 continue
             if result.test_outcome == TestOutcome.SURVIVED:
                 spec = specs[job]
-                why = known.get(_changed_lines(result.diff or ""))
+                why = equivalent_reason(entries, sites, spec.start_pos[0],
+                                        *_changed_lines(result.diff or ""))
                 if why:
                     equivalent += 1
                     eq_lines.append(f"EQUIVALENT line {spec.start_pos[0]}: "
@@ -537,10 +686,12 @@ def reset_survivors(session: Path) -> None:
 
 
 def run(name: str, mod: Module, *, count_only: bool, report_only: bool, sample: int,
-        retest: bool) -> None:
+        retest: bool, only: tuple[str, ...] = ()) -> None:
     session = BUILD / f"{name}.sqlite"
+    rows = only_spans(ROOT / mod.path, mod, only) if only else None
+    equivalents(name, mod)  # refuse ambiguous entries before any run
     if report_only:
-        report(name, mod, session)
+        report(name, mod, session, rows)
         return
     make_tree()
     start = time.monotonic()
@@ -561,12 +712,12 @@ def run(name: str, mod: Module, *, count_only: bool, report_only: bool, sample: 
         stamp.write_text(digest)
     if retest:
         reset_survivors(session)
-    n = filter_session(session, mod, sample)
+    n = filter_session(session, mod, sample, only)
     print(f"{name}: {n} mutants in scope (baseline test run {baseline:.1f} s)", flush=True)
     if count_only:
         return
     cosmic("exec", str(cfg), str(session))
-    report(name, mod, session)
+    report(name, mod, session, rows)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -580,14 +731,20 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--sample", type=int, default=25,
                         help="run a seeded sample of at most this many mutants per module "
                              "(default 25; 0: all)")
+    parser.add_argument("--only", nargs="+", default=[], metavar="ITEM",
+                        help="(one module) run and report only the mutants of these "
+                             "functions of its scope (qualified names) and line ranges of "
+                             "its file (FIRST-LAST or LINE); the sample is drawn from them")
     args = parser.parse_args(argv)
     unknown = [m for m in args.modules if m not in MODULES]
     if unknown:
         parser.error(f"unknown module {unknown[0]!r}; valid: {', '.join(MODULES)}")
+    if args.only and len(args.modules) != 1:
+        parser.error("--only needs exactly one MODULE")
     BUILD.mkdir(parents=True, exist_ok=True)
     for name in args.modules or list(MODULES):
         run(name, MODULES[name], count_only=args.count, report_only=args.report,
-            sample=args.sample, retest=args.retest)
+            sample=args.sample, retest=args.retest, only=tuple(args.only))
     return 0
 
 

@@ -9,11 +9,13 @@ from scenegen.evaluation import metrics
 from scenegen.evaluation.mot import (
     HOTA_ALPHAS,
     MotScores,
+    add_counts,
     box_iou,
     clear,
     combine,
     hota,
     identity,
+    mot_counts,
     mot_frames,
     remove_distractor_matches,
     score_all,
@@ -170,4 +172,47 @@ def test_combine_of_one_sequence_and_bad_input():
         combine(one)
     with pytest.raises(ValueError, match="not dict"):
         combine([one, {}])
+    for bad in (None, 3.5):  # neither a sequence nor one MotScores
+        with pytest.raises(ValueError, match="sequence of MotScores"):
+            combine(bad)
     assert isinstance(again, MotScores)
+
+
+@pytest.mark.parametrize("kind", ["no-gt", "no-tracks", "empty"])
+def test_combine_of_sequences_without_objects_or_tracks_divides_by_at_least_one(kind):
+    """TrackEval's combined final fields divide by max(1, count), unlike one sequence,
+    which returns early: sequences with no ground truth combine to MOTA = MODA = -FP
+    (one such sequence alone scores 0), and DetRe, DetPr and DetA are 0, not 0 / 0."""
+    rng = np.random.default_rng(11)
+    parts = [_part(rng, "no-gt" if kind == "empty" else kind) for _ in range(2)]
+    if kind == "empty":
+        parts = [(g, np.full_like(e, np.nan)) for g, e in parts]
+    got = combine([score_all(mot_frames(g, e)) for g, e in parts])
+    fp = sum(int(np.sum(~np.isnan(e[..., 0]))) for g, e in parts if np.isnan(g).all())
+    c, h = got.clear, got.hota
+    assert (c.tp, c.fp, c.motp) == (0, fp, 0.0) and (fp > 0) == (kind == "no-gt")
+    assert c.mota == c.moda == (-fp if c.fn == 0 else 0.0)
+    assert (c.fn > 0) == (kind == "no-tracks")
+    for name in ("hota", "deta", "detre", "detpr", "assa", "assre", "asspr"):
+        assert getattr(h, name) == 0.0, name
+    np.testing.assert_array_equal(h.deta_alpha, 0.0)
+    assert h.loca == 1.0
+
+
+def test_add_counts_adds_key_by_key_and_refuses_counts_it_cannot_add():
+    """add_counts sums mot_counts entries key by key (the per-threshold lists element by
+    element) and names the first key an entry lacks, or whose list has not one value per
+    HOTA threshold (a list of 1 would broadcast), instead of a KeyError or a wrong sum."""
+    rng = np.random.default_rng(7)
+    a, b = (mot_counts(score_all(mot_frames(*_part(rng, "plain")))) for _ in range(2))
+    both = add_counts([a, b])
+    assert both["tp"] == a["tp"] + b["tp"] and both["idfp"] == a["idfp"] + b["idfp"]
+    np.testing.assert_array_equal(both["hota_fn"], np.add(a["hota_fn"], b["hota_fn"]))
+    missing = {k: v for k, v in b.items() if k != "tp"}
+    short = {**b, "hota_fn": [float(b["hota_fn"][0])]}
+    for entries, key in (([a, missing], "tp"), ([a, short], "hota_fn"),
+                         ([a, score_all(mot_frames(*_part(rng, "plain")))], "tp")):
+        with pytest.raises(ValueError, match=f"an entry has no '{key}'"):
+            add_counts(entries)
+    with pytest.raises(ValueError, match="no counts to add"):
+        add_counts([])
