@@ -420,10 +420,12 @@ def prepare_folder(root: Path, want: list[str]) -> list[Path]:
                 if p.is_symlink():
                     p.unlink()
                     removed.append(p)
+    # Each folder once (a large benchmark's files share a few), the outermost first.
+    folders = {f for name in want for f in Path(name).parents[:-1]}
+    for f in sorted(folders, key=lambda f: (len(f.parts), f)):
+        if (root / f).exists() and not (root / f).is_dir():
+            raise ConfigError(f"{root / f}: is a file, not a folder")
     for name in want:
-        up = _file_in_the_way(root, name)
-        if up is not None:
-            raise ConfigError(f"{up}: is a file, not a folder")
         if (root / name).is_dir():
             raise ConfigError(f"{root / name}: is a folder, expected a file name")
     return removed
