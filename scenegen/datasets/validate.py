@@ -17,6 +17,7 @@ from scenegen.datasets.build import (
 )
 from scenegen.datasets.family import Family
 from scenegen.errors import ConfigError, DataError
+from scenegen.io.atomic import describe_special_file
 
 __all__ = ["validate_dataset"]
 
@@ -90,7 +91,10 @@ def validate_dataset(
     for n, (file, group) in enumerate(sorted(by_file.items())):
         path = p / file
         if not path.is_file():
-            problems.append(f"{path}: missing shard file ({len(group)} sequences)")
+            special = describe_special_file(path)  # named as such, not "missing"
+            problems.append(f"{special} where a shard file belongs ({len(group)} sequences)"
+                            if special else  # fmt: skip
+                            f"{path}: missing shard file ({len(group)} sequences)")
             continue
         found = check_file(path, isolate=True)
         if found:

@@ -25,6 +25,7 @@ Helpers
 from __future__ import annotations
 
 import contextlib
+import errno
 import json
 import os
 import re
@@ -39,7 +40,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from scenegen.errors import ConfigError
+from scenegen.errors import ConfigError, DataError
 
 __all__ = [
     "atomic_path",
@@ -47,12 +48,20 @@ __all__ = [
     "describe_special_file",
     "describe_temp_file",
     "discard_temp_files",
+    "read_regular",
+    "read_regular_text",
+    "SpecialFile",
     "temp_file_owner",
     "temp_prefix",
     "write_json",
     "write_npy",
     "write_text",
 ]
+
+class SpecialFile(DataError):
+    """A FIFO, a device or a socket where a file was to be read (:func:`read_regular`);
+    its message is :func:`describe_special_file`'s line."""
+
 
 _in_progress: set[Path] = set()  # temporary files of this process's unfinished writes
 
@@ -218,6 +227,12 @@ def describe_special_file(path: str | Path) -> str | None:
         mode = os.stat(path).st_mode
     except (OSError, ValueError):
         return None
+    return _special_text(path, mode)
+
+
+def _special_text(path: str | Path, mode: int) -> str | None:
+    """:func:`describe_special_file`'s line for a file of ``mode`` (None: regular or
+    folder)."""
     if stat.S_ISREG(mode) or stat.S_ISDIR(mode):
         return None
     if stat.S_ISFIFO(mode):
@@ -229,6 +244,74 @@ def describe_special_file(path: str | Path) -> str | None:
     else:
         kind = "a special file"
     return f"{path}: is not a regular file ({kind})"
+
+
+def read_regular(path: str | Path) -> bytes:
+    """The bytes of the regular file at ``path`` (through symbolic links), never waiting
+    on a FIFO or reading a device without end.
+
+    The file is opened without blocking and checked on the open descriptor, so a FIFO,
+    device or socket put there at any moment is refused at once (no window between a
+    check and the read).
+
+    Parameters
+    ----------
+    path : str or Path
+        The file.
+
+    Returns
+    -------
+    bytes
+        Its content.
+
+    Raises
+    ------
+    SpecialFile
+        ``path`` is a FIFO, a device or a socket: :func:`describe_special_file`'s line.
+    FileNotFoundError, IsADirectoryError, OSError
+        As :func:`open` raises them (missing, a folder, unreadable).
+    """
+    fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+    try:
+        mode = os.fstat(fd).st_mode
+    except BaseException:
+        os.close(fd)
+        raise
+    if not stat.S_ISREG(mode):
+        os.close(fd)
+        if stat.S_ISDIR(mode):
+            raise IsADirectoryError(errno.EISDIR, os.strerror(errno.EISDIR), str(path))
+        raise SpecialFile(_special_text(path, mode))
+    with os.fdopen(fd, "rb") as fh:
+        return fh.read()
+
+
+def read_regular_text(path: str | Path, encoding: str = "utf-8") -> str:
+    """:func:`read_regular`, decoded as :meth:`pathlib.Path.read_text` decodes (universal
+    newlines).
+
+    Parameters
+    ----------
+    path : str or Path
+        The file.
+    encoding : str, optional
+        Its encoding.
+
+    Returns
+    -------
+    str
+        Its text.
+
+    Raises
+    ------
+    SpecialFile, FileNotFoundError, IsADirectoryError, OSError
+        As :func:`read_regular`.
+    UnicodeDecodeError
+        The bytes are not text in ``encoding``.
+    """
+    import io
+
+    return io.TextIOWrapper(io.BytesIO(read_regular(path)), encoding=encoding).read()
 
 
 def _real_target(path: str | Path) -> Path:

@@ -39,7 +39,7 @@ from typing import Any
 
 from scenegen.config import json_object
 from scenegen.errors import DataError
-from scenegen.io.atomic import describe_special_file, write_json
+from scenegen.io.atomic import SpecialFile, describe_special_file, read_regular, write_json
 
 __all__ = [
     "MAX_BYTES",
@@ -187,13 +187,13 @@ def _parse(p: Path) -> Any:
         raise DataError(f"{p}: is a folder, not a JSON file")
     special = describe_special_file(p)
     if special is not None:  # a FIFO waits for a writer; /dev/zero never ends
-        raise DataError(special)
+        raise SpecialFile(special)
     try:
         size = p.stat().st_size
         if size > MAX_BYTES:
             raise DataError(f"{p}: too large for a JSON document ({size} bytes, at most "
                             f"{MAX_BYTES})")  # fmt: skip
-        raw = p.read_bytes()
+        raw = read_regular(p)
     except OSError as err:
         raise DataError(f"{p}: unreadable ({err.strerror or type(err).__name__})") from None
     if not raw.strip():

@@ -776,7 +776,8 @@ def run_benchmark(
         As :func:`plan_benchmark`; a bad ``jobs`` (< 1, or given with ``scheduler``) or an
         unreachable scheduler; ``out``
         holding a dataset (its ``manifest.json``), an experiment's results or a report of
-        ``scenegen experiment all``, or that cannot be created.
+        ``scenegen experiment all``, or that cannot be created; a FIFO, a device or a
+        socket where the benchmark writes a file (refused before any run).
     DataError
         ``dataset`` is not a dataset folder, or a shard is damaged; with kept tracks, a
         deterministic tracker run again for its tracks gave another record than the
@@ -807,6 +808,12 @@ def run_benchmark(
         raise ConfigError(f"-o {outp}: holds {what}; write the benchmark into another "
                           "folder")  # fmt: skip
     make_output_folder(outp)
+    from scenegen.io.atomic import describe_special_file
+
+    for p in [outp / n for n in ("results.json", *PAGES)] + sorted(outp.glob("*.png")):
+        special = describe_special_file(p)
+        if special is not None:  # refused before any run, not after them all
+            raise ConfigError(special)
     meta = dataset_meta(man, root)
     listed = listed_digests(outp, meta)
     from scenegen.lab import benchmark_tracks as bt
@@ -1026,6 +1033,10 @@ def _csv_cell(value: Any) -> Any:
     return value
 
 
+PAGES = ("scores.csv", "leaderboard.md", "index.html")
+"""The text files a benchmark writes beside ``results.json`` (:func:`texts`)."""
+
+
 def texts(results: dict[str, Any]) -> dict[str, str]:
     """``scores.csv``, ``leaderboard.md`` and ``index.html`` of ``results``, by file name.
 
@@ -1050,8 +1061,8 @@ def texts(results: dict[str, Any]) -> dict[str, str]:
                     *[_csv_cell(r["params"].get(p)) for p in pnames],
                     *["" if r.get(m) is None else r[m] for m in metric_cols]])  # fmt: skip
     figures = [(name, cap) for name, cap, _ in figure_list(results)]
-    return {"scores.csv": buf.getvalue(), "leaderboard.md": _markdown(board),
-            "index.html": _html(meta, board, figures, results["params"])}  # fmt: skip
+    return dict(zip(PAGES, (buf.getvalue(), _markdown(board),
+                            _html(meta, board, figures, results["params"])), strict=True))
 
 
 def write_outputs(

@@ -34,7 +34,8 @@ import re
 from pathlib import Path
 from typing import Any
 
-from scenegen.errors import DataError
+from scenegen.errors import ConfigError, DataError
+from scenegen.io.atomic import SpecialFile, read_regular, read_regular_text
 from scenegen.io.sealed import Unsealed, content_digest, read_sealed_json
 from scenegen.lab.experiments.outputs import _more, parse_listing, read_checked, warn
 from scenegen.lab.experiments.runner import _round
@@ -279,11 +280,19 @@ def load_record(path: Path, task: Any, listed: tuple[str, dict[str, Any]] | None
     -------
     dict or None
         The stored record (without its digest), or None to run the task.
+
+    Raises
+    ------
+    ConfigError
+        ``path`` is a FIFO, a device or a socket (``"PATH: is not a regular file (a
+        FIFO); remove it"``): the run could not be stored there, so it is not run.
     """
     if not path.exists():
         return None
     try:
         data = read_record(path)
+    except SpecialFile as err:  # its run could not be stored there: refused before running
+        raise ConfigError(f"{err}; remove it") from None
     except DataError as err:
         warn(f"{err}; running it again")
         return None
@@ -399,9 +408,11 @@ def check_benchmark(folder: str | Path, *, deep: bool = False,
     for name, text in texts(results).items():
         path = root / name
         try:
-            stored = path.read_text(encoding="utf-8")
+            stored = read_regular_text(path)
         except FileNotFoundError:
             problems.append(f"{path}: missing ({_RERUN})")
+        except SpecialFile as err:
+            problems.append(f"{err} (remove it, then {_RERUN})")
         except (OSError, UnicodeDecodeError) as err:
             problems.append(f"{path}: unreadable ({type(err).__name__})")
         else:
@@ -411,10 +422,15 @@ def check_benchmark(folder: str | Path, *, deep: bool = False,
     for name, _, _ in figure_list(results):
         path = root / name
         try:
-            with path.open("rb") as fh:
-                head = fh.read(8)
-        except OSError:
+            head = read_regular(path)[:8]
+        except FileNotFoundError:
             problems.append(f"{path}: missing ({_RERUN})")
+            continue
+        except SpecialFile as err:
+            problems.append(f"{err} (remove it, then {_RERUN})")
+            continue
+        except OSError as err:
+            problems.append(f"{path}: unreadable ({type(err).__name__})")
             continue
         if head != b"\x89PNG\r\n\x1a\n":
             problems.append(f"{path}: not a PNG file (damaged)")
@@ -538,6 +554,6 @@ def _check_deep(root: Path, results: dict[str, Any], records: list[dict[str, Any
         kept = root / track_file(task.tracker, names[task.index])
         with tempfile.TemporaryDirectory() as tmp:
             write_tracks(Path(tmp) / "t.txt", rec["n_frames"], done[1], done[2])
-            if (Path(tmp) / "t.txt").read_bytes() != kept.read_bytes():
+            if (Path(tmp) / "t.txt").read_bytes() != read_regular(kept):
                 problems.append(f"{kept}: differs from the tracks of the run computed again")
     return problems

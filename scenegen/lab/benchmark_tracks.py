@@ -211,11 +211,13 @@ def file_digest(path: Path) -> str | None:
     Returns
     -------
     str or None
-        64 hex digits.
+        64 hex digits; None also for a FIFO, a device or a socket (never waited on).
     """
+    from scenegen.io.atomic import SpecialFile, read_regular
+
     try:
-        return hashlib.sha256(path.read_bytes()).hexdigest()
-    except OSError:
+        return hashlib.sha256(read_regular(path)).hexdigest()
+    except (OSError, SpecialFile):
         return None
 
 
@@ -328,6 +330,7 @@ def check_tracks(root: Path, results: dict[str, Any], records: list[dict[str, An
     list of str
         One line per problem, each naming the file or folder at fault.
     """
+    from scenegen.io.atomic import describe_special_file
     from scenegen.lab.experiments.outputs import parse_listing
 
     rerun = "run the same `scenegen benchmark ... --keep-tracks` command again to rewrite it"
@@ -366,6 +369,8 @@ def check_tracks(root: Path, results: dict[str, Any], records: list[dict[str, An
         elif path.is_dir():
             problems.append(f"{path}: a folder where the kept tracks have a file (remove it, "
                             f"then {rerun})")  # fmt: skip
+        elif (special := describe_special_file(path)) is not None:
+            problems.append(f"{special} (remove it, then {rerun})")
         elif not path.is_file():
             problems.append(f"{path}: missing ({rerun})")
         elif file_digest(path) != digest:
@@ -387,7 +392,8 @@ def _file_in_the_way(root: Path, name: str) -> Path | None:
 def prepare_folder(root: Path, want: list[str]) -> list[Path]:
     """Make the kept folder ready to be written: remove the symbolic links in it (a link
     would have the benchmark write one tracker's boxes through it, into another file), and
-    refuse a file where a kept file needs a folder, or a folder where it needs a file.
+    refuse a file where a kept file needs a folder, a folder where it needs a file, and a
+    FIFO, device or socket where it needs a file (reading it would wait or never end).
 
     Parameters
     ----------
@@ -404,12 +410,14 @@ def prepare_folder(root: Path, want: list[str]) -> list[Path]:
     Raises
     ------
     scenegen.errors.ConfigError
-        ``"PATH: is a file, not a folder"`` or ``"PATH: is a folder, expected a file
-        name"``, before anything is written.
+        ``"PATH: is a file, not a folder"``, ``"PATH: is a folder, expected a file
+        name"`` or ``"PATH: is not a regular file (a FIFO); remove it"``, before anything
+        is written.
     """
     import os
 
     from scenegen.errors import ConfigError
+    from scenegen.io.atomic import describe_special_file
 
     removed = []
     kept = root / FOLDER
@@ -428,6 +436,9 @@ def prepare_folder(root: Path, want: list[str]) -> list[Path]:
     for name in want:
         if (root / name).is_dir():
             raise ConfigError(f"{root / name}: is a folder, expected a file name")
+        special = describe_special_file(root / name)
+        if special is not None:  # reading it would wait for a writer, or never end
+            raise ConfigError(f"{special}; remove it")
     return removed
 
 

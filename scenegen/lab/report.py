@@ -22,8 +22,15 @@ from typing import Any
 
 from scenegen.datasets.build import holds_report, make_output_folder
 from scenegen.errors import ConfigError, DataError
+from scenegen.io.atomic import describe_special_file
 from scenegen.io.sealed import write_sealed_json
-from scenegen.lab.experiments import get, names, run_experiment, verdict_counts
+from scenegen.lab.experiments import (
+    get,
+    names,
+    refuse_special_outputs,
+    run_experiment,
+    verdict_counts,
+)
 from scenegen.lab.experiments.definitions import DEMO_PLAN
 from scenegen.lab.experiments.outputs import (
     WRITTEN_BY,
@@ -118,12 +125,20 @@ def run_all(
     ------
     ConfigError
         As :func:`scenegen.lab.experiments.run_experiment`; ``out_dir`` holding a dataset,
-        a benchmark's outputs or one experiment's results (:func:`check_report_folder`).
+        a benchmark's outputs or one experiment's results (:func:`check_report_folder`); a
+        FIFO, a device or a socket where a file of the report or of an experiment is
+        written, before any run.
     """
     from scenegen.lab.experiments.runner import plan_tasks, workers
 
     check_report_folder(out_dir)
     out = Path(out_dir) / "experiments"
+    for page in ("index.html", "results.json"):
+        special = describe_special_file(Path(out_dir) / page)
+        if special is not None:
+            raise ConfigError(special)
+    for name in names():  # before any run, not after the experiments before it
+        refuse_special_outputs(out / name)
     # One set of workers for every experiment, given every experiment's tasks at once: they
     # run the next experiment's tasks while this process summarises the previous one.
     with workers(jobs=jobs, scheduler=scheduler) as pool:
@@ -358,6 +373,7 @@ def build_report(out_dir: str | Path) -> Path:
 
 def index_problem(out_dir: str | Path) -> str | None:
     """What is wrong with ``out_dir/index.html``: ``"missing"``, ``"unreadable (...)"``,
+    ``"is not a regular file (a FIFO): remove it"`` (or a device, a socket: never waited on),
     ``"stale"`` (not the page :func:`build_report` writes from the folder as it is: edited,
     damaged, or written from other results), or None (``scenegen validate``).
 
@@ -376,11 +392,15 @@ def index_problem(out_dir: str | Path) -> str | None:
     DataError
         As :func:`render_report`, when the page exists.
     """
+    from scenegen.io.atomic import SpecialFile, read_regular_text
+
     index = Path(out_dir) / "index.html"
     try:
-        text = index.read_text(encoding="utf-8")
+        text = read_regular_text(index)
     except FileNotFoundError:
         return "missing"
+    except SpecialFile as err:  # "PATH: is not a regular file (a FIFO)"
+        return f"{str(err).removeprefix(f'{index}: ')}: remove it"
     except (OSError, UnicodeDecodeError) as err:
         return f"unreadable ({type(err).__name__})"
     if text != render_report(out_dir)[0]:

@@ -32,9 +32,12 @@ def load_expected(path: Any) -> NDArray[Any] | None:
         The stored array, of its stored shape and dtype; None if the file is missing or
         not a readable ``.npy`` array.
     """
-    try:
-        with open(path, "rb") as f:
-            arr = np.load(f, allow_pickle=False)
+    import io
+
+    from scenegen.io.atomic import read_regular
+
+    try:  # read_regular: a FIFO or a device is refused at once (a ValueError)
+        arr = np.load(io.BytesIO(read_regular(path)), allow_pickle=False)
     except (OSError, ValueError, EOFError):
         return None
     return arr if isinstance(arr, np.ndarray) else None

@@ -513,9 +513,11 @@ def load_registry(folder: Path, *, missing_ok: bool) -> dict[str, Any]:
         if missing_ok:
             return {"schema": SCHEMA, "fixtures": {}}
         raise DataError(f"{path}: no such file (write the fixtures with `scenegen fixtures regen`)")
-    try:
-        reg = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, json.JSONDecodeError) as err:
+    from scenegen.io.atomic import read_regular_text
+
+    try:  # a FIFO there is refused at once (SpecialFile, a DataError line)
+        reg = json.loads(read_regular_text(path))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as err:
         raise DataError(f"{path}: not a readable JSON registry: {err}") from None
     if not isinstance(reg, dict) or reg.get("schema") != SCHEMA:
         raise DataError(f"{path}: schema is not {SCHEMA!r}")

@@ -326,11 +326,12 @@ def scenegen_fixture(request: pytest.FixtureRequest) -> Callable[[str], Any]:
 
 
 def _check_digests(registry: Path, name: str, seq: Any) -> None:
+    from scenegen.io.atomic import SpecialFile, read_regular_text
     from scenegen.testing.fixtures import digests
 
     try:
-        doc = json.loads(registry.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as err:
+        doc = json.loads(read_regular_text(registry))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError, SpecialFile) as err:
         raise AssertionError(f"{registry}: not a readable JSON registry: {err}") from None
     fixtures = doc.get("fixtures", {}) if isinstance(doc, dict) else None
     if not isinstance(fixtures, dict):

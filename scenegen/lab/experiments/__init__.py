@@ -74,6 +74,7 @@ __all__ = [
     "get",
     "holds_experiment_outputs",
     "names",
+    "refuse_special_outputs",
     "results_document",
     "run_experiment",
     "run_task",
@@ -185,6 +186,27 @@ def _refuse_other_outputs(out: Path, name: str) -> None:
         )
 
 
+def refuse_special_outputs(out: Path) -> None:
+    """Refuse, before any run, a FIFO, a device or a socket where an experiment writes a
+    file into ``out`` (``results.json``, ``table.md``, a ``*.png`` figure): writing it would
+    fail only after the runs, and reading it (``validate``) would wait.
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        The experiment's output folder.
+
+    Raises
+    ------
+    ConfigError
+        ``"PATH: is not a regular file (a FIFO)"``.
+    """
+    for p in [out / "results.json", out / "table.md", *sorted(out.glob("*.png"))]:
+        special = describe_special_file(p)
+        if special is not None:
+            raise ConfigError(special)
+
+
 def run_experiment(
     name: str,
     out_dir: str | Path,
@@ -246,9 +268,10 @@ def run_experiment(
     ------
     ConfigError
         Unknown experiment or method (listing the valid ones), bad runs/scenes/jobs/seed, an
-        override a chosen method does not accept, an unreachable scheduler, or an
+        override a chosen method does not accept, an unreachable scheduler, an
         ``out_dir`` holding a dataset, a benchmark's outputs, another experiment's results
-        or a report of ``scenegen experiment all``.
+        or a report of ``scenegen experiment all``, or a FIFO, device or socket where a file
+        is written (:func:`refuse_special_outputs`).
     """
     exp = get(name)
     if jobs is not None and jobs < 1:
@@ -259,6 +282,7 @@ def run_experiment(
                        values=values, overrides=overrides)
     out = Path(out_dir)
     _refuse_other_outputs(out, exp.name)
+    refuse_special_outputs(out)
     make_output_folder(out)
     records = execute(tasks, out / "runs", jobs=jobs, scheduler=scheduler, progress=progress)
     results = results_document(exp, records)

@@ -13,7 +13,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-__all__ = ["write_figures"]
+__all__ = ["figure_names", "write_figures"]
 
 
 def _save(fig: Figure, path: Path) -> str:
@@ -60,6 +60,21 @@ def _bars(ax: Any, groups: list[str], series: dict[str, list[Any]], ylabel: str,
     ax.grid(axis="y", alpha=0.3)
 
 
+def _fig4_methods(res: dict[str, Any]) -> list[str]:
+    """The methods of ``dps-synthetic``'s Fig. 4 (first λ), none when it is not drawn."""
+    methods = next(iter(res["summary"]["by_value"].values()))["methods"]
+    shown = [s for s in methods if s in ("nonps", "ps-1234567", "ps-2345671", "dps")]
+    return shown if shown and "uniqueness" in methods[shown[0]] else []
+
+
+def _uniqueness_drawn(res: dict[str, Any]) -> bool:
+    """Whether the RealSeq experiments' uniqueness figure is drawn (its first preset's
+    first method has uniqueness)."""
+    first = next(iter(res["summary"]["presets"].values()), {})
+    labels = list(first)
+    return bool(labels) and "uniqueness" in first[labels[0]]
+
+
 def _dps_synthetic(res: dict[str, Any], out: Path) -> list[str]:
     from scenegen.lab.experiments.definitions import PAPER
 
@@ -67,8 +82,8 @@ def _dps_synthetic(res: dict[str, Any], out: Path) -> list[str]:
     files = []
     v0 = next(iter(by))
     methods = by[v0]["methods"]
-    shown = [s for s in methods if s in ("nonps", "ps-1234567", "ps-2345671", "dps")]
-    if shown and "uniqueness" in methods[shown[0]]:
+    shown = _fig4_methods(res)
+    if shown:
         k = len(methods[shown[0]]["uniqueness"])
         objs = [str(i + 1) for i in range(k)]
         ed0 = np.asarray(methods[shown[0]].get("effective_dynamics", []), dtype=float)
@@ -150,7 +165,7 @@ def _dps_real(res: dict[str, Any], out: Path) -> list[str]:
     files = [_save(fig, out / "success_recovery.png")]
     first = next(iter(presets.values()), {})
     labels = list(first)
-    if labels and "uniqueness" in first[labels[0]]:
+    if _uniqueness_drawn(res):
         fig = Figure(figsize=(10, 4))
         ax = fig.subplots()
         k = len(first[labels[0]]["uniqueness"])
@@ -170,7 +185,7 @@ def _kams_accuracy(res: dict[str, Any], out: Path) -> list[str]:
     from scenegen.lab.experiments.definitions import PAPER
 
     methods = res["summary"]["methods"]
-    presets = sorted({p for v in methods.values() for p in v})
+    presets = _kams_presets(res)
     if not presets:
         return []
     fig = Figure(figsize=(12, 8))
@@ -197,6 +212,16 @@ def _kams_accuracy(res: dict[str, Any], out: Path) -> list[str]:
     return [_save(fig, out / "centre_error.png")]
 
 
+def _kams_presets(res: dict[str, Any]) -> list[str]:
+    """The presets of ``kams-accuracy``'s error figure (one panel each), sorted."""
+    return sorted({p for v in res["summary"]["methods"].values() for p in v})
+
+
+def _shm_records(records: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """The SHM runs the ordering-probability figure draws from (none: not drawn)."""
+    return [r for r in records if "order_prob" in r]
+
+
 def _kams_robustness(res: dict[str, Any], out: Path) -> list[str]:
     from scenegen.lab.experiments.definitions import PAPER
 
@@ -216,7 +241,7 @@ def _kams_robustness(res: dict[str, Any], out: Path) -> list[str]:
 
 
 def _shm_depth(res: dict[str, Any], out: Path, records: list[dict[str, Any]]) -> list[str]:
-    shm = [r for r in records if "order_prob" in r]
+    shm = _shm_records(records)
     if not shm:
         return []
     slugs = sorted({r["key"]["method"] for r in shm})
@@ -244,6 +269,38 @@ def _shm_depth(res: dict[str, Any], out: Path, records: list[dict[str, Any]]) ->
     axes[-1].set_xlabel("frame")
     fig.tight_layout()
     return [_save(fig, out / "ordering_probability.png")]
+
+
+def figure_names(name: str, results: dict[str, Any], records: list[dict[str, Any]]
+                 ) -> list[str]:  # fmt: skip
+    """The file names :func:`write_figures` writes for these results, without drawing
+    (``scenegen validate`` checks that each is there and a PNG).
+
+    Parameters
+    ----------
+    name : str
+        The experiment.
+    results : dict
+        Its summary, as written to ``results.json``.
+    records : list of dict
+        The run records.
+
+    Returns
+    -------
+    list of str
+        File names relative to the experiment folder, in the order they are written.
+    """
+    if name == "dps-synthetic":
+        return (["fig4_uniqueness_effective_dynamics.png"] if _fig4_methods(results)
+                else []) + ["success_recovery.png"]  # fmt: skip
+    if name in ("dps-occlusion", "dps-dancers"):
+        return ["success_recovery.png"] + (["uniqueness.png"] if _uniqueness_drawn(results)
+                                           else [])  # fmt: skip
+    if name == "kams-accuracy":
+        return ["centre_error.png"] if _kams_presets(results) else []
+    if name == "kams-robustness":
+        return ["robustness_z.png"] if results["summary"]["pairs"] else []
+    return ["ordering_probability.png"] if _shm_records(records) else []
 
 
 def write_figures(name: str, results: dict[str, Any], records: list[dict[str, Any]],

@@ -1,7 +1,7 @@
 """The files an experiment writes and reads back, sealed, and the check of its folder.
 
 An experiment folder ``DIR`` holds one run record per finished run (``DIR/runs/*.json``),
-``DIR/results.json`` and ``DIR/table.md`` (plus PNG figures, which nothing reads back).
+``DIR/results.json``, ``DIR/table.md`` and PNG figures (which nothing reads back).
 Records and ``results.json`` are sealed JSON documents
 (:mod:`scenegen.io.sealed`: a ``sha256`` key over the canonical content, written
 atomically). ``results.json`` also lists, under ``records``, every run file it was
@@ -18,7 +18,9 @@ tied to exactly those records.
   record reads, matches its digest, its listed digest and its file name, and has the
   record's fields; ``results.json`` equals the summary recomputed from those records (so
   an edit whose digest was recomputed is still found); ``table.md`` is the table of
-  ``results.json``. With ``deep``, every run is also computed again and compared. When
+  ``results.json``; each figure the experiment writes
+  (:func:`scenegen.lab.experiments.figures.figure_names`) is there and a PNG file. With
+  ``deep``, every run is also computed again and compared. When
   only the summary or the table differs, the line names :func:`rerun_command`, which
   recomputes both from the intact runs, and the versions (:data:`WRITTEN_BY`) that
   differ between the software that wrote ``results.json`` and this one.
@@ -37,6 +39,7 @@ from pathlib import Path
 from typing import Any
 
 from scenegen.errors import DataError
+from scenegen.io.atomic import SpecialFile, read_regular, read_regular_text
 from scenegen.io.sealed import content_digest, read_sealed_json, write_sealed_json
 
 __all__ = [
@@ -669,6 +672,7 @@ def _check_experiment(folder: str | Path, deep: bool) -> tuple[list[str], list[d
     """:func:`check_experiment`'s lines, and the ``key`` of every record it read."""
     from scenegen.lab.experiments import results_document
     from scenegen.lab.experiments.definitions import get
+    from scenegen.lab.experiments.figures import figure_names
     from scenegen.lab.experiments.runner import Task, run_task
     from scenegen.lab.experiments.tables import render_table
     from scenegen.lab.experiments.why import WHY
@@ -724,9 +728,12 @@ def _check_experiment(folder: str | Path, deep: bool) -> tuple[list[str], list[d
                         f"(edited, {redo()})")  # fmt: skip
     table = root / "table.md"
     try:
-        text = table.read_text(encoding="utf-8")
+        text = read_regular_text(table)
     except FileNotFoundError:
         problems.append(f"{table}: missing")
+    except SpecialFile as err:
+        problems.append(f"{err} (remove it, then `{rerun_command(exp, keys, root)}` writes "
+                        "the table again)")  # fmt: skip
     except (OSError, UnicodeDecodeError) as err:
         problems.append(f"{table}: unreadable ({type(err).__name__})")
     else:
@@ -736,12 +743,33 @@ def _check_experiment(folder: str | Path, deep: bool) -> tuple[list[str], list[d
         if text != render_table(exp, shown, WHY.get(exp.name, "")):
             problems.append(f"{table}: is not the table of {res_path.name} (damaged, edited, "
                             f"{redo()})")  # fmt: skip
+    for name in figure_names(exp.name, fresh, records):
+        problems += _figure_problems(root / name, lambda: rerun_command(exp, keys, root))
     if deep and not problems:
         for (name, _), rec in zip(entries, records, strict=True):
             again = json.loads(json.dumps(run_task(Task(**rec["key"])), sort_keys=True))
             if again != rec:
                 problems.append(f"{root / 'runs' / name}: differs from the run computed again")
     return _more(problems), keys
+
+
+_PNG = b"\x89PNG\r\n\x1a\n"
+
+
+def _figure_problems(path: Path, command: Callable[[], str]) -> list[str]:
+    """A figure the experiment writes: there, a regular file, and a PNG (nothing reads it
+    back, so only its signature is checked); ``command()`` writes it again."""
+    try:
+        head = read_regular(path)[:8]
+    except FileNotFoundError:
+        return [f"{path}: missing (`{command()}` writes it again)"]
+    except SpecialFile as err:
+        return [f"{err} (remove it, then `{command()}` writes it again)"]
+    except OSError as err:
+        return [f"{path}: unreadable ({type(err).__name__})"]
+    if head != _PNG:
+        return [f"{path}: not a PNG file (damaged: `{command()}` writes it again)"]
+    return []
 
 
 def check_report(folder: str | Path,

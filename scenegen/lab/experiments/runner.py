@@ -565,8 +565,15 @@ def load_record(path: Path, task: Task) -> dict[str, Any] | None:
     -------
     dict or None
         The stored record (without its digest), or None to compute the run.
+
+    Raises
+    ------
+    ConfigError
+        ``path`` is a FIFO, a device or a socket (``"PATH: is not a regular file (a
+        FIFO); remove it"``): the run could not be stored there, so it is not computed.
     """
-    from scenegen.errors import DataError
+    from scenegen.errors import ConfigError, DataError
+    from scenegen.io.atomic import SpecialFile
     from scenegen.io.sealed import content_digest
     from scenegen.lab.experiments.outputs import listed_digest, read_record, warn
 
@@ -574,6 +581,8 @@ def load_record(path: Path, task: Task) -> dict[str, Any] | None:
         return None
     try:
         data = read_record(path)
+    except SpecialFile as err:  # its run could not be stored there: refused before running
+        raise ConfigError(f"{err}; remove it") from None
     except DataError as err:
         warn(f"{err}; computing this run again")
         return None

@@ -131,6 +131,9 @@ def test_validate_reports_missing_and_foreign_files(reference, tmp_path):
     problems = validate_dataset(out)
     assert any("shard-00001.h5: missing shard file" in p for p in problems)
     assert any("shard-00009.h5: shard file not listed" in p for p in problems)
+    os.mkfifo(out / "shard-00001.h5")  # was called a missing shard file
+    assert f"{out / 'shard-00001.h5'}: is not a regular file (a FIFO) where a shard file " \
+        f"belongs ({SHARD} sequences)" in validate_dataset(out)
     assert validate_dataset(tmp_path) == [f"{tmp_path}: not a dataset folder (no manifest.json)"]
 
 

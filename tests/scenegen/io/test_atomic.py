@@ -298,3 +298,32 @@ def test_a_device_or_fifo_is_never_replaced_and_a_link_is_written_through(tmp_pa
     link.symlink_to(real)
     write_text(link, "new")
     assert link.is_symlink() and real.read_text() == "new"
+
+
+def test_read_regular_refuses_a_fifo_a_device_and_a_folder_at_once(tmp_path, deadline):
+    # Path.read_bytes() on a FIFO waits for a writer for ever: `scenegen validate` hung on
+    # a FIFO in place of an output folder's table.md, leaderboard.md or index.html.
+    from scenegen.io.atomic import SpecialFile, read_regular, read_regular_text
+
+    fifo = tmp_path / "table.md"
+    os.mkfifo(fifo)
+    link = tmp_path / "link.md"
+    link.symlink_to(fifo)
+    with deadline(10):
+        for p in (fifo, link):
+            with pytest.raises(SpecialFile, match=f"^{p}: is not a regular file \\(a FIFO\\)$"):
+                read_regular(p)
+        if os.path.exists("/dev/zero"):
+            with pytest.raises(SpecialFile, match="/dev/zero: is not a regular file \\(a dev"):
+                read_regular_text("/dev/zero")
+    with pytest.raises(IsADirectoryError, match=str(tmp_path)):
+        read_regular(tmp_path)
+    with pytest.raises(FileNotFoundError):
+        read_regular(tmp_path / "none")
+    text = tmp_path / "crlf.md"
+    text.write_bytes(b"a\r\nb\rc\n\xc3\xa9")
+    assert read_regular(text) == text.read_bytes()
+    assert read_regular_text(text) == text.read_text(encoding="utf-8") == "a\nb\nc\né"
+    text.write_bytes(b"\xff")
+    with pytest.raises(UnicodeDecodeError):
+        read_regular_text(text)

@@ -923,6 +923,53 @@ def test_a_kept_file_made_a_link_is_not_written_through(dataset, kept, tmp_path,
     assert check_benchmark(out) == [] and files(out) == files(kept)
 
 
+def test_a_fifo_in_a_benchmark_folder_is_one_line_and_never_waited_on(dataset, kept, tmp_path,
+                                                                    deadline):  # fmt: skip
+    """A FIFO in place of a page, a figure or a kept file: validate names it in one line;
+    with a kept file, the command run again refuses in one line before running anything.
+    validate waited for ever on a page or a figure and called a kept FIFO "missing"; the
+    command waited for ever on a kept FIFO (reading it for its digest)."""
+    import os
+
+    from scenegen.errors import ConfigError
+    from scenegen.lab.benchmark_outputs import check_benchmark
+
+    out = tmp_path / "b"
+    shutil.copytree(kept, out)
+    figure = next(out.glob("*.png"))
+    pages = [out / n for n in ("leaderboard.md", "scores.csv", "index.html")] + [figure]
+    kept_files = [_track(out, "sok", 2), out / "trackeval/gt/mot_challenge/seqmaps/"
+                  "scenegen-all.txt"]  # fmt: skip
+    for p in pages + kept_files:
+        body = p.read_bytes()
+        p.unlink()
+        os.mkfifo(p)
+        fix = (f"remove it, then {_REDO}" if p in kept_files else
+               "remove it, then run the same `scenegen benchmark` command again into this "
+               "folder to recompute it")  # fmt: skip
+        with deadline(30):
+            assert check_benchmark(out) == [f"{p}: is not a regular file (a FIFO) ({fix})"]
+            if p in kept_files:
+                ran = []
+                with pytest.raises(ConfigError, match=f"^{p}: is not a regular file \\(a "
+                                   "FIFO\\); remove it$"):  # fmt: skip
+                    run_benchmark(dataset, TRACKERS, out, params=PARAMS, jobs=1,
+                                  on_done=ran.append)  # fmt: skip
+                assert ran == [] and p.is_fifo()
+        p.unlink()
+        p.write_bytes(body)
+    assert check_benchmark(out) == [] and files(out) == files(kept)
+    # A page the benchmark would write only after every run: refused before the first.
+    shutil.rmtree(out / "runs")
+    page = out / "leaderboard.md"
+    page.unlink()
+    os.mkfifo(page)
+    ran = []
+    with deadline(30), pytest.raises(ConfigError, match=f"^{page}: is not a regular file"):
+        run_benchmark(dataset, TRACKERS, out, params=PARAMS, jobs=1, on_done=ran.append)
+    assert ran == [] and not (out / "runs").exists()
+
+
 def test_deep_compares_each_tracker_file_with_its_run_again(kept, tmp_path):
     """A tracker file replaced and its digest listed again (results.json resealed) is
     found only by the runs computed again."""

@@ -14,6 +14,7 @@ import pytest
 from scenegen.cli import experiment as cli_experiment
 from scenegen.errors import ConfigError
 from scenegen.lab.experiments import derive_seed, get, names, run_experiment
+from scenegen.lab.experiments.figures import figure_names
 from scenegen.lab.experiments.runner import (
     BATCH,
     Task,
@@ -374,7 +375,7 @@ def test_cli_exit_codes_for_bad_input(tmp_path, capsys):
         ("kams-accuracy", ["sok"], ["centre_error.png"]),
         ("kams-robustness", ["kams", "meanshift"], ["robustness_z.png"]),
         ("shm-depth", ["kalman", "shm-fast"], ["ordering_probability.png"]),
-        ("dps-dancers", ["ps-1234", "dps"], ["success_recovery.png"]),
+        ("dps-dancers", ["ps-1234", "dps"], ["success_recovery.png", "uniqueness.png"]),
     ],
 )
 def test_every_experiment_end_to_end_in_quick_mode(tmp_path, name, methods, figures):
@@ -386,6 +387,56 @@ def test_every_experiment_end_to_end_in_quick_mode(tmp_path, name, methods, figu
     assert "Indicative only" in table
     for f in figures:
         assert (tmp_path / f).stat().st_size > 1000, f
+    records = [json.loads(p.read_text()) for p in sorted((tmp_path / "runs").iterdir())]
+    assert figure_names(name, res, records) == figures  # what validate checks
+    assert sorted(p.name for p in tmp_path.glob("*.png")) == sorted(figures)
+
+
+def test_a_damaged_figure_or_table_is_one_line_and_never_waited_on(tmp_path, capsys,
+                                                                   deadline):  # fmt: skip
+    """Each figure the experiment writes is checked: missing, not a PNG, or a FIFO is one
+    line naming the command that writes it again (validate said "valid" for all three); a
+    FIFO in place of table.md is one line (validate waited for ever)."""
+    import shlex
+
+    from scenegen.cli import main
+
+    assert main(["experiment", "shm-depth", "--runs", "1", "--scenes", "1", "--quick",
+                 "--method", "shm-fast", "--jobs", "1", "-o", str(tmp_path)]) == 0
+    command = (f"scenegen experiment shm-depth --scenes 1 --quick --method shm-fast "
+               f"-o {tmp_path}")  # fmt: skip
+    figure, table = tmp_path / "ordering_probability.png", tmp_path / "table.md"
+    saved = {p: p.read_bytes() for p in (figure, table)}
+    again = f"`{command}` writes it again"
+    for path, damage, what in [
+        (figure, lambda p: p.unlink(), f"missing ({again})"),
+        (figure, lambda p: p.write_bytes(b"GIF89a" + saved[p]), f"not a PNG file (damaged: "
+         f"{again})"),
+        (figure, lambda p: (p.unlink(), os.mkfifo(p)), "is not a regular file (a FIFO) "
+         f"(remove it, then {again})"),
+        (table, lambda p: (p.unlink(), os.mkfifo(p)), "is not a regular file (a FIFO) "
+         f"(remove it, then `{command}` writes the table again)"),
+    ]:
+        damage(path)
+        capsys.readouterr()
+        with deadline(60):
+            assert main(["validate", str(tmp_path)]) == 1
+        assert capsys.readouterr().err.splitlines() == [f"{path}: {what}"]
+        if not path.is_fifo():
+            assert main(shlex.split(command)[1:]) == 0
+        path.unlink(missing_ok=True)
+        path.write_bytes(saved[path])
+        assert main(["validate", str(tmp_path)]) == 0
+    # A file the experiment writes after its runs: refused before the first run.
+    shutil.rmtree(tmp_path / "runs")
+    table.unlink()
+    os.mkfifo(table)
+    capsys.readouterr()
+    with deadline(60):
+        assert main(shlex.split(command)[1:]) == 2
+    assert capsys.readouterr().err.splitlines() == [
+        f"scenegen: error: {table}: is not a regular file (a FIFO)"]
+    assert not (tmp_path / "runs").exists()
 
 
 def test_experiment_all_writes_one_report(tmp_path, monkeypatch, capsys):
@@ -404,7 +455,8 @@ def test_experiment_all_writes_one_report(tmp_path, monkeypatch, capsys):
     assert main(["experiment", "all", "--value", "20", "-o", str(tmp_path)]) == 2
 
 
-def test_a_stale_report_names_the_command_that_writes_it_again(tmp_path, monkeypatch, capsys):
+def test_a_stale_report_names_the_command_that_writes_it_again(tmp_path, monkeypatch, capsys,
+                                                               deadline):  # fmt: skip
     # The report's results.json no longer holds its experiments' results (edited, or written
     # by another version): `validate` names the command, which rewrites it from the intact
     # experiments without computing a run again.
@@ -450,10 +502,15 @@ def test_a_stale_report_names_the_command_that_writes_it_again(tmp_path, monkeyp
         (lambda: index.write_bytes(b"\xff\xfe" + page),
          f"unreadable (UnicodeDecodeError); `{command}` writes it again"),
         (index.unlink, f"missing; `{command}` writes it again"),
+        # validate waited for ever on a FIFO there
+        (lambda: (index.unlink(), os.mkfifo(index)),
+         f"is not a regular file (a FIFO): remove it; `{command}` writes it again"),
     ]:
         damage()
-        assert main(["validate", str(tmp_path)]) == 1
+        with deadline(60):
+            assert main(["validate", str(tmp_path)]) == 1
         assert capsys.readouterr().err.splitlines() == [f"{index}: {what}"]
+        index.unlink(missing_ok=True)
         index.write_bytes(page)
     assert main(shlex.split(command)[1:]) == 0
     assert index.read_bytes() == page

@@ -152,7 +152,7 @@ def test_a_list_valued_override_resumes_and_validates(tmp_path, capsys):
     from scenegen.cli import main
 
     kw = dict(runs=1, scenes=1, quick=True, methods=["dps"], jobs=1, progress=False,
-              figures=False, overrides={"sigma": [1.0, 1.0, 0.01]})  # fmt: skip
+              overrides={"sigma": [1.0, 1.0, 0.01]})  # fmt: skip
     run_experiment(NAME, tmp_path, **kw)
     (path,) = (tmp_path / "runs").iterdir()
     (task,) = plan_tasks(EXP, runs=1, scenes=1, seed=0, quick=True, methods=["dps"],
@@ -178,7 +178,7 @@ def test_an_override_with_more_than_six_decimals_keeps_its_run(tmp_path, capsys)
 
     over = {"sigma": [1.0, 1.0, 0.0012345678]}
     kw = dict(runs=1, scenes=1, quick=True, methods=["dps"], jobs=1, progress=False,
-              figures=False, overrides=over)  # fmt: skip
+              overrides=over)  # fmt: skip
     run_experiment(NAME, tmp_path, **kw)
     (path,) = (tmp_path / "runs").iterdir()
     record = json.loads(path.read_text())

@@ -296,6 +296,24 @@ def test_a_damaged_registry_is_named(tmp_path, text, needle):
     assert needle in str(info.value)
 
 
+def test_a_fifo_registry_is_named_not_waited_on(tmp_path, deadline):
+    # The plugin and `scenegen fixtures verify` read a FIFO registry.json for ever.
+    import os
+
+    from scenegen.errors import DataError
+    from scenegen.testing.fixtures import load_registry
+    from scenegen.testing.pytest_plugin import _check_digests
+
+    reg = tmp_path / "registry.json"
+    os.mkfifo(reg)
+    with deadline(20):
+        with pytest.raises(AssertionError, match=f"{reg}: not a readable JSON registry: "
+                           f"{reg}: is not a regular file \\(a FIFO\\)"):  # fmt: skip
+            _check_digests(reg, "small", None)
+        with pytest.raises(DataError, match=f"^{reg}: is not a regular file \\(a FIFO\\)$"):
+            load_registry(tmp_path, missing_ok=False)
+
+
 def test_cache_key_changes_with_every_input():
     from scenegen.config import from_dict
 
