@@ -833,9 +833,12 @@ def run_benchmark(
             todo.append(t)
             continue
         records[(t.tracker, t.index)] = rec
-        if keep and not (listed.get(t.filename(), ("",))[0] == content_digest(rec) and
-                         bt.sound_file(outp, bt.track_file(t.tracker, names[t.index]),
-                                       listed_t)):  # fmt: skip
+        if not keep:
+            continue
+        track, digest = bt.track_file(t.tracker, names[t.index]), content_digest(rec)
+        listed_ok = (listed.get(t.filename(), ("",))[0] == digest
+                     and bt.sound_file(outp, track, listed_t))  # fmt: skip
+        if not (listed_ok or bt.pending_sound(outp, t.filename(), track, digest)):
             todo.append(t)  # run again for its tracks only
     bar = tqdm(total=len(tasks), initial=len(records), disable=not progress, unit="run",
                desc="benchmark", leave=False)  # fmt: skip
@@ -859,6 +862,9 @@ def run_benchmark(
             write_sealed_json(outp / t.filename(), rec, parents=True)
             records[(t.tracker, t.index)] = _content(rec)
             bar.update(1)
+        if keep:  # resumable from here without running the pair again
+            bt.write_pending(outp, t.filename(), bt.track_file(t.tracker, names[t.index]),
+                             content_digest(records[(t.tracker, t.index)]))  # fmt: skip
         if on_done is not None:
             on_done(t)
 
@@ -881,7 +887,9 @@ def run_benchmark(
             warn(f"{gone}: removed from the kept tracks (not a tracker or sequence of this "
                  "benchmark; TrackEval would read it)")  # fmt: skip
         tracks = [f"{n} {bt.file_digest(outp / n)}" for n in kept]
-    return write_outputs(outp, meta, list(trackers), ordered, tracks)
+    results = write_outputs(outp, meta, list(trackers), ordered, tracks)
+    bt.remove_pending(outp)  # results.json lists the kept files now
+    return results
 
 
 def _content(rec: dict[str, Any]) -> dict[str, Any]:

@@ -23,9 +23,14 @@ with the seqmap ``scenegen-multi.txt`` (``--SEQMAP_FILE``).
 
 Every file is written atomically. ``results.json`` lists them under ``tracks``
 (``"trackeval/... SHA256"``, the digest of the file's bytes), a key it has only when the
-tracks are kept; a run record is the same with or without them. A resumed benchmark
-keeps a file whose digest is the one listed (with the run record listed beside it), and
-runs its pair again otherwise; the run record it gives must be the stored one.
+tracks are kept; a run record is the same with or without them. Until ``results.json``
+lists them (it is written last), each pair's tracker file has a sealed note in
+:data:`PENDING`, written after the file and its run record: the file's digest and the
+record's. A resumed benchmark keeps a file whose digest is the one listed (with the run
+record listed beside it) or the one its note gives (with that run record), and runs its
+pair again otherwise; the run record it gives must be the stored one. So a benchmark
+interrupted after writing some tracks resumes without running their pairs again; the
+notes are removed once ``results.json`` lists the files.
 :func:`check_tracks` is the part of ``scenegen validate OUT`` that checks the folder.
 """
 
@@ -43,14 +48,18 @@ __all__ = [
     "BENCHMARK",
     "FOLDER",
     "GT_MODE",
+    "PENDING",
     "SPLIT",
     "check_tracks",
     "file_digest",
     "gt_files",
     "kept_files",
     "listed_tracks",
+    "pending_file",
+    "pending_sound",
     "pair_with_tracks",
     "prepare_folder",
+    "remove_pending",
     "remove_unlisted",
     "seqmap_file",
     "seqmap_text",
@@ -59,6 +68,7 @@ __all__ = [
     "track_file",
     "unlisted",
     "write_gt",
+    "write_pending",
     "write_tracks",
 ]
 
@@ -73,6 +83,10 @@ MULTI = "multi"
 GT_MODE = "amodal"
 """The ground-truth mode the benchmark scores with (:func:`scenegen.evaluation.evaluate`'s
 default) and the kept ``gt.txt`` files are written in."""
+
+PENDING = "tracks-pending"
+"""The folder, in the output folder, of the notes of the tracker files written since
+``results.json`` last listed them (:func:`write_pending`)."""
 
 _GT = f"{FOLDER}/gt/mot_challenge"
 _TRACKERS = f"{FOLDER}/trackers/mot_challenge/{BENCHMARK}-{SPLIT}"
@@ -556,6 +570,110 @@ def listed_tracks(out: Path, meta: dict[str, Any]) -> dict[str, str]:
     if any(res["dataset"].get(k) != meta.get(k) for k in ("family_digest", "seed", "count")):
         return {}
     return dict(parse_listing(res.get("tracks")) or [])
+
+
+def pending_file(run_name: str) -> str:
+    """The note of a pair's tracker file, relative to the output folder.
+
+    Parameters
+    ----------
+    run_name : str
+        The pair's run file (``"runs/TRACKER/NNNNN.json"``).
+
+    Returns
+    -------
+    str
+        ``"tracks-pending/TRACKER/NNNNN.json"``.
+
+    Examples
+    --------
+    >>> pending_file("runs/kalman/00007.json")
+    'tracks-pending/kalman/00007.json'
+    """
+    return f"{PENDING}/{run_name.removeprefix('runs/')}"
+
+
+def write_pending(out: Path, run_name: str, track: str, record_digest: str) -> None:
+    """Write the note of a pair's tracker file (sealed, atomically), once the file and the
+    pair's run record are written: the file's name and digest, and the record's digest.
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        The benchmark's output folder.
+    run_name : str
+        The pair's run file (``"runs/TRACKER/NNNNN.json"``).
+    track : str
+        Its tracker file (:func:`track_file`).
+    record_digest : str
+        :func:`scenegen.io.sealed.content_digest` of its run record.
+    """
+    from scenegen.io.sealed import write_sealed_json
+
+    write_sealed_json(out / pending_file(run_name), {
+        "file": track, "file_digest": file_digest(out / track), "record_digest": record_digest,
+    }, parents=True)  # fmt: skip
+
+
+def pending_sound(out: Path, run_name: str, track: str, record_digest: str) -> bool:
+    """Whether a pair's tracker file is the one its note (:func:`write_pending`) says, for
+    the run record of digest ``record_digest``.
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        The benchmark's output folder.
+    run_name : str
+        The pair's run file.
+    track : str
+        Its tracker file.
+    record_digest : str
+        The digest of its stored run record.
+
+    Returns
+    -------
+    bool
+        False for no note, a damaged or edited one, one of another record, or a tracker
+        file that is missing or of another digest.
+
+    Raises
+    ------
+    scenegen.errors.ConfigError
+        The note is a FIFO, a device or a socket (it could not be written again).
+    """
+    from scenegen.errors import ConfigError, DataError
+    from scenegen.io.atomic import SpecialFile
+    from scenegen.io.sealed import read_sealed_json
+
+    path = Path(out) / pending_file(run_name)
+    if not path.exists():
+        return False
+    try:
+        note = read_sealed_json(path)
+    except SpecialFile as err:
+        raise ConfigError(f"{err}; remove it") from None
+    except DataError:
+        return False
+    digest = file_digest(Path(out) / track)
+    return digest is not None and note == {"file": track, "file_digest": digest,
+                                           "record_digest": record_digest}  # fmt: skip
+
+
+def remove_pending(out: Path) -> None:
+    """Remove the notes (:data:`PENDING`), once ``results.json`` lists the files.
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        The benchmark's output folder.
+    """
+    import shutil
+
+    path = Path(out) / PENDING
+    if path.is_symlink() or path.is_file():
+        path.unlink()
+    elif path.is_dir():
+        shutil.rmtree(path)
 
 
 def sound_file(out: Path, name: str, listed: dict[str, str]) -> bool:

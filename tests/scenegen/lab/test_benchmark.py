@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 
 from scenegen.datasets import build_dataset
-from scenegen.lab.benchmark import leaderboard, run_benchmark
+from scenegen.lab.benchmark import leaderboard, run_benchmark, run_file
 
 TWO = {
     "width": 64, "height": 48, "n_frames": 5,
@@ -751,6 +751,49 @@ def test_resume_writes_the_missing_tracks_and_keeps_the_records(dataset, referen
     run_benchmark(dataset, TRACKERS, out, params=PARAMS, jobs=1, keep_tracks=True,
                   on_done=ran.append)  # fmt: skip
     assert ran == [] and files(out) == files(kept)
+
+
+def test_an_interrupted_benchmark_keeps_the_tracks_it_wrote(dataset, kept, tmp_path):
+    """Interrupted after 3 of its 8 pairs, a --keep-tracks benchmark run again runs only
+    the 5 others (it ran all 8 again: no results.json listed the 3 tracker files yet), but
+    also a pair whose tracker file was edited since, or whose note was; it ends as an
+    uninterrupted run, without its notes."""
+    from scenegen.lab.benchmark_tracks import PENDING, pending_file
+
+    class Stop(Exception):
+        pass
+
+    out = tmp_path / "b"
+    done = []
+
+    def stop_after_3(t):
+        done.append((t.tracker, t.index))
+        if len(done) == 3:
+            raise Stop
+
+    with pytest.raises(Stop):
+        run_benchmark(dataset, TRACKERS, out, params=PARAMS, jobs=1, keep_tracks=True,
+                      on_done=stop_after_3)  # fmt: skip
+    assert not (out / "results.json").exists()
+    assert sorted(p.relative_to(out).as_posix() for p in (out / PENDING).rglob("*.json")) == \
+        sorted(pending_file(run_file(t, i)) for t, i in done)
+    ran = []
+    again = dict(params=PARAMS, jobs=1, keep_tracks=True, on_done=ran.append)
+    shutil.copytree(out, tmp_path / "c")
+    run_benchmark(dataset, TRACKERS, out, **again)
+    pairs = [(t, i) for t in TRACKERS for i in range(4)]
+    assert [(t.tracker, t.index) for t in ran] == [p for p in pairs if p not in done]
+    assert files(out) == files(kept) and not (out / PENDING).exists()
+    # The same interrupted folder, one kept file edited and one note damaged.
+    out = tmp_path / "c"
+    f = _track(out, *done[0])
+    f.write_bytes(f.read_bytes().replace(b",", b", ", 1))
+    note = out / pending_file(run_file(*done[1]))
+    note.write_bytes(note.read_bytes()[:-3])
+    ran.clear()
+    run_benchmark(dataset, TRACKERS, out, **again)
+    assert [(t.tracker, t.index) for t in ran] == [p for p in pairs if p not in done[2:]]
+    assert files(out) == files(kept)
 
 
 def test_a_tracker_dropped_from_a_benchmark_leaves_its_kept_tracks(dataset, kept, tmp_path,
