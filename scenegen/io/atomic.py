@@ -33,7 +33,7 @@ import shutil
 import socket
 import stat
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -50,6 +50,7 @@ __all__ = [
     "discard_temp_files",
     "read_regular",
     "read_regular_text",
+    "refuse_special_files",
     "SpecialFile",
     "temp_file_owner",
     "temp_prefix",
@@ -228,6 +229,26 @@ def describe_special_file(path: str | Path) -> str | None:
     except (OSError, ValueError):
         return None
     return _special_text(path, mode)
+
+
+def refuse_special_files(paths: Iterable[str | Path]) -> None:
+    """Refuse, before any work, a FIFO, a device or a socket among the files a command is
+    about to write (writing it would fail only at the end; reading it would wait).
+
+    Parameters
+    ----------
+    paths : iterable of str or Path
+        The files to be written.
+
+    Raises
+    ------
+    ConfigError
+        :func:`describe_special_file`'s line for the first such file.
+    """
+    for p in paths:
+        special = describe_special_file(p)
+        if special is not None:
+            raise ConfigError(special)
 
 
 def _special_text(path: str | Path, mode: int) -> str | None:

@@ -808,12 +808,11 @@ def run_benchmark(
         raise ConfigError(f"-o {outp}: holds {what}; write the benchmark into another "
                           "folder")  # fmt: skip
     make_output_folder(outp)
-    from scenegen.io.atomic import describe_special_file
+    from scenegen.io.atomic import refuse_special_files
 
-    for p in [outp / n for n in ("results.json", *PAGES)] + sorted(outp.glob("*.png")):
-        special = describe_special_file(p)
-        if special is not None:  # refused before any run, not after them all
-            raise ConfigError(special)
+    # Refused before any run, not after them all.
+    refuse_special_files([outp / n for n in ("results.json", *PAGES)]
+                         + sorted(outp.glob("*.png")))  # fmt: skip
     meta = dataset_meta(man, root)
     listed = listed_digests(outp, meta)
     from scenegen.lab import benchmark_tracks as bt

@@ -22,7 +22,7 @@ from typing import Any
 
 from scenegen.datasets.build import holds_report, make_output_folder
 from scenegen.errors import ConfigError, DataError
-from scenegen.io.atomic import describe_special_file
+from scenegen.io.atomic import refuse_special_files
 from scenegen.io.sealed import write_sealed_json
 from scenegen.lab.experiments import (
     get,
@@ -133,10 +133,7 @@ def run_all(
 
     check_report_folder(out_dir)
     out = Path(out_dir) / "experiments"
-    for page in ("index.html", "results.json"):
-        special = describe_special_file(Path(out_dir) / page)
-        if special is not None:
-            raise ConfigError(special)
+    refuse_special_files(Path(out_dir) / page for page in ("index.html", "results.json"))
     for name in names():  # before any run, not after the experiments before it
         refuse_special_outputs(out / name)
     # One set of workers for every experiment, given every experiment's tasks at once: they

@@ -42,7 +42,7 @@ from scenegen.datasets.build import (
     make_output_folder,
 )
 from scenegen.errors import ConfigError
-from scenegen.io.atomic import describe_special_file
+from scenegen.io.atomic import describe_special_file, refuse_special_files
 from scenegen.lab.experiments.definitions import EXPERIMENTS, PAPER, Experiment, Method, get, names
 from scenegen.lab.experiments.outputs import (
     RECORDS,
@@ -201,10 +201,7 @@ def refuse_special_outputs(out: Path) -> None:
     ConfigError
         ``"PATH: is not a regular file (a FIFO)"``.
     """
-    for p in [out / "results.json", out / "table.md", *sorted(out.glob("*.png"))]:
-        special = describe_special_file(p)
-        if special is not None:
-            raise ConfigError(special)
+    refuse_special_files([out / "results.json", out / "table.md", *sorted(out.glob("*.png"))])
 
 
 def run_experiment(
