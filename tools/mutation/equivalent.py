@@ -958,15 +958,16 @@ EQUIVALENT["profiles"] = [  # noqa: F821
     ("kbuf[c - c0] = 0", "kbuf[c - c0] = 1", _UNCOVERED),
     ("kbuf[c - c0] = 0", "kbuf[c + c0] = 0", _UNCOVERED),
 ]
-_BIT_IDENTICAL = ("only chooses the path: a reference's boxes then all take the direct path, "
-                  "which gives the same bits as the integral path (the tests compare them bit "
-                  "for bit); only the time changes")
 EQUIVALENT["histogram"] = [  # noqa: F821
-    ("n_groups += 1", "n_groups += 0",
-     "no group is formed (starts[:1] = [n_boxes]): " + _BIT_IDENTICAL),
-    ("if integral_ok and method != METHOD_DIRECT and n_boxes > 0:",
-     "if integral_ok and method != METHOD_DIRECT and n_boxes >= 0:",
-     "with no boxes, _reference_groups returns no group: the loop over groups is empty"),
+    # 2026-12-05, the path choice made observable (region_paths, and the direct-path mask
+    # _region_distances returns): "n_groups += 0" and the "n_boxes > 0" guard were
+    # equivalent while only the distances were compared; the first is now killed by
+    # tests/trackers/models/test_histogram_paths.py, the second's line is gone.
+    ("n_chunks = max(min(n_chunks, n_boxes), 1)", "n_chunks = max(min(n_chunks, n_boxes), 0)",
+     "n_chunks (the thread count) is at least 1: the bound is 0 only with no boxes, when "
+     "there is nothing to score"),
+    ("for g in prange(integral.shape[0]):", "for g in prange(integral.shape[ -1]):",
+     "integral is one-dimensional (G,): shape[-1] is shape[0]"),
     ("rects = np.empty((n_levels, 4), dtype=np.int64)",
      "rects = np.empty((n_levels, 5), dtype=np.int64)",
      "a fifth column that nothing writes or reads"),

@@ -92,9 +92,11 @@ _RENDER_TESTS = (
 # and shrinking it took 20-40 s a mutant in the generator's drawn scenes.
 _NO_SHRINK = {"HYPOTHESIS_PROFILE": "mutate"}
 # The histogram kernels' tests: per-box numpy transcriptions of every kernel, the paths
-# (direct, support, integral) against them and against each other, the box kernel.
+# (direct, support, integral) against them and against each other, the box kernel, and
+# which path each box takes (the cost model transcribed, the dispatch following it).
 _HISTOGRAM_TESTS = (
     "tests/trackers/models/test_observation.py", "tests/trackers/models/test_box_kernel.py",
+    "tests/trackers/models/test_histogram_paths.py",
 )
 
 # A mutant of a file of trackers/kernels drops every kernel's numba cache (numba_cache.py),
@@ -346,8 +348,8 @@ MODULES: dict[str, Module] = {
     # and ROI), the parallel dispatch, and the Bhattacharyya coefficient and distance.
     "histogram": Module(
         "trackers/kernels/histogram.py",
-        ("_reference_groups", "_integral_group", "_region_distances", "_support",
-         "bhattacharyya_coefficient", "bhattacharyya_distance"),
+        ("_reference_groups", "_integral_cheaper", "_plan_paths", "_region_distances",
+         "_support", "region_paths", "bhattacharyya_coefficient", "bhattacharyya_distance"),
         _HISTOGRAM_TESTS, {"NUMBA_BOUNDSCHECK": "1", **_NO_SHRINK}, min_timeout=_KERNEL_TIMEOUT,
     ),
 }

@@ -8,7 +8,8 @@ Bhattacharyya distances to reference histograms (``region_distances``, which nev
 materialises the (P, B) histogram array).
 
 This module holds those entry points and, per reference, the choice between the two
-evaluation paths (a fitted cost model); the work is in four modules it re-exports from:
+evaluation paths (a fitted cost model; ``region_paths`` tells which path each box takes);
+the work is in four modules it re-exports from:
 ``quantize`` (the bin-index image), ``profiles`` (kernel codes, box-kernel levels, the
 pixel rule of a box and each row's fixed-point weights), ``direct`` (pixel-by-pixel
 accumulation) and ``integral`` (integral histograms).
@@ -98,6 +99,7 @@ __all__ = [
     "quantize_rgb",
     "region_distances",
     "region_histograms",
+    "region_paths",
 ]
 
 
@@ -144,12 +146,11 @@ def _reference_groups(ref_index):
 
 
 @njit(cache=True)
-def _integral_group(bin_img, boxes, members, sqrt_refs, nz, nz_start, empty_rho, n_bins,
-                    n_parts, method, kernel, fracs, a_fixed, n_levels, out):
-    """Score one reference's boxes by the integral path if it is the cheaper (or asked
-    for); returns whether it did."""
-    rows, cols = bin_img.shape
-    roi = np.empty(4, dtype=np.int64)
+def _integral_cheaper(rows, cols, boxes, members, nz, nz_start, n_bins, n_parts, method,
+                      n_levels, roi):
+    """Whether one reference's boxes ``members`` take the integral path: it is asked for,
+    or the cost model finds it cheaper; and the integral fits in ``_MAX_CELLS`` cells.
+    Fills ``roi`` (r0, r1, c0, c1) with the union of the members' pixels."""
     # The union of the members' pixels, and what each path would cost.
     roi[0], roi[1], roi[2], roi[3] = rows, 0, cols, 0
     area = 0.0
@@ -178,12 +179,35 @@ def _integral_group(bin_img, boxes, members, sqrt_refs, nz, nz_start, empty_rho,
     cost_direct = area * _COST_PIXEL + k * (n_sup * _COST_SWEEP + _COST_BOX_DIRECT)
     cost_integral = (cells * _COST_CELL + roi_pixels * _COST_ROI
                      + k * (n_sup * n_levels * _COST_CORNER + _COST_BOX_INTEGRAL))
-    if roi[1] > roi[0] and cells <= _MAX_CELLS and (
-            method == METHOD_INTEGRAL or cost_integral < cost_direct):
-        _integral_distances(bin_img, boxes, members, sqrt_refs, nz, nz_start, empty_rho,
-                            n_bins, n_parts, roi, out, kernel, fracs, a_fixed)
-        return True
-    return False
+    return roi[1] > roi[0] and cells <= _MAX_CELLS and (
+        method == METHOD_INTEGRAL or cost_integral < cost_direct)
+
+
+@njit(cache=True)
+def _plan_paths(rows, cols, boxes, ref_index, nz, nz_start, n_bins, n_parts, kernel,
+                method, n_levels):
+    """The boxes grouped by reference, and per group whether it takes the integral path
+    (``_integral_cheaper``) and its ROI.
+
+    Returns ``order`` (P,) (boxes sorted by reference), ``starts`` (G + 1,) (where each
+    group's run starts in ``order``), ``integral`` (G,) bool and ``rois`` (G, 4); the
+    direct path alone (``method`` direct, an elliptic kernel, no box) gives no group.
+    """
+    n_boxes = boxes.shape[0]
+    if ((kernel != KERNEL_UNIFORM and kernel != KERNEL_BOX) or method == METHOD_DIRECT
+            or n_boxes == 0):
+        return (np.arange(n_boxes), np.zeros(1, dtype=np.int64),
+                np.zeros(0, dtype=np.bool_), np.zeros((0, 4), dtype=np.int64))
+    order, starts = _reference_groups(ref_index)
+    n_groups = starts.shape[0] - 1
+    integral = np.zeros(n_groups, dtype=np.bool_)
+    rois = np.zeros((n_groups, 4), dtype=np.int64)
+    for g in range(n_groups):
+        members = order[starts[g]:starts[g + 1]]
+        ref = ref_index[members[0]]
+        integral[g] = _integral_cheaper(rows, cols, boxes, members, nz[ref], nz_start[ref],
+                                        n_bins, n_parts, method, n_levels, rois[g])
+    return order, starts, integral, rois
 
 
 @njit(cache=True, parallel=True)
@@ -195,23 +219,26 @@ def _region_distances(bin_img, boxes, sqrt_refs, ref_index, nz, nz_start, empty_
     scratch, with sums in a fixed order, so the result does not depend on the number of
     threads or on how the boxes are chunked. The direct path of a reference with at most
     ``max_support`` support bins in every band counts only those (``_SMALL_SUPPORT``; the
-    same bits as the whole histogram)."""
+    same bits as the whole histogram).
+
+    Returns the distances (P,) and, per box, whether the direct path scored it (P,) bool
+    (``region_paths``' complement: the scoring follows ``_plan_paths``)."""
     n_boxes = boxes.shape[0]
-    cols = bin_img.shape[1]
+    rows, cols = bin_img.shape
     out = np.empty(n_boxes)
     direct = np.ones(n_boxes, dtype=np.bool_)
-    integral_ok = kernel == KERNEL_UNIFORM or kernel == KERNEL_BOX
     n_levels = max(a_fixed.shape[0], 1)
-    if integral_ok and method != METHOD_DIRECT and n_boxes > 0:
-        order, starts = _reference_groups(ref_index)
-        for g in prange(starts.shape[0] - 1):
+    order, starts, integral, rois = _plan_paths(rows, cols, boxes, ref_index, nz, nz_start,
+                                                n_bins, n_parts, kernel, method, n_levels)
+    for g in prange(integral.shape[0]):
+        if integral[g]:
             members = order[starts[g]:starts[g + 1]]
             ref = ref_index[members[0]]
-            if _integral_group(bin_img, boxes, members, sqrt_refs[ref], nz[ref],
-                               nz_start[ref], empty_rho[ref], n_bins, n_parts, method,
-                               kernel, fracs, a_fixed, n_levels, out):
-                for m in members:
-                    direct[m] = False
+            _integral_distances(bin_img, boxes, members, sqrt_refs[ref], nz[ref],
+                                nz_start[ref], empty_rho[ref], n_bins, n_parts, rois[g],
+                                out, kernel, fracs, a_fixed)
+            for m in members:
+                direct[m] = False
     dim = n_parts * n_bins
     # Per reference: its support bins' colours within their band, and whether every band
     # has few enough of them for the support path (``_SMALL_SUPPORT``).
@@ -240,7 +267,7 @@ def _region_distances(bin_img, boxes, sqrt_refs, ref_index, nz, nz_start, empty_
                                           nz_start[ref], empty_rho[ref], n_bins, kernel,
                                           n_parts, hist, lanes, totals, tbuf, kbuf, fracs,
                                           a_fixed, rects, colours[ref], sums, small[ref])
-    return out
+    return out, direct
 
 
 @njit(cache=True)
@@ -497,6 +524,30 @@ def prepare_references(refs: NDArray[np.floating], n_parts: int = 1) -> Prepared
                               n_parts)
 
 
+def _check_prepared_args(boxes, prepared, ref_index, kernel, method):
+    """The checks of ``prepared_distances`` and ``region_paths``; the boxes and indices as
+    contiguous float64 and int64 arrays."""
+    if method not in METHODS:
+        raise ValueError(f"unknown method {method!r}; valid: {', '.join(METHODS)}")
+    if not _is_kernel_code(kernel, KERNELS.values()):
+        raise ValueError(f"kernel must be one of {sorted(KERNELS.values())} "
+                         f"({', '.join(KERNELS)}), got {kernel!r}")
+    bx = np.ascontiguousarray(boxes, dtype=np.float64)
+    if bx.ndim != 2 or bx.shape[1] != 4:
+        raise ValueError(f"boxes must have shape (P, 4), got {bx.shape}")
+    # A NaN or an infinity makes the sum non-finite.
+    if bx.size and not (np.isfinite(bx.sum()) and bx[:, 2:].min() > 0):
+        raise ValueError("boxes must be finite with positive width and height")
+    idx = np.ascontiguousarray(ref_index, dtype=np.int64)
+    n_refs = prepared.refs.shape[0]
+    if idx.shape != (bx.shape[0],):
+        raise ValueError(f"ref_index must have shape ({bx.shape[0]},), got {idx.shape}")
+    if idx.size and (idx.min() < 0 or idx.max() >= n_refs):
+        raise ValueError(f"ref_index must lie in [0, {n_refs}), got "
+                         f"[{idx.min()}, {idx.max()}]")
+    return bx, idx
+
+
 def prepared_distances(
     bin_img: NDArray[np.integer],
     boxes: NDArray[np.floating],
@@ -543,30 +594,84 @@ def prepared_distances(
         For boxes that are not (P, 4), finite and of positive size, a ``ref_index`` of the
         wrong shape or out of range, an unknown kernel or method.
     """
-    if method not in METHODS:
-        raise ValueError(f"unknown method {method!r}; valid: {', '.join(METHODS)}")
-    if not _is_kernel_code(kernel, KERNELS.values()):
-        raise ValueError(f"kernel must be one of {sorted(KERNELS.values())} "
-                         f"({', '.join(KERNELS)}), got {kernel!r}")
-    bx = np.ascontiguousarray(boxes, dtype=np.float64)
-    if bx.ndim != 2 or bx.shape[1] != 4:
-        raise ValueError(f"boxes must have shape (P, 4), got {bx.shape}")
-    # A NaN or an infinity makes the sum non-finite.
-    if bx.size and not (np.isfinite(bx.sum()) and bx[:, 2:].min() > 0):
-        raise ValueError("boxes must be finite with positive width and height")
-    idx = np.ascontiguousarray(ref_index, dtype=np.int64)
-    n_refs = prepared.refs.shape[0]
-    if idx.shape != (bx.shape[0],):
-        raise ValueError(f"ref_index must have shape ({bx.shape[0]},), got {idx.shape}")
-    if idx.size and (idx.min() < 0 or idx.max() >= n_refs):
-        raise ValueError(f"ref_index must lie in [0, {n_refs}), got "
-                         f"[{idx.min()}, {idx.max()}]")
+    bx, idx = _check_prepared_args(boxes, prepared, ref_index, kernel, method)
     fracs, a_fixed = _level_args(int(kernel), box_levels)
     return _region_distances(bin_img, bx, prepared.sqrt_refs, idx, prepared.nz,
                              prepared.nz_start, prepared.empty_rho, prepared.n_bins,
                              int(kernel), prepared.n_parts, _lanes(prepared.refs.shape[1]),
                              METHODS[method], fracs, a_fixed, numba.get_num_threads(),
-                             _SMALL_SUPPORT)
+                             _SMALL_SUPPORT)[0]
+
+
+def region_paths(
+    bin_img: NDArray[np.integer],
+    boxes: NDArray[np.floating],
+    prepared: PreparedReferences,
+    ref_index: NDArray[np.integer],
+    kernel: int,
+    *,
+    method: str = "auto",
+    box_levels: int = DEFAULT_BOX_LEVELS,
+) -> NDArray[np.bool_]:
+    """Which boxes ``prepared_distances`` scores by the integral path.
+
+    The same compiled choice the scoring makes (one definition): per reference, the
+    integral path when ``method`` is "integral", or when it is "auto" and the fitted cost
+    model finds it cheaper than the direct path; never for the elliptic kernels, and not
+    for a reference whose integral histogram would exceed 2**24 cells. Both paths give the
+    same distances (to rounding), so this only tells where the time goes: a profiler's and
+    a test's view of the dispatch.
+
+    Parameters
+    ----------
+    bin_img : ndarray of shape (H, W), integer
+        The bin-index image (only its shape is read).
+    boxes : ndarray of shape (P, 4)
+        Candidate boxes [x, y, w, h] in pixels.
+    prepared : PreparedReferences
+        From ``prepare_references``.
+    ref_index : ndarray of shape (P,), integer
+        Row of ``prepared.refs`` that box p is compared with.
+    kernel : int
+        Kernel code, as in ``region_histograms``.
+    method : {"auto", "direct", "integral"}, optional
+        Evaluation path, as in ``region_distances``.
+    box_levels : int, optional
+        Levels L of ``KERNEL_BOX`` (ignored by the other kernels).
+
+    Returns
+    -------
+    ndarray of shape (P,), bool
+        True where box p takes the integral path, False where it takes the direct path.
+
+    Raises
+    ------
+    ValueError
+        As ``prepared_distances``, and for a ``bin_img`` that is not two-dimensional.
+
+    Examples
+    --------
+    >>> img = np.zeros((100, 100), dtype=np.int32)
+    >>> prepared = prepare_references(np.array([[0.5, 0.5]]))
+    >>> cloud = np.tile([20.0, 20.0, 40.0, 40.0], (300, 1))
+    >>> bool(region_paths(img, cloud, prepared, np.zeros(300), KERNEL_BOX).all())
+    True
+    >>> bool(region_paths(img, cloud[:1], prepared, np.zeros(1), KERNEL_BOX).any())
+    False
+    """
+    bx, idx = _check_prepared_args(boxes, prepared, ref_index, kernel, method)
+    shape = np.shape(bin_img)
+    if len(shape) != 2:
+        raise ValueError(f"bin_img must have shape (H, W), got {shape}")
+    _, a_fixed = _level_args(int(kernel), box_levels)
+    order, starts, integral, _ = _plan_paths(
+        int(shape[0]), int(shape[1]), bx, idx, prepared.nz, prepared.nz_start,
+        prepared.n_bins, prepared.n_parts, int(kernel), METHODS[method],
+        max(a_fixed.shape[0], 1))
+    taken = np.zeros(bx.shape[0], dtype=np.bool_)
+    for g in np.flatnonzero(integral):
+        taken[order[starts[g]:starts[g + 1]]] = True
+    return taken
 
 
 def bhattacharyya_coefficient(

@@ -24,6 +24,7 @@ from trackers.kernels.histogram import (
     quantize_rgb,
     region_distances,
     region_histograms,
+    region_paths,
 )
 from trackers.models.observation import ColourModel
 
@@ -171,6 +172,8 @@ def test_integral_path_is_taken_for_particle_clouds_and_matches_direct():
     boxes = np.repeat(truth, 300, axis=0)
     boxes[:, :2] += rng.normal(0.0, 4.0, (900, 2))
     index = np.repeat(np.arange(3), 300)
+    taken = region_paths(bin_img, boxes, prepare_references(refs), index, KERNEL_UNIFORM)
+    assert taken.all()  # "auto" takes the integral path for every cloud
     direct = region_distances(bin_img, boxes, refs, index, KERNEL_UNIFORM, method="direct")
     assert np.sum(direct < 1e-6) >= 3  # boxes on the references: d = 0 up to rounding
     for method in ("integral", "auto"):
@@ -494,8 +497,8 @@ def _check_support_path(seed, width, n_parts, kernel, dtype):
     args = (bin_img, boxes, prepared.sqrt_refs, index, prepared.nz, prepared.nz_start,
             prepared.empty_rho, n_bins, kernel, n_parts, _lanes(n_parts * n_bins),
             METHODS["direct"], fracs, a_fixed, 1)
-    whole = _region_distances(*args, -1)
-    support = _region_distances(*args, n_bins)
+    whole = _region_distances(*args, -1)[0]
+    support = _region_distances(*args, n_bins)[0]
     np.testing.assert_array_equal(support, whole)
     np.testing.assert_array_equal(
         region_distances(bin_img, boxes, refs, index, kernel, n_parts, method="direct"), whole)
@@ -522,7 +525,7 @@ def test_a_box_scored_against_its_own_histogram_has_distance_zero(kernel, method
             d = _region_distances(bin_img, boxes, prepared.sqrt_refs, np.arange(200),
                                   prepared.nz, prepared.nz_start, prepared.empty_rho, 3,
                                   kernel, n_parts, _lanes(3 * n_parts), METHODS[method],
-                                  fracs, a_fixed, 1, max_support)
+                                  fracs, a_fixed, 1, max_support)[0]
             assert np.all(np.isfinite(d)) and np.all(d >= 0.0)
             assert d.max() < 1e-7, (n_parts, max_support)
             assert d[0] == 0.0 and d[1] == 0.0
