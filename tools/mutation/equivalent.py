@@ -963,18 +963,23 @@ EQUIVALENT["histogram"] = [  # noqa: F821
     # _region_distances returns): "n_groups += 0" and the "n_boxes > 0" guard were
     # equivalent while only the distances were compared; the first is now killed by
     # tests/trackers/models/test_histogram_paths.py, the second's line is gone.
+    # The same day, the sample's eight unexamined survivors: the support path's choice
+    # (now _support_colours, tested), the level count and the area (killed either side
+    # of the cost model's tie), the empty-boxes guard (gone; the plan's order is tested
+    # as a permutation) and the scratch rows' slack (gone: they are the frame's width).
     ("n_chunks = max(min(n_chunks, n_boxes), 1)", "n_chunks = max(min(n_chunks, n_boxes), 0)",
      "n_chunks (the thread count) is at least 1: the bound is 0 only with no boxes, when "
      "there is nothing to score"),
     ("for g in prange(integral.shape[0]):", "for g in prange(integral.shape[ -1]):",
      "integral is one-dimensional (G,): shape[-1] is shape[0]"),
-    ("rects = np.empty((n_levels, 4), dtype=np.int64)",
-     "rects = np.empty((n_levels, 5), dtype=np.int64)",
+    ("rects = np.empty((a_fixed.shape[0], 4), dtype=np.int64)",
+     "rects = np.empty((a_fixed.shape[0], 5), dtype=np.int64)",
      "a fifth column that nothing writes or reads"),
-    ("kbuf = np.empty(cols + 2 + _PAD, dtype=np.int64)",
-     "kbuf = np.empty(cols + 1 + _PAD, dtype=np.int64)",
-     "a scratch row is read and written below index cols (the box's clipped columns, or "
-     "the support path's padded run, at most cols long when the frame is that wide)"),
+    ("rects = np.empty((a_fixed.shape[0], 4), dtype=np.int64)",
+     "rects = np.empty((a_fixed.shape[ -1], 4), dtype=np.int64)",
+     "a_fixed is one-dimensional (L,): shape[-1] is shape[0]"),
+    ("n_levels = max(a_fixed.shape[0], 1)", "n_levels = max(a_fixed.shape[ -1], 1)",
+     "a_fixed is one-dimensional (L,): shape[-1] is shape[0]"),
     ("if q[r, b] > 0:", "if q[r, b] >= 0:",
      "bins where q = 0 join the support: each adds sqrt(p) * 0 = +0.0 to rho (the same "
      "bits) and 0 to the empty band's rho; they only make the support path or the "

@@ -348,8 +348,9 @@ MODULES: dict[str, Module] = {
     # and ROI), the parallel dispatch, and the Bhattacharyya coefficient and distance.
     "histogram": Module(
         "trackers/kernels/histogram.py",
-        ("_reference_groups", "_integral_cheaper", "_plan_paths", "_region_distances",
-         "_support", "region_paths", "bhattacharyya_coefficient", "bhattacharyya_distance"),
+        ("_reference_groups", "_integral_cheaper", "_plan_paths", "_support_colours",
+         "_region_distances", "_support", "region_paths", "bhattacharyya_coefficient",
+         "bhattacharyya_distance"),
         _HISTOGRAM_TESTS, {"NUMBA_BOUNDSCHECK": "1", **_NO_SHRINK}, min_timeout=_KERNEL_TIMEOUT,
     ),
 }

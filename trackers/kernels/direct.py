@@ -139,7 +139,7 @@ def _accumulate(bin_img, x, y, w, h, n_bins, kernel, n_parts, hist, lanes, total
     """Add the fixed-point weighted pixels of box [x, y, w, h] into ``hist``.
 
     ``hist`` (lanes * n_parts * n_bins, int64) receives the weights in ``lanes`` copies,
-    ``totals`` (n_parts, int64) each band's total; ``tbuf`` and ``kbuf`` (W + 2,) are
+    ``totals`` (n_parts, int64) each band's total; ``tbuf`` and ``kbuf`` (W,) are
     scratch. Every pixel of the box's rows is visited; those outside the kernel's ellipse
     get weight 0 (finding each row's chord costs more than the pixels it skips). For the
     box kernel, ``fracs`` and ``a_fixed`` (L,) are its levels and ``rects`` (L, 4) scratch.
@@ -205,7 +205,7 @@ def _accumulate_support(bin_img, x, y, w, h, kernel, n_parts, colours, nz_start,
     """As ``_accumulate``, but only the weights of the support colours: band j's support
     bins t in [nz_start[j], nz_start[j + 1]) (colour ``colours[t]`` of the band) get their
     fixed-point weight in ``sums[t]``, each band its total in ``totals[j]`` (the support
-    path, see ``_SMALL_SUPPORT``). ``tbuf`` and ``kbuf`` (W + 2 + _PAD,) are scratch."""
+    path, see ``_SMALL_SUPPORT``). ``tbuf`` and ``kbuf`` (W,) are scratch."""
     rows, cols = bin_img.shape
     r0, r1 = _pixel_range(y, h, rows)
     c0, c1 = _pixel_range(x, w, cols)
@@ -301,8 +301,8 @@ def _region_histograms(bin_img, boxes, n_bins, kernel, n_parts, lanes, fracs, a_
     out = np.empty((n_boxes, dim))
     hist = np.zeros(lanes * dim, dtype=np.int64)
     totals = np.empty(n_parts, dtype=np.int64)
-    tbuf = np.empty(bin_img.shape[1] + 2, dtype=np.int64)
-    kbuf = np.empty(bin_img.shape[1] + 2, dtype=np.int64)
+    tbuf = np.empty(bin_img.shape[1], dtype=np.int64)
+    kbuf = np.empty(bin_img.shape[1], dtype=np.int64)
     rects = np.empty((max(fracs.shape[0], 1), 4), dtype=np.int64)
     for p in range(n_boxes):
         _accumulate(bin_img, boxes[p, 0], boxes[p, 1], boxes[p, 2], boxes[p, 3], n_bins,

@@ -59,7 +59,6 @@ from numba import njit, prange
 from numpy.typing import NDArray
 
 from trackers.kernels.direct import (
-    _PAD,
     _SMALL_SUPPORT,
     _direct_distance,
     _lanes,
@@ -185,19 +184,22 @@ def _integral_cheaper(rows, cols, boxes, members, nz, nz_start, n_bins, n_parts,
 
 @njit(cache=True)
 def _plan_paths(rows, cols, boxes, ref_index, nz, nz_start, n_bins, n_parts, kernel,
-                method, n_levels):
+                method, a_fixed):
     """The boxes grouped by reference, and per group whether it takes the integral path
     (``_integral_cheaper``) and its ROI.
 
-    Returns ``order`` (P,) (boxes sorted by reference), ``starts`` (G + 1,) (where each
-    group's run starts in ``order``), ``integral`` (G,) bool and ``rois`` (G, 4); the
-    direct path alone (``method`` direct, an elliptic kernel, no box) gives no group.
+    ``a_fixed`` (L,) are the box kernel's level weights (empty for the other kernels,
+    whose integral reads one rectangle a box: L counts as 1 in the cost).
+
+    Returns ``order`` (P,) (a permutation of the boxes, sorted by reference), ``starts``
+    (G + 1,) (where each group's run starts in ``order``), ``integral`` (G,) bool and
+    ``rois`` (G, 4); the direct path alone (``method`` direct, an elliptic kernel) gives
+    no group.
     """
-    n_boxes = boxes.shape[0]
-    if ((kernel != KERNEL_UNIFORM and kernel != KERNEL_BOX) or method == METHOD_DIRECT
-            or n_boxes == 0):
-        return (np.arange(n_boxes), np.zeros(1, dtype=np.int64),
+    if (kernel != KERNEL_UNIFORM and kernel != KERNEL_BOX) or method == METHOD_DIRECT:
+        return (np.arange(boxes.shape[0]), np.zeros(1, dtype=np.int64),
                 np.zeros(0, dtype=np.bool_), np.zeros((0, 4), dtype=np.int64))
+    n_levels = max(a_fixed.shape[0], 1)
     order, starts = _reference_groups(ref_index)
     n_groups = starts.shape[0] - 1
     integral = np.zeros(n_groups, dtype=np.bool_)
@@ -208,6 +210,25 @@ def _plan_paths(rows, cols, boxes, ref_index, nz, nz_start, n_bins, n_parts, ker
         integral[g] = _integral_cheaper(rows, cols, boxes, members, nz[ref], nz_start[ref],
                                         n_bins, n_parts, method, n_levels, rois[g])
     return order, starts, integral, rois
+
+
+@njit(cache=True)
+def _support_colours(nz, nz_start, n_bins, n_parts, max_support):
+    """Per reference, its support bins' colours within their band (``colours``, shaped
+    as ``nz``) and whether every band has at most ``max_support`` of them (``small``,
+    (R,) bool): the references whose direct path is the support path (``_SMALL_SUPPORT``).
+    """
+    n_refs = nz.shape[0]
+    colours = np.zeros_like(nz)
+    small = np.empty(n_refs, dtype=np.bool_)
+    for q in range(n_refs):
+        small[q] = True
+        for j in range(n_parts):
+            if nz_start[q, j + 1] - nz_start[q, j] > max_support:
+                small[q] = False
+            for t in range(nz_start[q, j], nz_start[q, j + 1]):
+                colours[q, t] = nz[q, t] - j * n_bins
+    return colours, small
 
 
 @njit(cache=True, parallel=True)
@@ -227,9 +248,8 @@ def _region_distances(bin_img, boxes, sqrt_refs, ref_index, nz, nz_start, empty_
     rows, cols = bin_img.shape
     out = np.empty(n_boxes)
     direct = np.ones(n_boxes, dtype=np.bool_)
-    n_levels = max(a_fixed.shape[0], 1)
     order, starts, integral, rois = _plan_paths(rows, cols, boxes, ref_index, nz, nz_start,
-                                                n_bins, n_parts, kernel, method, n_levels)
+                                                n_bins, n_parts, kernel, method, a_fixed)
     for g in prange(integral.shape[0]):
         if integral[g]:
             members = order[starts[g]:starts[g + 1]]
@@ -240,25 +260,15 @@ def _region_distances(bin_img, boxes, sqrt_refs, ref_index, nz, nz_start, empty_
             for m in members:
                 direct[m] = False
     dim = n_parts * n_bins
-    # Per reference: its support bins' colours within their band, and whether every band
-    # has few enough of them for the support path (``_SMALL_SUPPORT``).
-    n_refs = nz.shape[0]
-    colours = np.empty_like(nz)
-    small = np.empty(n_refs, dtype=np.bool_)
-    for q in range(n_refs):
-        small[q] = True
-        for j in range(n_parts):
-            if nz_start[q, j + 1] - nz_start[q, j] > max_support:
-                small[q] = False
-            for t in range(nz_start[q, j], nz_start[q, j + 1]):
-                colours[q, t] = nz[q, t] - j * n_bins
+    colours, small = _support_colours(nz, nz_start, n_bins, n_parts, max_support)
     n_chunks = max(min(n_chunks, n_boxes), 1)
     for ch in prange(n_chunks):
         hist = np.zeros(lanes * dim, dtype=np.int64)
         totals = np.empty(n_parts, dtype=np.int64)
-        tbuf = np.empty(cols + 2 + _PAD, dtype=np.int64)
-        kbuf = np.empty(cols + 2 + _PAD, dtype=np.int64)
-        rects = np.empty((n_levels, 4), dtype=np.int64)
+        # A row's weights and squared offsets: at most the frame's width (``direct``).
+        tbuf = np.empty(cols, dtype=np.int64)
+        kbuf = np.empty(cols, dtype=np.int64)
+        rects = np.empty((a_fixed.shape[0], 4), dtype=np.int64)
         sums = np.empty(dim, dtype=np.int64)
         for p in range(ch * n_boxes // n_chunks, (ch + 1) * n_boxes // n_chunks):
             if direct[p]:
@@ -666,8 +676,7 @@ def region_paths(
     _, a_fixed = _level_args(int(kernel), box_levels)
     order, starts, integral, _ = _plan_paths(
         int(shape[0]), int(shape[1]), bx, idx, prepared.nz, prepared.nz_start,
-        prepared.n_bins, prepared.n_parts, int(kernel), METHODS[method],
-        max(a_fixed.shape[0], 1))
+        prepared.n_bins, prepared.n_parts, int(kernel), METHODS[method], a_fixed)
     taken = np.zeros(bx.shape[0], dtype=np.bool_)
     for g in np.flatnonzero(integral):
         taken[order[starts[g]:starts[g + 1]]] = True

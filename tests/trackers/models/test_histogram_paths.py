@@ -19,7 +19,9 @@ from trackers.kernels.histogram import (
     KERNEL_EPANECHNIKOV,
     KERNEL_UNIFORM,
     METHODS,
+    _plan_paths,
     _region_distances,
+    _support_colours,
     prepare_references,
     prepared_distances,
     quantize_rgb,
@@ -37,6 +39,15 @@ def _pixel_range(lo, size, n):
 def _expected_integral(shape, boxes, q, n_parts, method, n_levels):
     """The documented choice for one reference's boxes, in the kernel's order of
     operations (the histogram module's comment above its cost constants)."""
+    cost_direct, cost_integral, cells, has_pixel = _costs(shape, boxes, q, n_parts,
+                                                          n_levels)
+    return bool(has_pixel and cells <= hist._MAX_CELLS
+                and (method == "integral" or cost_integral < cost_direct))
+
+
+def _costs(shape, boxes, q, n_parts, n_levels):
+    """(direct cost, integral cost, integral cells, whether a box has a pixel) of one
+    reference's boxes, as the histogram module's comment above its constants states."""
     rows, cols = shape
     r_lo, r_hi, c_lo, c_hi = rows, 0, cols, 0
     area = 0.0
@@ -57,8 +68,7 @@ def _expected_integral(shape, boxes, q, n_parts, method, n_levels):
                                                  + hist._COST_BOX_DIRECT)
     cost_integral = (cells * hist._COST_CELL + roi_pixels * hist._COST_ROI
                      + k * (n_sup * n_levels * hist._COST_CORNER + hist._COST_BOX_INTEGRAL))
-    return bool(r_hi > r_lo and cells <= hist._MAX_CELLS
-                and (method == "integral" or cost_integral < cost_direct))
+    return cost_direct, cost_integral, cells, r_hi > r_lo
 
 
 @st.composite
@@ -192,3 +202,108 @@ def test_the_particle_filters_clouds_take_the_integral_path(monkeypatch, preset)
             tracker.step(frame)
         assert len(calls) >= 3
         assert all(taken.all() for taken in calls), name
+
+
+def _near_tie(kernel, levels, lo, hi):
+    """A reference's boxes (k boxes of w x h, each shifted dx right of the last, on a
+    200 x 200 frame) and its histogram (n colours of equal weight) whose direct cost
+    minus integral cost lies in [lo, hi]: the first such in a fixed search order."""
+    n_levels = levels if kernel == KERNEL_BOX else 1
+    for n in (1, 2, 3):
+        q = np.zeros(8)
+        q[:n] = 1.0 / n
+        for k in range(1, 13):
+            for dx in (0, 1, 2):
+                for w in range(1, 31):
+                    for h in range(1, 31):
+                        boxes = np.array([[10.0 + i * dx, 10.0, w, h] for i in range(k)])
+                        direct, integral, _, _ = _costs((200, 200), boxes, q, 1, n_levels)
+                        if lo <= direct - integral <= hi:
+                            return boxes, q
+    raise AssertionError(f"no configuration with a cost margin in [{lo}, {hi}]")
+
+
+@pytest.mark.parametrize(("kernel", "levels"), [(KERNEL_UNIFORM, 3), (KERNEL_BOX, 1),
+                                                (KERNEL_BOX, 3)])
+def test_the_choice_at_the_cost_models_tie(kernel, levels):
+    """Either side of a tie, within a pixel visit: the integral path when it is cheaper
+    by 0.05-0.95 of a pixel visit, the direct path when it costs 0.05-0.95 more (the
+    uniform kernel's integral reads one rectangle a box, however many levels are asked)."""
+    img = np.zeros((200, 200), dtype=np.int32)
+    for lo, hi, expected in ((0.05, 0.95, True), (-0.95, -0.05, False)):
+        boxes, q = _near_tie(kernel, levels, lo, hi)
+        prepared = prepare_references(q[None, :])
+        index = np.zeros(len(boxes), dtype=np.int64)
+        taken = region_paths(img, boxes, prepared, index, kernel, box_levels=levels)
+        assert taken.tolist() == [expected] * len(boxes), (lo, hi, boxes[0], len(boxes))
+
+
+@pytest.mark.parametrize("kernel", [KERNEL_UNIFORM, KERNEL_BOX, KERNEL_EPANECHNIKOV,
+                                    KERNEL_CONE])
+@pytest.mark.parametrize("method", ["auto", "integral", "direct"])
+@pytest.mark.parametrize("n_boxes", [0, 1, 7])
+def test_the_plan_orders_every_box_once(kernel, method, n_boxes):
+    """``_plan_paths``' order is a permutation of the boxes, sorted by reference and
+    stable, whatever path they take; its groups cover it."""
+    rng = np.random.default_rng(n_boxes)
+    prepared = prepare_references(np.array([[0.5, 0.5], [0.25, 0.75], [1.0, 0.0]]))
+    boxes = np.column_stack([rng.uniform(0, 40, (n_boxes, 2)), rng.uniform(1, 20, (n_boxes, 2))])
+    index = rng.integers(0, 3, n_boxes)
+    _, a_fixed = _level_args(kernel, 3)
+    order, starts, integral, rois = _plan_paths(
+        50, 60, boxes, index, prepared.nz, prepared.nz_start, prepared.n_bins,
+        prepared.n_parts, kernel, METHODS[method], a_fixed)
+    assert sorted(order.tolist()) == list(range(n_boxes))
+    assert integral.shape == (starts.shape[0] - 1,) and rois.shape == (integral.shape[0], 4)
+    if integral.shape[0]:
+        np.testing.assert_array_equal(order, np.argsort(index, kind="stable"))
+        assert starts[0] == 0 and starts[-1] == n_boxes
+        assert len(set(index[order[starts[:-1]]].tolist())) == integral.shape[0]
+
+
+def test_the_support_path_is_for_references_of_few_colours_in_every_band():
+    """A reference takes the support path when each band has at most ``max_support``
+    colours of positive weight (here 8 and 9 around the limit, in either band), and its
+    support bins are given by their colour within their band."""
+    n_bins = 16
+    cases = []
+    for first, second in ((8, 8), (9, 1), (1, 9), (8, 0), (16, 16), (1, 1)):
+        q = np.zeros(2 * n_bins)
+        q[n_bins - first:n_bins] = 1.0  # the last colours of band 0
+        q[n_bins:n_bins + second] = 1.0
+        q[0] += (first + second == 0)
+        cases.append(q / q.sum())
+    prepared = prepare_references(np.array(cases), 2)
+    colours, small = _support_colours(prepared.nz, prepared.nz_start, n_bins, 2,
+                                      _SMALL_SUPPORT)
+    assert _SMALL_SUPPORT == 8
+    assert small.tolist() == [True, False, False, True, False, True]
+    for r, (first, second) in enumerate(((8, 8), (9, 1), (1, 9), (8, 0), (16, 16), (1, 1))):
+        used = prepared.nz_start[r, 2]
+        assert colours[r, :used].tolist() == [*range(n_bins - first, n_bins),
+                                              *range(second)], r
+
+
+@pytest.mark.parametrize("kernel", [KERNEL_UNIFORM, KERNEL_BOX, KERNEL_EPANECHNIKOV,
+                                    KERNEL_CONE])
+def test_the_direct_path_scores_boxes_as_wide_as_the_frame(kernel):
+    """A row's scratch spans the frame: boxes covering every column (and beyond), of
+    widths that are and are not multiples of the support path's 8-column padding, score
+    as their histograms do on both direct paths."""
+    rng = np.random.default_rng(5)
+    for width in (8, 13, 64, 67):
+        bin_img = rng.integers(0, 4, (20, width)).astype(np.int32)
+        boxes = np.array([[0.0, 0.0, width, 20.0], [-3.0, 2.0, width + 6.0, 9.0],
+                          [0.5, 1.0, width - 0.5, 7.0], [-1.0, -1.0, width + 1.0, 30.0]])
+        refs = region_histograms(bin_img, boxes[[1, 0]], 4, kernel)
+        index = np.array([0, 1, 0, 1])
+        hists = region_histograms(bin_img, boxes, 4, kernel)
+        expected = hist.bhattacharyya_distance(hists, refs[index])
+        fracs, a_fixed = _level_args(kernel, 3)
+        prepared = prepare_references(refs)
+        for max_support in (-1, _SMALL_SUPPORT):
+            d = _region_distances(bin_img, boxes, prepared.sqrt_refs, index, prepared.nz,
+                                  prepared.nz_start, prepared.empty_rho, 4, kernel, 1,
+                                  _lanes(4), METHODS["direct"], fracs, a_fixed, 2,
+                                  max_support)[0]
+            np.testing.assert_allclose(d**2, expected**2, rtol=0, atol=1e-12)
