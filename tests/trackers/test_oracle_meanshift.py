@@ -349,7 +349,7 @@ def kernel_first_step(bins, q, centre, size, kernel, cap=12):
     n_bins = q.size
     hist, totals = np.zeros(n_bins), np.empty(1)
     touched, weight = np.empty(n_bins, dtype=np.int64), np.empty(n_bins)
-    kbuf = np.empty(bins.shape[1] + 2)
+    kbuf = np.empty(bins.shape[1])
     (x0, y0), (w, h) = (float(v) for v in centre), (float(v) for v in size)
     n = ms._window(bins, x0, y0, w, h, kernel, hist, totals, touched, kbuf)
     d0 = ms._distance(q, hist, totals, touched, n, n_bins)

@@ -144,11 +144,8 @@ EQUIVALENT["meanshift"] += [  # noqa: F821
      "x1, y1, sw = _shift(bin_img, x0, y0, w, h, q, hist, totals[ -1], touched, n,", _ONE),
     ("totals = np.empty(1)", "totals = np.empty( 2)",
      "a second element that nothing reads"),
-    ("kbuf = np.empty(bin_img.shape[1] + 2)", "kbuf = np.empty(bin_img.shape[1] + 1)",
-     "the chord is clipped to the frame's W columns: W entries suffice (a test with a "
-     "window wider than the frame kills W - 1)"),
-    ("kbuf = np.empty(bin_img.shape[1] + 2)", "kbuf = np.empty(bin_img.shape[1] + 3)",
-     "a larger scratch row"),
+    ("kbuf = np.empty(bin_img.shape[1])", "kbuf = np.empty(bin_img.shape[ -1])",
+     "bin_img is two-dimensional (H, W): its last axis is W"),
     ("scale = 0.0", "scale = 1.0",
      "an empty window touches no bin, so the scale multiplies nothing"),
     ("scale = 0.0", "scale = -1.0",

@@ -120,7 +120,7 @@ def _window(bin_img, cx, cy, w, h, kernel, hist, totals, touched, kbuf):
 
     The bins that become non-zero are listed in ``touched`` so that the distance and the
     clearing cost the window's size, not the number of bins. ``totals[0]`` receives the
-    total weight; ``kbuf`` (W + 2,) is scratch. Returns the number of touched bins.
+    total weight; ``kbuf`` (W,) is scratch. Returns the number of touched bins.
     """
     rows, cols = bin_img.shape
     x = cx - 0.5 * w
@@ -246,7 +246,7 @@ def _mean_shift(bin_img, models, model_index, centres, sizes, kernel, max_iter, 
     totals = np.empty(1)
     touched = np.empty(n_bins, dtype=np.int64)
     weight = np.empty(n_bins)
-    kbuf = np.empty(bin_img.shape[1] + 2)
+    kbuf = np.empty(bin_img.shape[1])
     eps2 = eps * eps
     for p in range(n_points):
         q = models[model_index[p]]
