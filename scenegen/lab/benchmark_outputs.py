@@ -18,7 +18,7 @@ every run file it was computed from with that file's digest, as an experiment's 
   from those records and its own dataset description; the records are one run of each
   listed tracker on each of the dataset's sequences, in order, a built-in tracker's runs
   deterministic; ``scores.csv``, ``leaderboard.md`` and ``index.html`` are the texts of
-  ``results.json``; every figure it names is a PNG file. With ``deep``, every record's
+  ``results.json``; every figure it names is a whole PNG image. With ``deep``, every record's
   key is checked against the manifest of the dataset (found at the path ``results.json``
   names) and its run computed again from it and compared with the record.
 - With kept tracks (``--keep-tracks``), every file of ``OUT/trackeval/`` that
@@ -36,6 +36,7 @@ from typing import Any
 
 from scenegen.errors import ConfigError, DataError
 from scenegen.io.atomic import SpecialFile, read_regular, read_regular_text
+from scenegen.io.png import png_problem
 from scenegen.io.sealed import Unsealed, content_digest, read_sealed_json
 from scenegen.lab.experiments.outputs import _more, parse_listing, read_checked, warn
 from scenegen.lab.experiments.runner import _round
@@ -422,7 +423,7 @@ def check_benchmark(folder: str | Path, *, deep: bool = False,
     for name, _, _ in figure_list(results):
         path = root / name
         try:
-            head = read_regular(path)[:8]
+            data = read_regular(path)
         except FileNotFoundError:
             problems.append(f"{path}: missing ({_RERUN})")
             continue
@@ -432,8 +433,9 @@ def check_benchmark(folder: str | Path, *, deep: bool = False,
         except OSError as err:
             problems.append(f"{path}: unreadable ({type(err).__name__})")
             continue
-        if head != b"\x89PNG\r\n\x1a\n":
-            problems.append(f"{path}: not a PNG file (damaged)")
+        problem = png_problem(data)
+        if problem is not None:
+            problems.append(f"{path}: {problem} (damaged)")
     if deep and not problems:
         problems += _check_deep(root, results, records, skipped if skipped is not None else [])
     return _more(problems)

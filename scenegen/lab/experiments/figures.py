@@ -274,7 +274,7 @@ def _shm_depth(res: dict[str, Any], out: Path, records: list[dict[str, Any]]) ->
 def figure_names(name: str, results: dict[str, Any], records: list[dict[str, Any]]
                  ) -> list[str]:  # fmt: skip
     """The file names :func:`write_figures` writes for these results, without drawing
-    (``scenegen validate`` checks that each is there and a PNG).
+    (``scenegen validate`` checks that each is there and a whole PNG image).
 
     Parameters
     ----------

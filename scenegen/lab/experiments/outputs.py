@@ -19,8 +19,8 @@ tied to exactly those records.
   record's fields; ``results.json`` equals the summary recomputed from those records (so
   an edit whose digest was recomputed is still found); ``table.md`` is the table of
   ``results.json``; each figure the experiment writes
-  (:func:`scenegen.lab.experiments.figures.figure_names`) is there and a PNG file. With
-  ``deep``, every run is also computed again and compared. When
+  (:func:`scenegen.lab.experiments.figures.figure_names`) is there and a whole PNG
+  image. With ``deep``, every run is also computed again and compared. When
   only the summary or the table differs, the line names :func:`rerun_command`, which
   recomputes both from the intact runs, and the versions (:data:`WRITTEN_BY`) that
   differ between the software that wrote ``results.json`` and this one.
@@ -40,6 +40,7 @@ from typing import Any
 
 from scenegen.errors import DataError
 from scenegen.io.atomic import SpecialFile, read_regular, read_regular_text
+from scenegen.io.png import png_problem
 from scenegen.io.sealed import content_digest, read_sealed_json, write_sealed_json
 
 __all__ = [
@@ -753,22 +754,21 @@ def _check_experiment(folder: str | Path, deep: bool) -> tuple[list[str], list[d
     return _more(problems), keys
 
 
-_PNG = b"\x89PNG\r\n\x1a\n"
-
-
 def _figure_problems(path: Path, command: Callable[[], str]) -> list[str]:
-    """A figure the experiment writes: there, a regular file, and a PNG (nothing reads it
-    back, so only its signature is checked); ``command()`` writes it again."""
+    """A figure the experiment writes: there, a regular file, and a whole PNG image
+    (:func:`scenegen.io.png.png_problem`; nothing reads it back, so it is not compared
+    with anything); ``command()`` writes it again."""
     try:
-        head = read_regular(path)[:8]
+        data = read_regular(path)
     except FileNotFoundError:
         return [f"{path}: missing (`{command()}` writes it again)"]
     except SpecialFile as err:
         return [f"{err} (remove it, then `{command()}` writes it again)"]
     except OSError as err:
         return [f"{path}: unreadable ({type(err).__name__})"]
-    if head != _PNG:
-        return [f"{path}: not a PNG file (damaged: `{command()}` writes it again)"]
+    problem = png_problem(data)
+    if problem is not None:
+        return [f"{path}: {problem} (damaged: `{command()}` writes it again)"]
     return []
 
 

@@ -267,8 +267,12 @@ def test_each_page_and_figure_is_checked_against_results(reference, tmp_path, pa
                                     "again into this folder to recompute it)"]  # fmt: skip
     (out / page).write_text(text)
     figure = sorted(out.glob("curve-*.png"))[1]
-    figure.write_bytes(figure.read_bytes()[1:])
+    whole = figure.read_bytes()
+    figure.write_bytes(whole[1:])
     assert check_benchmark(out) == [f"{figure}: not a PNG file (damaged)"]
+    figure.write_bytes(whole[:-10])  # the signature is right
+    assert check_benchmark(out) == [f"{figure}: not a whole PNG image (it does not end with "
+                                    "the IEND chunk) (damaged)"]  # fmt: skip
     figure.unlink()
     assert check_benchmark(out)[0].startswith(f"{figure}: missing (run the same")
 

@@ -394,9 +394,10 @@ def test_every_experiment_end_to_end_in_quick_mode(tmp_path, name, methods, figu
 
 def test_a_damaged_figure_or_table_is_one_line_and_never_waited_on(tmp_path, capsys,
                                                                    deadline):  # fmt: skip
-    """Each figure the experiment writes is checked: missing, not a PNG, or a FIFO is one
-    line naming the command that writes it again (validate said "valid" for all three); a
-    FIFO in place of table.md is one line (validate waited for ever)."""
+    """Each figure the experiment writes is checked: missing, not a PNG, cut short or a
+    FIFO is one line naming the command that writes it again (validate said "valid" for
+    all four: a cut figure passed the signature check); a FIFO in place of table.md is one
+    line (validate waited for ever)."""
     import shlex
 
     from scenegen.cli import main
@@ -412,6 +413,8 @@ def test_a_damaged_figure_or_table_is_one_line_and_never_waited_on(tmp_path, cap
         (figure, lambda p: p.unlink(), f"missing ({again})"),
         (figure, lambda p: p.write_bytes(b"GIF89a" + saved[p]), f"not a PNG file (damaged: "
          f"{again})"),
+        (figure, lambda p: p.write_bytes(saved[p][:-10]), "not a whole PNG image (it does not "
+         f"end with the IEND chunk) (damaged: {again})"),
         (figure, lambda p: (p.unlink(), os.mkfifo(p)), "is not a regular file (a FIFO) "
          f"(remove it, then {again})"),
         (table, lambda p: (p.unlink(), os.mkfifo(p)), "is not a regular file (a FIFO) "
