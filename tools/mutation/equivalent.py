@@ -981,6 +981,27 @@ EQUIVALENT["histogram"] = [  # noqa: F821
      "bins where q = 0 join the support: each adds sqrt(p) * 0 = +0.0 to rho (the same "
      "bits) and 0 to the empty band's rho; they only make the support path or the "
      "integral's channels less likely, both bit-identical to the whole histogram"),
+    # 2026-12-06, a seeded sample of 40 after the eight were dealt with: 34 killed, 6
+    # survived; "roi[1] >= roi[0]" is killed by a frame with no rows, these five are not.
+    ("for p in range(ch * n_boxes // n_chunks, (ch + 1) * n_boxes // n_chunks):",
+     "for p in range(ch / n_boxes // n_chunks, (ch + 1) * n_boxes // n_chunks):",
+     "every chunk starts at box 0 (ch / n_boxes < 1): the chunks overlap and score boxes "
+     "again, each alone from zeroed scratch, so every write is the same value; only the "
+     "time grows"),
+    ("roi_pixels = max(roi[1] - roi[0], 0) * max(roi[3] - roi[2], 0) * 1.0",
+     "roi_pixels = max(roi[1] - roi[0], 1) * max(roi[3] - roi[2], 0) * 1.0",
+     "the ROI's height is <= 0 only when no member has a pixel, and then its width "
+     "(0 - cols) is <= 0 too: the product is 0 either way"),
+    ("roi[0], roi[1], roi[2], roi[3] = rows, 0, cols, 0",
+     "roi[0], roi[1], roi[2], roi[3] = rows, 0, cols, -1",
+     "a member with a pixel sets roi[3] to its c1 > 0 either way; with none, the width is "
+     "negative either way (clipped to 0) and roi[1] > roi[0] sends the group direct"),
+    ("ref = ref_index[members[0]]", "ref = ref_index[members[ -1]]",
+     "a group's members share one reference (_reference_groups groups by it)",
+     ("_plan_paths", "_region_distances")),
+    ("*,", "/,",
+     "every caller passes bin_img to kernel by position and method, box_levels by "
+     "keyword: the mutant only also accepts the last two by position", "region_paths"),
 ]
 
 # 2026-12-03, a seeded sample of 40 mutants of the compiled stages (key stages):

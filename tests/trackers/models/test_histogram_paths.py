@@ -144,6 +144,18 @@ def test_the_integral_path_is_bounded_by_its_cells_and_needs_a_pixel():
     outside = np.array([[200.0, 10.0, 30.0, 30.0], [10.0, -50.0, 30.0, 30.0]])
     assert not region_paths(np.zeros((100, 100), dtype=np.int32), outside, prepared,
                             np.zeros(2), KERNEL_BOX, method="integral").any()
+    # A frame with no rows or no columns has no pixel to integrate, even when asked; its
+    # boxes are empty regions (distance 0 to a uniform reference) on either path.
+    uniform = prepare_references(np.full((1, 2), 0.5))
+    box = np.array([[1.0, 1.0, 3.0, 3.0]])
+    for shape in ((0, 8), (8, 0), (0, 0)):
+        img = np.zeros(shape, dtype=np.int32)
+        for kernel in (KERNEL_UNIFORM, KERNEL_BOX):
+            assert not region_paths(img, box, uniform, np.zeros(1), kernel,
+                                    method="integral").any(), shape
+            for method in ("integral", "direct"):
+                assert prepared_distances(img, box, uniform, np.zeros(1), kernel,
+                                          method=method).tolist() == [0.0], shape
 
 
 @pytest.mark.parametrize("kernel", [KERNEL_UNIFORM, KERNEL_BOX])
