@@ -265,10 +265,10 @@ def cmd_validate(args: argparse.Namespace) -> int:
         or (folder / "experiments").is_dir()
     ):  # an experiment or report folder: its sealed records, results.json and table.md
         from scenegen.lab.experiments.outputs import check_experiment, check_report
-        from scenegen.lab.report import index_problem
+        from scenegen.lab.report import index_problem, presets_problems
 
         report = (folder / "experiments").is_dir()
-        problems = (check_report(folder, index_problem) if report
+        problems = (check_report(folder, index_problem) + presets_problems(folder) if report
                     else check_experiment(folder, deep=args.deep))  # fmt: skip
         for line in problems:
             print(line, file=sys.stderr)

@@ -36,7 +36,7 @@ from typing import Any
 
 from scenegen.errors import ConfigError, DataError
 from scenegen.io.atomic import SpecialFile, read_regular, read_regular_text
-from scenegen.io.png import png_problem
+from scenegen.io.images import png_problem
 from scenegen.io.sealed import Unsealed, content_digest, read_sealed_json
 from scenegen.lab.experiments.outputs import _more, parse_listing, read_checked, warn
 from scenegen.lab.experiments.runner import _round

@@ -40,7 +40,7 @@ from typing import Any
 
 from scenegen.errors import DataError
 from scenegen.io.atomic import SpecialFile, read_regular, read_regular_text
-from scenegen.io.png import png_problem
+from scenegen.io.images import png_problem
 from scenegen.io.sealed import content_digest, read_sealed_json, write_sealed_json
 
 __all__ = [
@@ -756,7 +756,7 @@ def _check_experiment(folder: str | Path, deep: bool) -> tuple[list[str], list[d
 
 def _figure_problems(path: Path, command: Callable[[], str]) -> list[str]:
     """A figure the experiment writes: there, a regular file, and a whole PNG image
-    (:func:`scenegen.io.png.png_problem`; nothing reads it back, so it is not compared
+    (:func:`scenegen.io.images.png_problem`; nothing reads it back, so it is not compared
     with anything); ``command()`` writes it again."""
     try:
         data = read_regular(path)

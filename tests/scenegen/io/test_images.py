@@ -1,4 +1,5 @@
-"""``png_problem``: a figure is a whole PNG image or one line says why not."""
+"""``png_problem`` and ``gif_problem``: a figure or preview is a whole image, or one line
+says why not."""
 
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ import zlib
 import numpy as np
 import pytest
 
-from scenegen.io.png import PNG_SIGNATURE, png_problem
+from scenegen.io.images import PNG_SIGNATURE, gif_problem, png_problem
 
 
 def _figure() -> bytes:
@@ -80,3 +81,29 @@ def test_a_size_field_of_a_huge_image_is_refused_without_allocating_it():
             + _chunk(b"IEND", b""))  # fmt: skip
     problem = png_problem(data)
     assert problem is not None and problem.startswith("not a whole PNG image (")
+
+
+def _gif() -> bytes:
+    """A 6-frame GIF written by Pillow, as the demo's previews are."""
+    from PIL import Image
+
+    rng = np.random.default_rng(1)
+    frames = [Image.fromarray(rng.integers(0, 255, (24, 32, 3), dtype=np.uint8))
+              for _ in range(6)]
+    buf = io.BytesIO()
+    frames[0].save(buf, format="GIF", save_all=True, append_images=frames[1:], duration=40)
+    return buf.getvalue()
+
+
+def test_a_whole_gif_is_sound_and_one_cut_short_is_not():
+    gif = _gif()
+    assert png_problem(gif) == "not a PNG file"
+    assert gif_problem(gif) is None
+    for cut in (1, 2, 50):
+        assert gif_problem(gif[:-cut]) == ("not a whole GIF image (it does not end with the "
+                                           "GIF trailer)")  # fmt: skip
+    # The trailer put back after half the file: a frame's pixels are missing.
+    problem = gif_problem(gif[: len(gif) // 2] + b";")
+    assert problem is not None and problem.startswith("not a whole GIF image (")
+    assert gif_problem(b"GIF88a" + gif[6:]) == "not a GIF file"
+    assert gif_problem(_figure()) == "not a GIF file"
