@@ -947,6 +947,13 @@ EQUIVALENT["direct"] = [  # noqa: F821
     ("return 4 if dim <= _SMALL_BINS else 1", "return 3 if dim <= _SMALL_BINS else 1",
      "any lane count but 4 takes _scatter's one-copy loop; the copies it leaves at zero "
      "add nothing when the copies are summed"),
+    # 2026-12-06, a seeded sample of 30 (after the scratch rows became W wide): 3 survived;
+    # "totals[j] > 1" and "part = n_parts - 0" are killed by tests of a rim pixel of one
+    # fixed-point unit and of a last row that rounds into a band past the last.
+    ("if r0 >= r1 or c0 >= c1:", "if r0 > r1 or c0 >= c1:",
+     "with r0 == r1 the box has no row: the row loop does not run and totals (and sums) "
+     "stay at the zeros set above; only the column table or rectangles are computed",
+     ("_accumulate", "_accumulate_support")),
 ]
 _UNCOVERED = ("_box_row_weights' last loop (columns no covering rectangle holds) never runs: "
               "the last rectangle (fraction l / L = 1 exactly) has the box's own pixel range, "

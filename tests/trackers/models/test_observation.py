@@ -190,6 +190,43 @@ def test_empty_region_is_uniform():
     np.testing.assert_allclose(hist, 1.0 / 8)
 
 
+def test_a_last_row_that_rounds_into_a_band_past_the_last_counts_in_the_last():
+    """Row 3's centre (3.5) is inside a box of height 3.5 + 1 ulp, but 3.5 / (h / 3) rounds
+    to 3.0: a band index one past the last, which every path clamps to band 2."""
+    h = np.nextafter(3.5, 4.0)
+    assert int(3.5 / (h / 3)) == 3
+    bins = np.repeat(np.arange(4, dtype=np.int32)[:, None], 5, axis=1)  # row r: colour r
+    box = np.array([[0.0, 0.0, 5.0, h]])
+    expected = np.zeros(12)
+    expected[[0, 5]] = 1 / 3  # bands 0 and 1: rows 0 and 1
+    expected[[10, 11]] = 1 / 6  # band 2: rows 2 and 3
+    np.testing.assert_allclose(region_histograms(bins, box, 4, KERNEL_UNIFORM, 3), [expected],
+                               rtol=0, atol=1e-15)
+    prepared = prepare_references(expected[None], 3)  # at most 8 colours a band: support path
+    for method in ("auto", "direct", "integral"):
+        np.testing.assert_allclose(prepared_distances(bins, box, prepared, np.zeros(1),
+                                                      KERNEL_UNIFORM, method=method), [0.0],
+                                   rtol=0, atol=1e-7, err_msg=method)
+
+
+def test_a_region_of_one_fixed_point_unit_of_weight_is_not_empty():
+    """The one pixel inside the box's ellipse lies on its rim, where the Epanechnikov weight
+    is one fixed-point unit (1 - dx^2 = 2**-32): the region is that pixel's colour, not
+    the uniform histogram of an empty region, on every path."""
+    one = 2.0**32
+    dx = np.sqrt(1.0 - 1.0 / one)
+    assert np.int64(dx * dx * one + 0.5) == one - 1  # the pixel's weight is exactly 1
+    box = np.array([[0.5 - dx - 1.0, -0.5, 2.0, 2.0]])  # centre dx left of pixel (0, 0)
+    bins = np.array([[3, 1, 2, 0]], dtype=np.int32)  # pixels 1-3 are outside the ellipse
+    np.testing.assert_array_equal(region_histograms(bins, box, 4, KERNEL_EPANECHNIKOV),
+                                  [[0.0, 0.0, 0.0, 1.0]])
+    prepared = prepare_references(np.array([[0.0, 0.0, 0.0, 1.0], [0.25, 0.25, 0.25, 0.25]]))
+    for method in ("auto", "direct"):
+        got = prepared_distances(bins, np.repeat(box, 2, axis=0), prepared, np.array([0, 1]),
+                                 KERNEL_EPANECHNIKOV, method=method)
+        np.testing.assert_allclose(got, [0.0, np.sqrt(0.5)], rtol=0, atol=1e-12)
+
+
 def test_quantize_rgb_formula():
     rng = np.random.default_rng(3)
     frame = rng.integers(0, 256, (7, 9, 3), dtype=np.uint8)
