@@ -936,6 +936,20 @@ EQUIVALENT["integral"] = [  # noqa: F821
      "only sizes the integral array and picks its integer type in _integral_distances: "
      "_integral_score fills and reads the ROI's R1 - R0 + 1 rows of it, and the counts "
      "are the same integers in uint16 or int32", "_integral_distances"),
+    # 2026-12-06, a seeded sample of 40: "(hgt + 1) / (wid + 1)" (16-bit counts on any ROI)
+    # is killed by a 300 x 300 ROI test; these are not.
+    ("for t in range(sq.shape[0]):", "for t in range(sq.shape[ -1]):",
+     "sq is one-dimensional (its support bins): shape[-1] is shape[0]"),
+    ("bounds = np.empty(n_parts + 1, dtype=np.int64)",
+     "bounds = np.empty(n_parts + 2, dtype=np.int64)",
+     "a last element that nothing writes or reads"),
+    (_RECTS, _RECTS.replace("1), 4)", "1), 5)"), "a fifth column that nothing writes or reads"),
+    ("if (hgt + 1) * (wid + 1) < 65536:", "if (hgt + 1) * (wid + 0) < 65536:",
+     "a count is at most the ROI's hgt * wid pixels, and (hgt + 1) * wid < 65536 still "
+     "bounds that below 2**16: 16-bit counts hold the same integers"),
+    ("if r0 >= r1 or c0 >= c1:", "if r0 > r1 or c0 >= c1:",
+     "with r0 == r1 the box has no row: _band_rows gives every band an empty row range, "
+     "and each band adds its empty_rho, in the same order as the guarded branch"),
 ]
 EQUIVALENT["direct"] = [  # noqa: F821
     *_RECTS_EQ,
