@@ -102,6 +102,7 @@ from typing import Any, ClassVar
 import numpy as np
 from numpy.typing import NDArray
 
+from trackers.kernels.stages import clip_centres
 from trackers.params import TrackerParams
 
 __all__ = [
@@ -462,10 +463,4 @@ def _signature(params: type[TrackerParams]) -> inspect.Signature:
 
 def clip_boxes(boxes: NDArray[np.float64], frame_shape: tuple[int, ...]) -> NDArray[np.float64]:
     """Keep every box's centre inside the frame (sizes unchanged), shape (K, 4)."""
-    b = np.array(boxes, dtype=np.float64, copy=True)
-    h, w = frame_shape[0], frame_shape[1]
-    cx = np.clip(b[:, 0] + b[:, 2] / 2, 0.0, w)
-    cy = np.clip(b[:, 1] + b[:, 3] / 2, 0.0, h)
-    b[:, 0] = cx - b[:, 2] / 2
-    b[:, 1] = cy - b[:, 3] / 2
-    return b
+    return clip_centres(boxes, frame_shape[1], frame_shape[0])

@@ -67,6 +67,7 @@ from trackers.filters.weights import normalised_weights
 from trackers.kernels.histogram import DEFAULT_BOX_LEVELS, KERNELS
 from trackers.kernels.sampling import SYSTEMATIC, count_distinct
 from trackers.kernels.stages import (
+    add_row_sums,
     effective_uv,
     gather_pair,
     group_weights,
@@ -546,23 +547,39 @@ class _Partitioned(_ParticleTracker):
         idx = resample(self.weights, method=self.params.resampler, rng=self.rng)
         return (*self._groups(idx), None)
 
+    def _init(self, frame: NDArray[np.uint8], boxes: NDArray[np.float64]) -> None:
+        self._kept_layout: tuple | None = None
+        super()._init(frame, boxes)
+
+    def _layout(self, sizes: NDArray[np.int64], orderings: NDArray[np.int64]
+                ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
+        """The step's stage layout for group sizes (C,) and orderings (C, M): the object
+        each particle moves at each stage (M, N), the groups' first indices (C,) and the
+        particle indices (N,). PS and DPS pass the same two arrays every step: the layout
+        is kept for them and rebuilt only when either array is another one."""
+        kept = self._kept_layout
+        if kept is not None and kept[0] is sizes and kept[1] is orderings:
+            return kept[2]
+        group = np.repeat(np.arange(sizes.size), sizes)
+        # objects[j, r]: the object particle r moves at stage j (its group's ordering).
+        objects = np.ascontiguousarray(orderings[group].T, dtype=np.int64)
+        layout = (objects, np.cumsum(sizes) - sizes, np.arange(int(sizes.sum())))
+        self._kept_layout = (sizes, orderings, layout)
+        return layout
+
     def _partitioned_step(self, frame: NDArray[np.uint8]) -> tuple[Estimate, NDArray]:
         obs: FrameLikelihood = self.model.observe(frame)
         n, m = self.params.n_particles, self.n_targets
         method = self.params.resampler
         idx, sizes, orderings, log_prior = self._ancestors()
         x, prev = gather_pair(self.particles, self._prev, idx)
-        group = np.repeat(np.arange(sizes.size), sizes)
-        # objects[j, r]: the object particle r moves at stage j (its group's ordering).
-        objects = np.ascontiguousarray(orderings[group].T, dtype=np.int64)
+        objects, starts, rows = self._layout(sizes, orderings)
         mode = RESAMPLE_MODES.get(method)
         dyn = self.dynamics
         logpi = np.zeros(n)
         ll = np.zeros((n, m))
         log_g = np.zeros(n)
         hook = self.propagation_hook
-        rows = np.arange(n)
-        starts = np.cumsum(sizes) - sizes
         stage_only = self.params.weighting == "stage"
         g_only = self.params.weighting == "g-only"
         # resample_scope "placed": placed[r, o] marks the objects row r has placed so far;
@@ -581,7 +598,7 @@ class _Partitioned(_ParticleTracker):
             boxes = state_boxes(new, np.exp(new[:, 2]), self._sizes, obj)
             stage = np.ascontiguousarray(obs.log_likelihoods(boxes, obj), dtype=np.float64)
             if j == m - 1:
-                ll[np.arange(n), obj] = stage
+                ll[rows, obj] = stage
                 break
             if placed is not None:
                 placed[rows, obj] = True
@@ -628,7 +645,7 @@ class _Partitioned(_ParticleTracker):
             logpi = np.log(w)
         # The set {x, π'} still represents the predicted joint state (weighted resampling
         # preserves it), so π' Π_i p(Z | X_i) are the unnormalised posterior weights w̃.
-        logw = logpi + ll.sum(axis=1)
+        logw = add_row_sums(logpi, ll)
         weights, mixture, self._log_mixture = self._reassemble(
             logw, logpi, sizes, log_prior, evidence=self._mixture_by_evidence())
         self._logw = logw

@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from trackers.base import clip_boxes
 from trackers.filters.diagnostics import effective_dynamics, uniqueness
 from trackers.filters.resampling import (
     RESAMPLE_MODES,
@@ -21,8 +22,16 @@ from trackers.filters.resampling import (
     weighted_resample_groups,
 )
 from trackers.filters.weights import log_sum_exp_groups, normalised_weights
-from trackers.kernels.sampling import SYSTEMATIC, count_distinct
+from trackers.kernels.sampling import (
+    MULTINOMIAL,
+    STRATIFIED,
+    SYSTEMATIC,
+    count_distinct,
+    inverse_cdf_groups,
+)
 from trackers.kernels.stages import (
+    add_row_sums,
+    clip_centres,
     effective_uv,
     gather_pair,
     normalise_groups_checked,
@@ -58,6 +67,102 @@ def test_sums_replicate_numpy_to_the_bit(n):
     starts = np.concatenate([[0], cuts]).astype(np.int64)
     sizes = np.diff(np.append(starts, n))
     assert np.array_equal(numpy_reduceat_sum(x, sizes), np.add.reduceat(x, starts))
+
+
+@pytest.mark.parametrize("k", [1, 2, 3, 7, 8, 9, 16, 17, 128, 129, 300])
+def test_add_row_sums_is_numpy_row_sums(k):
+    # Rows of 8 or more terms are summed pairwise by numpy, shorter ones in order; both,
+    # and a row longer than numpy's 128-term block, to the bit (-0.0 terms included: a
+    # likelihood of exactly 1 gives log -0.0).
+    rng = np.random.default_rng(k)
+    m = _values(rng, 40 * k).reshape(40, k) * rng.choice([-1.0, 1.0], (40, k))
+    m[rng.random((40, k)) < 0.1] = -0.0
+    m[0] = -0.0
+    a = _values(rng, 40)
+    got = add_row_sums(a, m)
+    assert np.array_equal(got, a + m.sum(axis=1))
+    assert not np.signbit(got[0] - a[0])
+
+
+def _clip_numpy(boxes, width, height):
+    # The numpy expression clip_centres replaced.
+    b = np.array(boxes, dtype=np.float64, copy=True)
+    cx = np.clip(b[:, 0] + b[:, 2] / 2, 0.0, width)
+    cy = np.clip(b[:, 1] + b[:, 3] / 2, 0.0, height)
+    b[:, 0] = cx - b[:, 2] / 2
+    b[:, 1] = cy - b[:, 3] / 2
+    return b
+
+
+def test_clip_centres_is_the_numpy_clip():
+    rng = np.random.default_rng(3)
+    for trial in range(300):
+        boxes = rng.normal(100, 150, (int(rng.integers(0, 8)), 4))
+        boxes[:, 2:] = np.abs(boxes[:, 2:])
+        if trial % 5 == 0 and boxes.size:
+            boxes.flat[rng.integers(0, boxes.size)] = rng.choice([np.nan, np.inf, -np.inf])
+        width, height = int(rng.integers(1, 400)), int(rng.integers(1, 400))
+        want = _clip_numpy(boxes, width, height)
+        got = clip_centres(boxes, width, height)
+        assert np.array_equal(got, want, equal_nan=True)
+        assert np.array_equal(clip_boxes(boxes, (height, width, 3)), want, equal_nan=True)
+    # Each side: centres left of, right of, above and below the frame, and inside.
+    boxes = np.array([[-30.0, 5.0, 10, 4], [95.0, 5.0, 10, 4], [5.0, -9.0, 4, 6],
+                      [5.0, 48.0, 4, 6], [20.0, 20.0, 4, 6]])
+    got = clip_centres(boxes, 100, 50)
+    assert got[:, 0] + got[:, 2] / 2 == pytest.approx([0, 100, 7, 7, 22])
+    assert got[:, 1] + got[:, 3] / 2 == pytest.approx([7, 7, 0, 50, 23])
+    assert np.array_equal(got[:, 2:], boxes[:, 2:])
+    assert not np.shares_memory(got, boxes)
+
+
+def _inverse_cdf_numpy(weights, sizes, counts, uniforms, mode):
+    # Each group's cdf (cumulative sums in order over their total, the last set to 1) and,
+    # per position u, the first index whose cdf exceeds u, the last index if none does.
+    out, start, j = [], 0, 0
+    for g, (size, count) in enumerate(zip(sizes, counts, strict=True)):
+        acc = np.cumsum(weights[start:start + size])
+        cdf = acc / acc[-1]
+        cdf[-1] = 1.0
+        for i in range(count):
+            if mode == MULTINOMIAL:
+                u = uniforms[j]
+            elif mode == STRATIFIED:
+                u = (i + uniforms[j]) / count
+            else:
+                u = (i + uniforms[g]) / count
+            out.append(start + min(int(np.searchsorted(cdf, u, side="right")), size - 1))
+            j += 1
+        start += size
+    return np.array(out, dtype=np.int64)
+
+
+@pytest.mark.parametrize("mode", [MULTINOMIAL, STRATIFIED, SYSTEMATIC])
+def test_inverse_cdf_groups_is_a_search_of_each_groups_cdf(mode):
+    # Sorted positions (stratified, systematic) are found by scanning on from the last
+    # answer, unsorted ones by bisection: both must be numpy's search, with zero weights
+    # (flat stretches of the cdf), uniforms at 0 and just below 1, and counts unlike the
+    # sizes.
+    rng = np.random.default_rng(11 + mode)
+    for trial in range(200):
+        sizes = rng.integers(1, 40, int(rng.integers(1, 5)))
+        counts = sizes if trial % 2 else rng.integers(1, 60, sizes.size)
+        weights = rng.random(sizes.sum()) ** int(rng.integers(1, 6))
+        weights[rng.random(weights.size) < 0.4] = 0.0
+        weights[np.cumsum(sizes) - sizes] = 1e-3  # every group has some weight
+        n_u = sizes.size if mode == SYSTEMATIC else int(counts.sum())
+        uniforms = rng.random(n_u)
+        if trial % 7 == 0:
+            uniforms[:] = np.nextafter(1.0, 0.0)
+        elif trial % 7 == 1:
+            uniforms[:] = 0.0
+        got = inverse_cdf_groups(weights, sizes, counts, uniforms, mode)
+        assert np.array_equal(got, _inverse_cdf_numpy(weights, sizes, counts, uniforms, mode))
+    # Positions that go back (uniforms outside [0, 1)) are bisected afresh, not scanned.
+    weights, sizes = np.ones(6), np.array([6])
+    uniforms = np.array([5.0, -5.0, 0.5, 0.1, 0.9, 0.2])
+    got = inverse_cdf_groups(weights, sizes, sizes, uniforms, mode)
+    assert np.array_equal(got, _inverse_cdf_numpy(weights, sizes, sizes, uniforms, mode))
 
 
 def test_a_naive_sum_would_fail_the_comparison():

@@ -122,7 +122,7 @@ MODULES: dict[str, Module] = {
         ("circular_shift", "_ParticleTracker._init", "_ParticleTracker._boxes",
          "_ParticleTracker._estimate",
          "Condensation._init", "Condensation._step", "JointPF._step",
-         "_Partitioned._partitioned_step", "_Partitioned._reassemble",
+         "_Partitioned._layout", "_Partitioned._partitioned_step", "_Partitioned._reassemble",
          "PartitionedSampling._groups", "DistributedPartitionedSampling._init",
          "DistributedPartitionedSampling._groups", "DistributedPartitionedSampling._step"),
         ("tests/trackers/test_oracle_particle.py", "tests/trackers/test_equivalences.py",
@@ -132,7 +132,8 @@ MODULES: dict[str, Module] = {
     # The compiled stages of the particle filters' step: numpy's pairwise sum replicated,
     # the AR2 propagation of each particle's stage object, the stage's boxes and
     # log-weights, the group normalisation, the weighted resampling with its gathers (joint
-    # and placed scope), the DPS reassembly, the estimate and the diagnostics. Left out:
+    # and placed scope), the DPS reassembly, the posterior log-weights (row sums), the
+    # estimate, the diagnostics and the clipping of returned boxes. Left out:
     # the test-only wrappers numpy_sum and numpy_reduceat_sum, and the checks (_valid,
     # normalise_groups_checked) that only send bad weights to numpy's path, which raises.
     "stages": Module(
@@ -144,7 +145,8 @@ MODULES: dict[str, Module] = {
          "_group_max_shift", "group_weights", "_reassemble_shift", "_reassemble_sums",
          "_max_shift", "_divide_by_sum", "_final_log_weights", "reassemble",
          "_weighted_mean_states", "_row_max_shift", "_normalise_rows", "_effective_uv",
-         "effective_uv"),
+         "effective_uv", "_add_row_sums", "add_row_sums", "_clip_corner", "_clip_centres",
+         "clip_centres"),
         ("tests/trackers/test_stage_kernels.py", "tests/trackers/test_ps_weighting.py",
          "tests/trackers/test_equivalences.py", "tests/trackers/filters/test_resampling.py",
          "tests/trackers/filters/test_resampling_oracle.py", "tests/trackers/test_particle.py",

@@ -42,6 +42,8 @@ def _inverse_cdf_groups(weights, sizes, counts, uniforms, mode):
             cdf[i] = acc / total
         cdf[stop - 1] = 1.0
         m = counts[g]
+        last_u = np.inf
+        lo = start
         for i in range(m):
             if mode == MULTINOMIAL:
                 u = uniforms[j]
@@ -49,16 +51,25 @@ def _inverse_cdf_groups(weights, sizes, counts, uniforms, mode):
                 u = (i + uniforms[j]) / m
             else:
                 u = (i + uniforms[g]) / m
-            # First index of the group whose cumulative weight exceeds u.
-            lo = start
-            hi = stop - 1
-            while lo < hi:
-                mid = (lo + hi) // 2
-                if cdf[mid] > u:
-                    hi = mid
-                else:
-                    lo = mid + 1
+            # The first index of the group whose cumulative weight exceeds u (the last
+            # index if none does). The cdf does not decrease, so when u does not either
+            # (the sorted positions of STRATIFIED and SYSTEMATIC) the answer is at or
+            # after the previous one: scan on from it. Otherwise bisect the group.
+            if not u >= last_u:
+                lo = start
+                hi = stop - 1
+                while lo < hi:
+                    mid = (lo + hi) // 2
+                    if cdf[mid] > u:
+                        hi = mid
+                    else:
+                        lo = mid + 1
+            else:
+                while lo < stop - 1 and not cdf[lo] > u:
+                    lo += 1
             out[j] = lo
+            if mode != MULTINOMIAL:
+                last_u = u
             j += 1
         start = stop
     return out

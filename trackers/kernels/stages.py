@@ -15,7 +15,10 @@ few compiled calls over all particles at once (docs/algorithms.md, implementatio
   objects', ``resample_scope``);
 - ``normalise_groups``: weights normalised per group (the plain resamplers' first step);
 - ``weighted_mean_states``: the weighted mean state per object, and the unweighted
-  variance of the set (the diagnostics), for the estimate.
+  variance of the set (the diagnostics), for the estimate;
+- ``add_row_sums``: the posterior log-weights, log π' plus each particle's summed
+  log-likelihoods;
+- ``clip_centres``: every returned box moved so that its centre lies in the frame.
 
 **Bit-identical to the numpy code they replace.** The results are the ones the numpy
 expressions give, to the last bit, because every operation is the same IEEE operation in
@@ -41,6 +44,8 @@ from numpy.typing import NDArray
 from trackers.kernels.sampling import _inverse_cdf_groups
 
 __all__ = [
+    "add_row_sums",
+    "clip_centres",
     "effective_uv",
     "gather_pair",
     "group_weights",
@@ -199,6 +204,84 @@ def numpy_reduceat_sum(a: NDArray[np.float64], sizes: NDArray[np.integer]
         out[g] = _numpy_reduceat_sum(a, start, int(s))
         start += int(s)
     return out
+
+
+@njit(cache=True)
+def _add_row_sums(a, m):
+    k = m.shape[1]
+    flat = m.reshape(m.shape[0] * k)
+    out = np.empty(a.shape[0])
+    for r in range(a.shape[0]):
+        # _numpy_sum of the row; a block-sized row straight to its block sum (a call of
+        # _pairwise per row costs more than the sum).
+        row = _pairwise_block(flat, r * k, k) if k <= _BLOCK else _pairwise(flat, r * k, k)
+        out[r] = a[r] + (0.0 + row)
+    return out
+
+
+def add_row_sums(a: NDArray[np.float64], m: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``a + m.sum(axis=1)``, to the bit, in one call.
+
+    numpy sums each row of a C-contiguous (N, K) array as ``np.sum`` sums a vector
+    (``_numpy_sum``: sequential below 8 terms, pairwise above).
+
+    Parameters
+    ----------
+    a : ndarray of float64, shape (N,)
+        The terms added to the row sums (log π').
+    m : ndarray of float64, shape (N, K)
+        The rows to sum (per-object log-likelihoods); made C-contiguous.
+
+    Returns
+    -------
+    ndarray of float64, shape (N,)
+        a[r] + Σ_k m[r, k].
+    """
+    return _add_row_sums(np.ascontiguousarray(a, dtype=np.float64),
+                         np.ascontiguousarray(m, dtype=np.float64))
+
+
+@njit(cache=True)
+def _clip_corner(corner, size, top):
+    """clip(corner + size / 2, 0, top) − size / 2, as numpy's clip (NaN stays NaN)."""
+    half = size / 2
+    centre = corner + half
+    if centre < 0.0:
+        centre = 0.0
+    elif centre > top:
+        centre = top
+    return centre - half
+
+
+@njit(cache=True)
+def _clip_centres(b, w, h):
+    for r in range(b.shape[0]):
+        b[r, 0] = _clip_corner(b[r, 0], b[r, 2], w)
+        b[r, 1] = _clip_corner(b[r, 1], b[r, 3], h)
+
+
+def clip_centres(boxes: NDArray[np.floating], width: float, height: float
+                 ) -> NDArray[np.float64]:
+    """A copy of ``boxes`` with each centre moved into [0, width] x [0, height].
+
+    The sizes are unchanged; x becomes clip(x + w / 2, 0, width) − w / 2 and y the same
+    with h and ``height``, the numpy expression's operations in its order.
+
+    Parameters
+    ----------
+    boxes : array_like of float, shape (K, 4)
+        Boxes [x, y, w, h], px.
+    width, height : float
+        The frame's size, px.
+
+    Returns
+    -------
+    ndarray of float64, shape (K, 4)
+        A new C-contiguous array.
+    """
+    b = np.array(boxes, dtype=np.float64, order="C", copy=True)
+    _clip_centres(b, float(width), float(height))
+    return b
 
 
 @njit(cache=True)
