@@ -325,7 +325,8 @@ def check_tracks(root: Path, results: dict[str, Any], records: list[dict[str, An
 
     Every file of :func:`kept_files` (for the trackers of ``results`` and the sequences of
     its records) must be listed, in order, nothing else listed, each file present with its
-    listed digest; and ``trackeval/`` must hold no other tracker folder, tracker file,
+    listed digest and the folder's own (neither it nor a folder on its way from
+    ``trackeval/`` a symbolic link); and ``trackeval/`` must hold no other tracker folder, tracker file,
     sequence folder or seqmap (TrackEval would read them). Files TrackEval writes beside a
     tracker's ``data/`` folder are allowed. Without ``tracks``, there must be no
     ``trackeval/`` folder.
@@ -385,6 +386,13 @@ def check_tracks(root: Path, results: dict[str, Any], records: list[dict[str, An
                             f"then {rerun})")  # fmt: skip
         elif (special := describe_special_file(path)) is not None:
             problems.append(f"{special} (remove it, then {rerun})")
+        elif (link := _link_on_the_way(root, name)) is not None:
+            # The bytes behind a link are not the folder's: they change or vanish with
+            # the target, and a copy of the folder may keep the link alone.
+            if link not in blocked:
+                blocked.add(link)
+                problems.append(f"{link}: a symbolic link in the kept tracks (they must be "
+                                f"the folder's own files: {rerun})")  # fmt: skip
         elif not path.is_file():
             problems.append(f"{path}: missing ({rerun})")
         elif file_digest(path) != digest:
@@ -400,6 +408,15 @@ def _file_in_the_way(root: Path, name: str) -> Path | None:
         p = root / part
         if p.exists() and not p.is_dir():
             return p
+    return None
+
+
+def _link_on_the_way(root: Path, name: str) -> Path | None:
+    """The first of the kept file ``name``'s folders (from ``trackeval/`` down) and the
+    file itself that is a symbolic link, or None."""
+    for part in [*reversed(Path(name).parents[:-1]), Path(name)]:
+        if (root / part).is_symlink():
+            return root / part
     return None
 
 

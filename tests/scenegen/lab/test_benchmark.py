@@ -970,6 +970,41 @@ def test_a_kept_file_made_a_link_is_not_written_through(dataset, kept, tmp_path,
     assert check_benchmark(out) == [] and files(out) == files(kept)
 
 
+def test_a_link_to_the_listed_bytes_is_not_a_kept_file(dataset, kept, tmp_path, capsys):
+    """A kept file, a tracker's folder or the whole trackeval/ folder replaced by a link to
+    a copy outside the output folder, with the listed bytes: validate names the link in
+    one line (it called the folder valid, though its files lived elsewhere), and the
+    command run again restores the folder's own files."""
+    from scenegen.cli import main
+    from scenegen.lab.benchmark_outputs import check_benchmark
+
+    out = tmp_path / "b"
+    shutil.copytree(kept, out)
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    f = _track(out, "sok", 1)
+    folder = f.parents[1]
+    for link in (f, folder, out / "trackeval"):
+        target = elsewhere / link.name
+        shutil.move(link, target)
+        link.symlink_to(target, target_is_directory=target.is_dir())
+        want = (f"{link}: a symbolic link in the kept tracks (they must be the folder's own "
+                f"files: {_REDO})")  # fmt: skip
+        assert check_benchmark(out) == [want]
+        assert main(["validate", str(out)]) == 1
+        assert capsys.readouterr().err.strip() == want
+        link.unlink()
+        shutil.move(target, link)
+        assert check_benchmark(out) == []
+    f.unlink()
+    f.symlink_to(kept / f.relative_to(out))
+    assert len(check_benchmark(out)) == 1
+    run_benchmark(dataset, TRACKERS, out, params=PARAMS, jobs=1)
+    capsys.readouterr()
+    assert not f.is_symlink()
+    assert check_benchmark(out) == [] and files(out) == files(kept)
+
+
 def test_a_fifo_in_a_benchmark_folder_is_one_line_and_never_waited_on(dataset, kept, tmp_path,
                                                                     deadline):  # fmt: skip
     """A FIFO in place of a page, a figure or a kept file: validate names it in one line;
