@@ -264,8 +264,9 @@ def cmd_validate(args: argparse.Namespace) -> int:
         (folder / "results.json").exists() or (folder / "runs").is_dir()
         or (folder / "experiments").is_dir()
     ):  # an experiment or report folder: its sealed records, results.json and table.md
+        from scenegen.lab.demo_presets import presets_problems
         from scenegen.lab.experiments.outputs import check_experiment, check_report
-        from scenegen.lab.report import index_problem, presets_problems
+        from scenegen.lab.report import index_problem
 
         report = (folder / "experiments").is_dir()
         problems = (check_report(folder, index_problem) + presets_problems(folder) if report

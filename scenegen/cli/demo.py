@@ -29,44 +29,9 @@ def _say(msg: str) -> None:
     print(msg, file=sys.stderr, flush=True)
 
 
-def _write_sheet(seq: object, path: Path) -> None:
-    """A contact sheet of 9 frames, 3 per row (each tile at full resolution)."""
-    import cv2
-
-    from scenegen.io.atomic import atomic_path
-    from scenegen.io.preview import contact_sheet
-
-    sheet = contact_sheet(seq, n=9, cols=3)  # type: ignore[arg-type]
-    ok, data = cv2.imencode(".png", cv2.cvtColor(sheet, cv2.COLOR_RGB2BGR))
-    if not ok:
-        raise OSError(f"{path}: could not encode PNG")
-    with atomic_path(path, ".png") as tmp:
-        tmp.write_bytes(data.tobytes())
-
-
-def generate_presets(out: Path, seed: int) -> list[Path]:
-    """Generate every preset into ``out/presets/`` with a PNG contact sheet and a GIF each."""
-    from scenegen import presets
-    from scenegen.io import write
-    from scenegen.io.preview import write_preview
-    from scenegen.render.plan import generate
-
-    folder = out / "presets"
-    folder.mkdir(parents=True, exist_ok=True)
-    written = []
-    for name in presets.all_names():
-        t0 = time.perf_counter()
-        seq = generate(name, seed=seed)
-        write(folder / f"{name}.h5", seq)
-        _write_sheet(seq, folder / f"{name}.png")
-        write_preview(seq, folder / f"{name}.gif", max_frames=80)
-        written.append(folder / f"{name}.h5")
-        _say(f"  preset {name}: {seq.n_frames} frames ({time.perf_counter() - t0:.1f} s)")
-    return written
-
-
 def cmd_demo(args: argparse.Namespace) -> int:
     from scenegen.errors import ConfigError
+    from scenegen.lab.demo_presets import generate_presets
     from scenegen.lab.report import build_report, check_report_folder, run_demo_experiments
 
     if args.jobs < 1:

@@ -326,10 +326,10 @@ def check_tracks(root: Path, results: dict[str, Any], records: list[dict[str, An
     Every file of :func:`kept_files` (for the trackers of ``results`` and the sequences of
     its records) must be listed, in order, nothing else listed, each file present with its
     listed digest and the folder's own (neither it nor a folder on its way from
-    ``trackeval/`` a symbolic link); and ``trackeval/`` must hold no other tracker folder, tracker file,
-    sequence folder or seqmap (TrackEval would read them). Files TrackEval writes beside a
-    tracker's ``data/`` folder are allowed. Without ``tracks``, there must be no
-    ``trackeval/`` folder.
+    ``trackeval/`` a symbolic link); and ``trackeval/`` must hold no other tracker
+    folder, tracker file, sequence folder or seqmap (TrackEval would read them). Files
+    TrackEval writes beside a tracker's ``data/`` folder are allowed. Without ``tracks``,
+    there must be no ``trackeval/`` folder.
 
     Parameters
     ----------

@@ -42,7 +42,7 @@ from scenegen.lab.experiments.tables import render_table
 from scenegen.lab.experiments.why import WHY
 
 __all__ = ["DEMO_PLAN", "FULL_COMMAND", "build_report", "check_report_folder", "index_problem",
-           "markdown_to_html", "presets_problems", "render_report", "run_all",
+           "markdown_to_html", "render_report", "run_all",
            "run_demo_experiments"]
 
 FULL_COMMAND = "scenegen experiment all -o out/"
@@ -404,57 +404,6 @@ def index_problem(out_dir: str | Path) -> str | None:
     if text != render_report(out_dir)[0]:
         return "stale"
     return None
-
-
-def presets_problems(out_dir: str | Path) -> list[str]:
-    """What is wrong with the preset files of a demo report (``out_dir/presets/``, from
-    ``scenegen demo``): each sequence file must be valid
-    (:func:`scenegen.io.validate.check_file`, read in a time-boxed child process), each
-    contact sheet a whole PNG image and each preview a whole GIF
-    (:mod:`scenegen.io.images`). Which files there are is the page's business
-    (:func:`index_problem`: a page that lists other previews is stale).
-
-    Parameters
-    ----------
-    out_dir : str or pathlib.Path
-        The report folder.
-
-    Returns
-    -------
-    list of str
-        One line per problem, naming the file and the command that writes it again; empty
-        when every preset file is sound or there is no ``presets/`` folder (a report of
-        ``scenegen experiment all``).
-    """
-    from scenegen.io.atomic import SpecialFile, describe_special_file, read_regular
-    from scenegen.io.images import gif_problem, png_problem
-    from scenegen.io.validate import check_file
-
-    folder = Path(out_dir) / "presets"
-    if not folder.is_dir():
-        return []
-    again = f"`scenegen demo -o {out_dir}` with the report's --seed writes it again"
-    images = {".png": png_problem, ".gif": gif_problem}
-    problems: list[str] = []
-    for path in sorted(folder.iterdir()):
-        if path.suffix != ".h5" and path.suffix not in images:
-            continue
-        special = describe_special_file(path)  # never opened: it could block
-        if special is not None:
-            problems.append(f"{special} (remove it, then {again})")
-        elif path.suffix == ".h5":
-            problems += [f"{line} ({again})" for line in check_file(path, isolate=True)]
-        else:
-            try:
-                problem = images[path.suffix](read_regular(path))
-            except SpecialFile as err:  # replaced since the check above
-                problems.append(f"{err} (remove it, then {again})")
-                continue
-            except OSError as err:
-                problem = f"unreadable ({type(err).__name__})"
-            if problem is not None:
-                problems.append(f"{path}: {problem} (damaged: {again})")
-    return problems
 
 
 def render_report(out_dir: str | Path) -> tuple[str, dict[str, dict[str, Any]]]:

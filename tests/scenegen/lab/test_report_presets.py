@@ -1,5 +1,7 @@
 """``validate`` on a demo report checks its preset files: a damaged sequence file, contact
-sheet or preview is one line naming it (it said "valid report folder" for all three)."""
+sheet or preview is one line naming it (it said "valid report folder" for all three), and
+so is any change of a preset file after it was written, against the sealed listing of
+their digests (a GIF has no checksum: a flipped bit in its pixels could still decode)."""
 
 from __future__ import annotations
 
@@ -9,7 +11,8 @@ import shutil
 import pytest
 
 from scenegen.cli import main
-from scenegen.lab.report import build_report, presets_problems
+from scenegen.lab.demo_presets import LISTING, generate_presets, presets_problems
+from scenegen.lab.report import build_report
 
 PRESET = "dps-synthetic"
 
@@ -17,18 +20,9 @@ PRESET = "dps-synthetic"
 @pytest.fixture(scope="module")
 def report(tmp_path_factory):
     """A report folder as ``scenegen demo`` leaves it, with one preset and no experiment."""
-    from scenegen.cli.demo import _write_sheet
-    from scenegen.io import write
-    from scenegen.io.preview import write_preview
-    from scenegen.render.plan import generate
-
     root = tmp_path_factory.mktemp("report")
     (root / "experiments").mkdir()
-    (root / "presets").mkdir()
-    seq = generate(PRESET, seed=0)
-    write(root / "presets" / f"{PRESET}.h5", seq)
-    _write_sheet(seq, root / "presets" / f"{PRESET}.png")
-    write_preview(seq, root / "presets" / f"{PRESET}.gif", max_frames=80)
+    generate_presets(root, 0, [PRESET])
     build_report(root)
     return root
 
@@ -84,3 +78,68 @@ def test_a_damaged_preset_file_is_one_line(folder, capsys, deadline, suffix, dam
         capsys.readouterr()
         assert main(["validate", str(folder)]) == 1
     assert capsys.readouterr().err.splitlines() == problems
+
+
+def _again(folder):
+    return f"`scenegen demo -o {folder}` with the report's --seed writes it again"
+
+
+def test_the_listing_gives_each_files_digest_in_the_order_written(report):
+    import hashlib
+
+    from scenegen.io.sealed import read_sealed_json
+
+    doc = read_sealed_json(report / "presets" / LISTING)
+    names = [f"{PRESET}{s}" for s in (".h5", ".png", ".gif")]
+    assert doc == {"files": [
+        f"{n} {hashlib.sha256((report / 'presets' / n).read_bytes()).hexdigest()}"
+        for n in names]}  # fmt: skip
+
+
+def test_a_flipped_bit_that_still_decodes_is_found(folder, capsys):
+    """A bit flipped in a GIF's compressed pixels that Pillow still decodes: the digest
+    differs from the listed one."""
+    from scenegen.io.images import gif_problem
+
+    path = folder / "presets" / f"{PRESET}.gif"
+    data = bytearray(path.read_bytes())
+    for at in range(len(data) // 2, len(data) - 2):  # the first flip that still decodes
+        data[at] ^= 0x10
+        if gif_problem(bytes(data)) is None:
+            break
+        data[at] ^= 0x10
+    else:
+        pytest.fail("no flipped bit of the preview decodes")
+    path.write_bytes(bytes(data))
+    want = (f"{path}: is not the file {LISTING} lists (damaged or edited: "
+            f"{_again(folder)})")  # fmt: skip
+    assert presets_problems(folder) == [want]
+    assert main(["validate", str(folder)]) == 1
+    assert capsys.readouterr().err.splitlines() == [want]
+
+
+def test_the_listing_missing_damaged_or_a_fifo_is_one_line(folder, deadline):
+    listing = folder / "presets" / LISTING
+    text = listing.read_text()
+    listing.write_text(text.replace(PRESET, "dps-synthetiC", 1))
+    assert presets_problems(folder) == [
+        f"{listing}: content does not match its sha256 digest (damaged or edited) "
+        f"({_again(folder)})"]  # fmt: skip
+    listing.unlink()
+    assert presets_problems(folder) == [
+        f"{listing}: missing: it lists the preset files' digests ({_again(folder)})"]
+    os.mkfifo(listing)
+    with deadline(60):
+        assert presets_problems(folder) == [
+            f"{listing}: is not a regular file (a FIFO) (remove it, then {_again(folder)})"]
+
+
+def test_a_file_not_listed_or_a_listed_file_missing_is_one_line(folder):
+    presets = folder / "presets"
+    extra = presets / "other.png"
+    shutil.copy(presets / f"{PRESET}.png", extra)
+    assert presets_problems(folder) == [
+        f"{extra}: not a file {LISTING} lists (remove it, or {_again(folder)})"]
+    extra.unlink()
+    (presets / f"{PRESET}.png").unlink()
+    assert presets_problems(folder) == [f"{presets / PRESET}.png: missing ({_again(folder)})"]
