@@ -71,6 +71,34 @@ def test_dps_with_one_group_is_ps():
     _assert_same_runs(a, b)
 
 
+@pytest.mark.parametrize("tracker", [PartitionedSampling, DistributedPartitionedSampling])
+def test_the_stage_layout_is_built_once_and_rebuilt_for_other_arrays(tracker):
+    """PS and DPS pass the same group sizes and orderings every step: the stage layout
+    built at the first step is the one every later step uses, and another pair of arrays
+    (equal or not) gets a layout of its own, built from them."""
+    frames, boxes = _scene(3)
+    t = tracker(n_particles=90, rng=3)
+    t.init(frames[0], boxes[0])
+    t.step(frames[1])
+    sizes, orderings, layout = t._kept_layout
+    for f in frames[2:]:
+        t.step(f)
+        assert t._kept_layout[2] is layout
+    objects, starts, rows = layout
+    group = np.repeat(np.arange(sizes.size), sizes)
+    assert np.array_equal(objects, orderings[group].T)
+    assert np.array_equal(starts, np.cumsum(sizes) - sizes)
+    assert np.array_equal(rows, np.arange(90))
+    for other_sizes, other_orderings in ((sizes.copy(), orderings),
+                                         (sizes, orderings.copy()),
+                                         (np.array([40, 50]), orderings[[0, 0]][:, ::-1])):
+        again = t._layout(other_sizes, other_orderings)
+        assert again[0] is not objects and t._kept_layout[2] is again
+        group = np.repeat(np.arange(other_sizes.size), other_sizes)
+        assert np.array_equal(again[0], other_orderings[group].T)
+        assert np.array_equal(again[1], np.cumsum(other_sizes) - other_sizes)
+
+
 def test_circular_shift_ordering_equals_explicit_permutation():
     frames, boxes = _scene(3)
     a = _run(PartitionedSampling(ordering=2, n_particles=60, rng=1), frames, boxes)

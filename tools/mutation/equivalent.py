@@ -1078,3 +1078,27 @@ EQUIVALENT["sampling"] = [  # noqa: F821
      "linear probing downwards instead of upwards: modulo the power-of-two table size it "
      "still visits every slot, and the table is never more than half full"),
 ]
+
+# 2026-12-06 (stop 49), every mutant of the new lines: the inverse-CDF draw's scan of sorted
+# positions, the posterior row sums and the compiled box clipping.
+_SCAN = ("only chooses between scanning on from the previous index and bisecting the "
+         "group: both give the first index whose cdf exceeds u (the last if none does), "
+         "because the cdf does not decrease and a scan starts only where u did not "
+         "decrease either (test_inverse_cdf_groups_is_a_search_of_each_groups_cdf); the "
+         "choice changes the time only")
+EQUIVALENT["sampling"] += [  # noqa: F821
+    ("if mode != MULTINOMIAL:", "if mode == MULTINOMIAL:", _SCAN),
+    ("if mode != MULTINOMIAL:", "if not mode != MULTINOMIAL:", _SCAN),
+    ("if not u >= last_u:", "if not u > last_u:", _SCAN),
+]
+EQUIVALENT["stages"] += [  # noqa: F821
+    ("if centre < 0.0:", "if centre <= 0.0:",
+     "a centre of exactly 0 set to 0: the box returned is the same (a centre of -0.0, from "
+     "a size of -0.0, gives x = 0.0 - -0.0 = -0.0 - -0.0 = 0.0 either way)"),
+    ("elif centre > top:", "elif centre >= top:",
+     "a centre of exactly the frame's width or height set to that value: the same"),
+    ("row = _pairwise_block(flat, r * k, k) if k <= _BLOCK else _pairwise(flat, r * k, k)",
+     "row = _pairwise_block(flat, r * k, k) if k < _BLOCK else _pairwise(flat, r * k, k)",
+     "a row of exactly 128 terms taken by _pairwise, which sums a block of at most 128 "
+     "terms with _pairwise_block: the same sum"),
+]
