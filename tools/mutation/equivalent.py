@@ -1102,3 +1102,29 @@ EQUIVALENT["stages"] += [  # noqa: F821
      "a row of exactly 128 terms taken by _pairwise, which sums a block of at most 128 "
      "terms with _pairwise_block: the same sum"),
 ]
+
+# 2026-12-06 (stop 49), wider samples of the two kernel modules not re-run since 12-03:
+# quantize 60 of 140 (59 killed), profiles 40 of 152 (34 killed; the cone's rounding,
+# "+ -0.5", is killed by test_a_cone_weight_below_one_fixed_point_unit_rounds_to_one).
+EQUIVALENT["quantize"] = [  # noqa: F821
+    ("h_top = np.int32(h_bins - 1)", "h_top = np.int32(h_bins + 1)",
+     "the hue bin's clamp is never reached: h6 < 6 d for every colour (where r is the "
+     "largest and g < b, h6 = 6 d - (b - g) <= 6 d - 1; otherwise h6 <= 5 d), so the "
+     "float32 floor of h6 h_bins / (6 d) stays below h_bins (checked on all 2**24 "
+     "colours)"),
+]
+EQUIVALENT["profiles"] += [  # noqa: F821
+    ("kbuf[c - c0] = 0", "kbuf[c - c0] = -1", _UNCOVERED),
+    ("n_levels = a_fixed.shape[0]", "n_levels = a_fixed.shape[ -1]",
+     "a_fixed is one-dimensional: shape[-1] is shape[0]"),
+    ("for lv in range(n_levels - 1, first - 1, -1):",
+     "for lv in range(n_levels - 1, first - 2, -1):",
+     "one more pass below the first covering level: the pass at that level leaves lo == hi, "
+     "so the extra pass writes no column (and the row is always covered: "
+     + _UNCOVERED.split(": ", 1)[1] + ")"),
+    ("if r < b < nxt:", "if r < b <= nxt:",
+     "a bound equal to the current next change sets it to the same row"),
+    ("for e in range(2):", "for e in range( 3):",
+     "a column bound taken as a row where the rectangles change only makes the caller "
+     "recompute a row's weights where they have not changed: the same weights"),
+]

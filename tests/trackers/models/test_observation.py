@@ -245,6 +245,27 @@ def test_a_region_of_one_fixed_point_unit_of_weight_is_not_empty():
         np.testing.assert_allclose(got, [0.0, np.sqrt(0.5)], rtol=0, atol=1e-12)
 
 
+def test_a_cone_weight_below_one_fixed_point_unit_rounds_to_one():
+    """The one pixel inside the box's ellipse lies so near its rim that its cone weight
+    1 - r is 0.6 of a fixed-point unit (2**-32): rounded to the nearest unit it weighs 1,
+    so the region is that pixel's colour on every path (truncated, it would weigh 0 and
+    leave the region empty)."""
+    one = 2.0**32
+    dx = 1.0 - 0.6 / one
+    box = np.array([[0.5 - dx - 1.0, -0.5, 2.0, 2.0]])  # centre dx left of pixel (0, 0)
+    x, w = box[0, 0], box[0, 2]
+    r = abs((0 + 0.5 - (x + 0.5 * w)) * (2.0 / w))  # as the kernel computes it
+    assert 0.5 < (1.0 - r) * one < 1.0
+    bins = np.array([[3, 1, 2, 0]], dtype=np.int32)  # pixels 1-3 are outside the ellipse
+    np.testing.assert_array_equal(region_histograms(bins, box, 4, KERNEL_CONE),
+                                  [[0.0, 0.0, 0.0, 1.0]])
+    prepared = prepare_references(np.array([[0.0, 0.0, 0.0, 1.0], [0.25, 0.25, 0.25, 0.25]]))
+    for method in ("auto", "direct"):
+        got = prepared_distances(bins, np.repeat(box, 2, axis=0), prepared, np.array([0, 1]),
+                                 KERNEL_CONE, method=method)
+        np.testing.assert_allclose(got, [0.0, np.sqrt(0.5)], rtol=0, atol=1e-12)
+
+
 def test_quantize_rgb_formula():
     rng = np.random.default_rng(3)
     frame = rng.integers(0, 256, (7, 9, 3), dtype=np.uint8)
