@@ -227,43 +227,44 @@ def test_a_last_row_that_rounds_into_a_band_past_the_last_counts_in_the_last():
                                    rtol=0, atol=1e-7, err_msg=method)
 
 
-def test_a_region_of_one_fixed_point_unit_of_weight_is_not_empty():
-    """The one pixel inside the box's ellipse lies on its rim, where the Epanechnikov weight
-    is one fixed-point unit (1 - dx^2 = 2**-32): the region is that pixel's colour, not
-    the uniform histogram of an empty region, on every path."""
-    one = 2.0**32
-    dx = np.sqrt(1.0 - 1.0 / one)
-    assert np.int64(dx * dx * one + 0.5) == one - 1  # the pixel's weight is exactly 1
-    box = np.array([[0.5 - dx - 1.0, -0.5, 2.0, 2.0]])  # centre dx left of pixel (0, 0)
-    bins = np.array([[3, 1, 2, 0]], dtype=np.int32)  # pixels 1-3 are outside the ellipse
-    np.testing.assert_array_equal(region_histograms(bins, box, 4, KERNEL_EPANECHNIKOV),
+def _rim_box(dx):
+    """A 2 x 2 box whose centre is dx left of pixel (0, 0)'s centre, on a 1 x 4 bin image
+    whose pixels 1-3 are outside the box's ellipse."""
+    return (np.array([[0.5 - dx - 1.0, -0.5, 2.0, 2.0]]),
+            np.array([[3, 1, 2, 0]], dtype=np.int32))
+
+
+def _assert_region_is_the_rim_pixel(box, bins, kernel):
+    """The region is pixel (0, 0)'s colour (bin 3), not the uniform histogram of an empty
+    region, on every path."""
+    np.testing.assert_array_equal(region_histograms(bins, box, 4, kernel),
                                   [[0.0, 0.0, 0.0, 1.0]])
     prepared = prepare_references(np.array([[0.0, 0.0, 0.0, 1.0], [0.25, 0.25, 0.25, 0.25]]))
     for method in ("auto", "direct"):
         got = prepared_distances(bins, np.repeat(box, 2, axis=0), prepared, np.array([0, 1]),
-                                 KERNEL_EPANECHNIKOV, method=method)
+                                 kernel, method=method)
         np.testing.assert_allclose(got, [0.0, np.sqrt(0.5)], rtol=0, atol=1e-12)
+
+
+def test_a_region_of_one_fixed_point_unit_of_weight_is_not_empty():
+    """The one pixel inside the box's ellipse lies on its rim, where the Epanechnikov weight
+    is one fixed-point unit (1 - dx^2 = 2**-32)."""
+    one = 2.0**32
+    dx = np.sqrt(1.0 - 1.0 / one)
+    assert np.int64(dx * dx * one + 0.5) == one - 1  # the pixel's weight is exactly 1
+    _assert_region_is_the_rim_pixel(*_rim_box(dx), KERNEL_EPANECHNIKOV)
 
 
 def test_a_cone_weight_below_one_fixed_point_unit_rounds_to_one():
     """The one pixel inside the box's ellipse lies so near its rim that its cone weight
-    1 - r is 0.6 of a fixed-point unit (2**-32): rounded to the nearest unit it weighs 1,
-    so the region is that pixel's colour on every path (truncated, it would weigh 0 and
-    leave the region empty)."""
+    1 - r is 0.6 of a fixed-point unit (2**-32): rounded to the nearest unit it weighs 1
+    (truncated, it would weigh 0 and leave the region empty)."""
     one = 2.0**32
-    dx = 1.0 - 0.6 / one
-    box = np.array([[0.5 - dx - 1.0, -0.5, 2.0, 2.0]])  # centre dx left of pixel (0, 0)
+    box, bins = _rim_box(1.0 - 0.6 / one)
     x, w = box[0, 0], box[0, 2]
     r = abs((0 + 0.5 - (x + 0.5 * w)) * (2.0 / w))  # as the kernel computes it
     assert 0.5 < (1.0 - r) * one < 1.0
-    bins = np.array([[3, 1, 2, 0]], dtype=np.int32)  # pixels 1-3 are outside the ellipse
-    np.testing.assert_array_equal(region_histograms(bins, box, 4, KERNEL_CONE),
-                                  [[0.0, 0.0, 0.0, 1.0]])
-    prepared = prepare_references(np.array([[0.0, 0.0, 0.0, 1.0], [0.25, 0.25, 0.25, 0.25]]))
-    for method in ("auto", "direct"):
-        got = prepared_distances(bins, np.repeat(box, 2, axis=0), prepared, np.array([0, 1]),
-                                 KERNEL_CONE, method=method)
-        np.testing.assert_allclose(got, [0.0, np.sqrt(0.5)], rtol=0, atol=1e-12)
+    _assert_region_is_the_rim_pixel(box, bins, KERNEL_CONE)
 
 
 def test_quantize_rgb_formula():
