@@ -248,10 +248,12 @@ def _context() -> Any:
     return multiprocessing.get_context("spawn")
 
 
-# A fork server listens on "TEMP/pymp-XXXXXXXX/listener-XXXXXXXX", a Unix socket path of at
-# most 103 bytes (104 with its NUL on macOS, 108 on Linux).
+# A fork server listens on "TEMP/pymp-<8 random characters>/listener-<8 more>", a Unix
+# socket path of at most 103 bytes (104 with its NUL on macOS, 108 on Linux). Only the
+# lengths of those names matter here: _RANDOM stands for the random characters.
+_RANDOM = "r" * 8
 _SOCKET_PATH_MAX = 103
-_SOCKET_NAME = "/listener-XXXXXXXX"
+_SOCKET_NAME = "/listener-" + _RANDOM
 _SYSTEM_TEMP_DIRS = ("/tmp", "/var/tmp", "/usr/tmp")
 
 
@@ -262,12 +264,12 @@ def _fits(folder: str) -> bool:
 def prepare_temp_dir() -> None:
     """Make sure multiprocessing has a temporary folder a fork server can listen in.
 
-    multiprocessing makes a private folder (``pymp-XXXXXXXX``, mode 0700) in the temporary
-    folder (``TMPDIR``, or ``tempfile.tempdir`` when a program sets it) for its sockets. When
-    that folder cannot be written to, or its path is too long for a Unix socket (about 75
-    characters), the private folder is made under the system's ``/tmp`` (or ``/var/tmp``)
-    instead, as Python 3.14 itself does for long paths. Called before a guarded child or a
-    local pool starts; cheap once the folder exists.
+    multiprocessing makes a private folder (``pymp-`` and 8 random characters, mode 0700) in
+    the temporary folder (``TMPDIR``, or ``tempfile.tempdir`` when a program sets it) for
+    its sockets. When that folder cannot be written to, or its path is too long for a Unix
+    socket (about 75 characters), the private folder is made under the system's ``/tmp``
+    (or ``/var/tmp``) instead, as Python 3.14 itself does for long paths. Called before a
+    guarded child or a local pool starts; cheap once the folder exists.
 
     Raises
     ------
@@ -290,7 +292,7 @@ def prepare_temp_dir() -> None:
         refused.append("tempfile: no writable default folder")
     bases += [b for b in _SYSTEM_TEMP_DIRS if b not in bases]
     for base in bases:
-        if not _fits(os.path.join(base, "pymp-XXXXXXXX")):
+        if not _fits(os.path.join(base, "pymp-" + _RANDOM)):
             refused.append(f"{base}: too long a path for a socket")
             continue
         try:
