@@ -404,6 +404,17 @@ def test_count_distinct_against_brute_force():
     assert np.array_equal(uniqueness(p) * 300, _distinct_brute(p))
 
 
+def test_count_distinct_tells_values_apart_closer_than_any_shift_keeps():
+    # Rows that differ by one unit in the last place, or by a subnormal: any arithmetic
+    # on the values before comparing them (a shift, a scale) would merge some of them.
+    tiny = np.nextafter(0.0, 1.0)
+    one_up = np.nextafter(1.0, 2.0)
+    p = np.zeros((6, 2, 3))
+    p[:, 0, 0] = [0.0, tiny, 2 * tiny, -tiny, -0.0, 0.0]
+    p[:, 1, 1] = [1.0, one_up, 1.0, 1e-300, 2e-300, one_up]
+    assert count_distinct(p).tolist() == [4, 4] == _distinct_brute(p).tolist()
+
+
 # --- the whole step against a pure-numpy reference -------------------------------------
 
 

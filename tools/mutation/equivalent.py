@@ -1134,6 +1134,18 @@ EQUIVALENT["stages"] += [  # noqa: F821
      "shared means weights has one column: column -1 is column 0"),
 ]
 
+# 2026-12-06 (stop 50), every mutant of sampling (136 in scope), stopped after 41 for
+# the session's time: 36 killed, 5 survived. "particles + 1.0" is killed by
+# test_count_distinct_tells_values_apart_closer_than_any_shift_keeps; "cdf[stop - 1] = 2.0"
+# showed the line was never read (removed); "u > last_u" is listed above; these two:
+EQUIVALENT["sampling"] += [  # noqa: F821
+    ("table[:] = -1", "table[:] = - 2",
+     "the empty-slot mark is tested as j < 0: any negative value marks a free slot"),
+    ("while size < 2 * n:", "while size <= 2 * n:",
+     "a table twice as large when 2 N is a power of two: the probes end at a free "
+     "slot or at an equal row either way"),
+]
+
 # 2026-12-06 (stop 49), wider samples of the two kernel modules not re-run since 12-03:
 # quantize 60 of 140 (59 killed), profiles 40 of 152 (34 killed; the cone's rounding,
 # "+ -0.5", is killed by test_a_cone_weight_below_one_fixed_point_unit_rounds_to_one).

@@ -355,6 +355,35 @@ MODULES: dict[str, Module] = {
          "bhattacharyya_distance"),
         _HISTOGRAM_TESTS, {"NUMBA_BOUNDSCHECK": "1", **_NO_SHRINK}, min_timeout=_KERNEL_TIMEOUT,
     ),
+    # What users judge their own trackers by: the conformance checks (a run and the
+    # malformed estimates it records, IoU and centres, the claims, determinism, the
+    # equivariance, the rate over repeats, the convention hint, the IoU checks), the one
+    # NaN-aware comparison behind fixtures and scenegen_expect, and the two-sample
+    # comparison of a stochastic tracker's runs. check_protocol and the error texts'
+    # helpers (first_line, _writes_hint) only word a failure the run already has.
+    "checks": Module(
+        "scenegen/testing/checks.py",
+        ("_run", "_iou", "_centres", "_claim", "check_edge_fixtures", "check_boxes",
+         "check_deterministic", "_judge", "check_translation_equivariance",
+         "_convention_hint", "_iou_check", "check_recovers_after_occlusion"),
+        ("tests/scenegen/testing/test_conformance.py",
+         "tests/trackers/test_tracker_conformance.py",
+         "tests/scenegen/testing/test_plugin.py", "tests/scenegen/testing/test_builtin.py"),
+        _NO_SHRINK,
+    ),
+    "compare": Module(
+        "scenegen/testing/compare.py",
+        ("_nan_mask", "_wide", "difference"),
+        ("tests/scenegen/testing/test_compare.py", "tests/scenegen/testing/test_fixtures.py",
+         "tests/scenegen/testing/test_plugin.py"),
+        _NO_SHRINK,
+    ),
+    "distribution": Module(
+        "scenegen/testing/distribution.py",
+        ("_runs", "distribution_difference", "assert_distribution_matches"),
+        ("tests/scenegen/testing/test_distribution.py",),
+        _NO_SHRINK,
+    ),
 }
 
 # One replacement per operator site (cosmic-ray's operator names).

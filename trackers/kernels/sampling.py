@@ -40,7 +40,8 @@ def _inverse_cdf_groups(weights, sizes, counts, uniforms, mode):
         for i in range(start, stop):
             acc += weights[i]
             cdf[i] = acc / total
-        cdf[stop - 1] = 1.0
+        # The group's last cdf value is never read: both searches below return the last
+        # index when no earlier value exceeds u (so rounding cannot leave u past the end).
         m = counts[g]
         last_u = np.inf
         lo = start
