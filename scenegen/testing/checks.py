@@ -21,6 +21,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from scenegen.evaluation.metrics import centres, iou
+
 __all__ = [
     "CHECKS",
     "EDGE_FIXTURES",
@@ -265,20 +267,9 @@ def first_line(err: BaseException) -> str:
 
 
 def _iou(a: NDArray[np.float64], b: NDArray[np.float64]) -> NDArray[np.float64]:
-    """IoU of boxes (..., 4) [x, y, w, h]; 0 where either is NaN."""
-    x0 = np.maximum(a[..., 0], b[..., 0])
-    y0 = np.maximum(a[..., 1], b[..., 1])
-    x1 = np.minimum(a[..., 0] + a[..., 2], b[..., 0] + b[..., 2])
-    y1 = np.minimum(a[..., 1] + a[..., 3], b[..., 1] + b[..., 3])
-    inter = np.clip(x1 - x0, 0, None) * np.clip(y1 - y0, 0, None)
-    union = a[..., 2] * a[..., 3] + b[..., 2] * b[..., 3] - inter
-    with np.errstate(invalid="ignore", divide="ignore"):
-        iou = inter / union
-    return np.nan_to_num(iou, nan=0.0)
-
-
-def _centres(boxes: NDArray[np.float64]) -> NDArray[np.float64]:
-    return boxes[..., :2] + boxes[..., 2:] / 2
+    """:func:`scenegen.evaluation.metrics.iou` of boxes (..., 4), with 0 (a miss) where
+    either box is missing (NaN)."""
+    return np.nan_to_num(iou(a, b), nan=0.0)
 
 
 # --------------------------------------------------------------------------------------
@@ -562,9 +553,10 @@ def check_translation_equivariance(factory: Callable[..., Any], opts: Options) -
         b = _run(_build(factory, seed), b_frames, init - shift)
         if a.error or b.error:
             return f"the run raised: {a.error or b.error}"
-        err = np.abs(_centres(b.boxes) + shift[:2] - _centres(a.boxes))
+        err = np.abs(centres(b.boxes) + shift[:2] - centres(a.boxes))
         worst = np.nan_to_num(err, nan=0.0).max(axis=-1)  # (T, K)
-        nan_differs = np.isnan(a.boxes[..., 0]) != np.isnan(b.boxes[..., 0])
+        # A box with any NaN is a lost target (a row with some NaN fails ``boxes``).
+        nan_differs = np.isnan(a.boxes).any(axis=-1) != np.isnan(b.boxes).any(axis=-1)
         if nan_differs.any():
             t = int(np.argwhere(nan_differs)[0][0])
             return f"the target is lost (NaN) in only one of the two views from frame {t}"

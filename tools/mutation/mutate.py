@@ -363,7 +363,7 @@ MODULES: dict[str, Module] = {
     # helpers (first_line, _writes_hint) only word a failure the run already has.
     "checks": Module(
         "scenegen/testing/checks.py",
-        ("_run", "_iou", "_centres", "_claim", "check_edge_fixtures", "check_boxes",
+        ("_run", "_iou", "_claim", "check_edge_fixtures", "check_boxes",
          "check_deterministic", "_judge", "check_translation_equivariance",
          "_convention_hint", "_iou_check", "check_recovers_after_occlusion"),
         ("tests/scenegen/testing/test_conformance.py",

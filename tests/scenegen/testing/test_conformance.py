@@ -426,3 +426,142 @@ def test_a_scene_that_cannot_be_built_is_raised_not_blamed_on_the_tracker(monkey
     finally:
         monkeypatch.undo()
         checks._scene.cache_clear()
+
+
+# --- what each verdict says, frame by frame (found by mutation testing) ----------------
+
+
+def _message(factory, check, **opts):
+    result = check_tracker(factory, report=True, checks=[check], **opts).results[0]
+    return result.status, result.message
+
+
+@pytest.mark.parametrize(
+    ("estimate", "needle"),
+    [
+        (lambda b: b.copy(), "the estimate (ndarray) has no .boxes"),
+        (lambda b: SimpleNamespace(boxes="abc"), ".boxes is not numeric"),
+    ],
+    ids=["no-boxes", "not-numeric"],
+)
+def test_every_malformed_frame_is_counted(estimate, needle):
+    # A malformed estimate does not end the run: each later frame is examined too.
+    from scenegen.testing.checks import _scene
+
+    class Malformed(Still):
+        def step(self, frame):
+            return estimate(self.boxes)
+
+    status, message = _message(Malformed, "boxes")
+    n_steps = len(_scene("pair")[0]) - 1
+    assert status == "failed"
+    assert f"pair: frame 1: {needle} (and {n_steps - 1} more)" in message, message
+
+
+def test_the_first_malformed_box_of_a_frame_is_named():
+    class TwoBad(Still):
+        def step(self, frame):
+            boxes = self.boxes.copy()
+            boxes[0, 2] = -3.0  # a negative width
+            if len(boxes) > 1:
+                boxes[1, 3] = np.nan  # a row with some NaN
+            return SimpleNamespace(boxes=boxes)
+
+    status, message = _message(TwoBad, "boxes")
+    assert status == "failed" and "pair: frame 1: box 0 is [" in message, message
+    assert "box 1 is" not in message
+
+
+class DriftsOnOddSeeds(Follower):
+    def __init__(self, rng=0):
+        self.drift = rng % 2
+
+    def step(self, frame):
+        est = super().step(frame)
+        est.boxes[:, 0] += 20 * self.drift
+        return est
+
+
+def test_exactly_three_failing_runs_are_all_given_and_no_more_are_announced():
+    status, message = _message(DriftsOnOddSeeds, "keeps_lone_target", repeats=6)
+    assert status == "failed" and message.startswith("passed 3 of 6 runs"), message
+    assert message.count("seed ") == 3 and "more failing runs" not in message, message
+
+
+class _TwoViews(Follower):
+    """Tells the two views of the equivariance check apart by the order trackers are
+    built in: the first one built tracks view A (the scene's top-left crop), the
+    next view B; ``on_b`` changes B's estimates or raises."""
+
+    built = 0
+
+    def __init__(self):
+        type(self).built += 1
+        self.view_b = type(self).built % 2 == 0
+
+    def step(self, frame):
+        est = super().step(frame)
+        self.t = getattr(self, "t", 0) + 1
+        if self.view_b:
+            self.on_b(self.t, est.boxes)
+        return est
+
+    def on_b(self, t, boxes):
+        pass
+
+
+def _views(on_b):
+    return type("Views", (_TwoViews,), {"built": 0, "on_b": staticmethod(on_b)})
+
+
+def test_a_good_tracker_is_equivariant_and_both_views_are_the_same_crop():
+    shapes = []
+
+    class Recording(Follower):
+        def init(self, frame, boxes):
+            shapes.append(frame.shape)
+            super().init(frame, boxes)
+
+    status, _ = _message(Recording, "translation_equivariance")
+    assert status == "passed"
+    # Two views of 96 x 72 of a scene 7 and 5 px larger, one per corner.
+    assert shapes == [(72, 96, 3), (72, 96, 3)]
+
+
+def test_the_frame_where_the_shifted_view_drifts_is_named():
+    def offset(t, boxes):
+        if t >= 3:
+            boxes[:, 1] += 3.0
+
+    status, message = _message(_views(offset), "translation_equivariance")
+    assert status == "failed"
+    assert "moved the estimated centre by 3.00 px more at frame 3 (tolerance 1 px)" in message
+
+
+@pytest.mark.parametrize("lost", [slice(None), slice(2, 3)], ids=["all-nan", "nan-width"])
+def test_a_target_lost_in_one_view_only_is_named_with_its_frame(lost):
+    def lose(t, boxes):
+        if t >= 4:
+            boxes[:, lost] = np.nan
+
+    status, message = _message(_views(lose), "translation_equivariance")
+    assert status == "failed"
+    assert message == "the target is lost (NaN) in only one of the two views from frame 4"
+
+
+def test_a_run_that_raises_in_one_view_only_is_named():
+    def boom(t, boxes):
+        if t == 2:
+            raise RuntimeError("boom")
+
+    status, message = _message(_views(boom), "translation_equivariance")
+    assert status == "failed"
+    assert message == "the run raised: step at frame 2 raised RuntimeError: boom"
+
+
+def test_determinism_names_a_second_run_that_raises():
+    status, message = _message(_views(lambda t, boxes: 1 / 0 if t == 1 else None),
+                               "deterministic")
+    assert status == "failed"
+    assert message == ("the run on 'lone' raised: step at frame 1 raised ZeroDivisionError: "
+                       "division by zero")
