@@ -515,17 +515,24 @@ def _views(on_b):
 
 
 def test_a_good_tracker_is_equivariant_and_both_views_are_the_same_crop():
-    shapes = []
+    from scenegen.testing.checks import SHIFT, _scene
+
+    shapes, starts = [], []
 
     class Recording(Follower):
         def init(self, frame, boxes):
             shapes.append(frame.shape)
+            starts.append(np.array(boxes))
             super().init(frame, boxes)
 
     status, _ = _message(Recording, "translation_equivariance")
     assert status == "passed"
-    # Two views of 96 x 72 of a scene 7 and 5 px larger, one per corner.
+    # Two views of 96 x 72 of a scene 7 and 5 px larger, one per corner, each started
+    # from the target's box at frame 0 in its own coordinates.
     assert shapes == [(72, 96, 3), (72, 96, 3)]
+    first = _scene("shifted")[2][0]
+    assert np.array_equal(starts[0], first)
+    assert np.array_equal(starts[1], first - [*SHIFT, 0, 0])
 
 
 def test_the_frame_where_the_shifted_view_drifts_is_named():
@@ -565,3 +572,192 @@ def test_determinism_names_a_second_run_that_raises():
     assert status == "failed"
     assert message == ("the run on 'lone' raised: step at frame 1 raised ZeroDivisionError: "
                        "division by zero")
+
+
+def _oracle(scene, change):
+    """A tracker that returns the scene's ground truth, passed through ``change(t, box)``."""
+    from scenegen.testing.checks import _scene
+
+    gt = _scene(scene)[2]
+
+    class Oracle(Still):
+        def step(self, frame):
+            self.t = getattr(self, "t", 0) + 1
+            return SimpleNamespace(boxes=change(self.t, gt[self.t].copy()))
+
+    return Oracle
+
+
+def test_an_iou_of_exactly_the_threshold_passes_and_the_first_frame_below_is_named():
+    def doubled(t, boxes):  # twice as wide from the same corner: IoU exactly 1/2
+        boxes[:, 2] *= 2
+        return boxes
+
+    assert _message(_oracle("lone", doubled), "keeps_lone_target") == (
+        "passed", "IoU >= 0.5 in all 16 frames")
+
+    def away(t, boxes):  # doubled, then away from frame 5: frames 1-4 at exactly 1/2
+        boxes = doubled(t, boxes)
+        if t >= 5:
+            boxes[:, 0] += 40.0
+        return boxes
+
+    status, message = _message(_oracle("lone", away), "keeps_lone_target")
+    assert status == "failed" and message.startswith(
+        "IoU fell to 0.00 (first below 0.5 at frame 5 of 16)"), message
+
+
+def test_a_lost_target_is_a_miss_not_a_match():
+    def lost(t, boxes):
+        return np.full_like(boxes, np.nan) if t >= 3 else boxes
+
+    status, message = _message(_oracle("lone", lost), "keeps_lone_target")
+    assert status == "failed" and message.startswith(
+        "IoU fell to 0.00 (first below 0.5 at frame 3 of 16)"), message
+
+
+def test_a_target_lost_in_both_views_alike_is_equivariant():
+    # Lost (a NaN width) from frame 4 in both views: the same in both, so no failure.
+    def lose(t, boxes):
+        if t >= 4:
+            boxes[:, 2] = np.nan
+
+    class BothLost(Follower):
+        def step(self, frame):
+            est = super().step(frame)
+            self.t = getattr(self, "t", 0) + 1
+            lose(self.t, est.boxes)
+            return est
+
+    assert _message(BothLost, "translation_equivariance")[0] == "passed"
+
+
+@pytest.mark.parametrize(("bad", "tail"), [((2,), ""), ((2, 4), " (and 1 more)")])
+def test_malformed_estimates_after_the_first_are_counted(bad, tail):
+    class SometimesBad(Still):
+        def step(self, frame):
+            self.t = getattr(self, "t", 0) + 1
+            return SimpleNamespace(boxes=self.boxes[:1] if self.t in bad else self.boxes)
+
+    status, message = _message(SometimesBad, "boxes")
+    assert status == "failed" and message.endswith(
+        "pair: frame 2: .boxes has shape (1, 4), expected (2, 4)" + tail), message
+
+
+def test_the_boxes_check_counts_the_lost_boxes_from_frame_1():
+    from scenegen.testing.checks import BOX_SCENES, EDGE_FIXTURES, _scene
+
+    class LostAtFrame1(Still):
+        def step(self, frame):
+            self.t = getattr(self, "t", 0) + 1
+            return SimpleNamespace(boxes=self.boxes * (np.nan if self.t == 1 else 1.0))
+
+    status, message = _message(LostAtFrame1, "boxes")
+    scenes = [_scene(n) for n in (*EDGE_FIXTURES, *BOX_SCENES)]
+    lost = sum(len(init) for frames, init, _ in scenes if len(frames) > 1)
+    assert status == "passed" and message.endswith(f"({lost} NaN boxes)"), message
+
+
+def test_a_hint_is_given_when_the_converted_boxes_reach_the_threshold_exactly():
+    # Centre boxes of a box twice as wide: read as [cx, cy, w, h] they overlap the
+    # truth by exactly 1/2 (integer boxes, exact arithmetic), as [x, y, w, h] not at all.
+    def centre_doubled(t, boxes):
+        return np.hstack([boxes[:, :2] + boxes[:, 2:] * [1.0, 0.5], boxes[:, 2:] * [2, 1]])
+
+    status, message = _message(_oracle("lone", centre_doubled), "keeps_lone_target")
+    assert status == "failed" and "read as [cx, cy, w, h] (centre) the boxes would match" in (
+        message), message
+
+
+def test_an_exactly_equivariant_tracker_passes_a_tolerance_of_zero():
+    # The init boxes are integers: the still boxes of the two views differ by the shift
+    # exactly.
+    assert _message(Still, "translation_equivariance", equivariance_tol=0.0) == (
+        "passed", "equivariant within 0 px")
+
+
+def test_determinism_names_the_first_frame_that_differs_in_one_coordinate():
+    class LateJitter(Still):
+        built = 0
+
+        def __init__(self):
+            type(self).built += 1
+            self.second = type(self).built % 2 == 1  # built after the claim: run b
+
+        def step(self, frame):
+            self.t = getattr(self, "t", 0) + 1
+            boxes = self.boxes.copy()
+            if self.second and self.t >= 3:
+                boxes[0, 0] += 0.25
+            return SimpleNamespace(boxes=boxes)
+
+    status, message = _message(LateJitter, "deterministic")
+    assert status == "failed" and message.startswith(
+        "two runs with seed 0 differ from frame 3 (largest difference 0.25 px)"), message
+
+
+def test_a_drift_of_exactly_the_tolerance_is_not_named_as_the_first_failure():
+    # Integer boxes (Still): view B off by exactly 1 px (the tolerance) at frame 2, then
+    # by 3 px from frame 3: frame 3 is the first beyond the tolerance.
+    class StillViews(Still):
+        built = 0
+
+        def __init__(self):
+            type(self).built += 1
+            self.view_b = type(self).built % 2 == 0
+
+        def step(self, frame):
+            self.t = getattr(self, "t", 0) + 1
+            boxes = self.boxes.copy()
+            if self.view_b and self.t >= 2:
+                boxes[:, 1] += 1.0 if self.t == 2 else 3.0
+            return SimpleNamespace(boxes=boxes)
+
+    status, message = _message(StillViews, "translation_equivariance")
+    assert status == "failed" and message.endswith(
+        "moved the estimated centre by 3.00 px more at frame 3 (tolerance 1 px)"), message
+
+
+def test_a_target_lost_in_both_views_alike_passes_a_tolerance_of_zero():
+    class StillLost(Still):
+        def step(self, frame):
+            self.t = getattr(self, "t", 0) + 1
+            return SimpleNamespace(boxes=self.boxes * (np.nan if self.t >= 4 else 1.0))
+
+    assert _message(StillLost, "translation_equivariance", equivariance_tol=0.0)[0] == "passed"
+
+
+def test_determinism_names_a_second_run_that_loses_the_target():
+    class LateLoss(Still):
+        built = 0
+
+        def __init__(self):
+            type(self).built += 1
+            self.second = type(self).built % 2 == 1
+
+        def step(self, frame):
+            self.t = getattr(self, "t", 0) + 1
+            lost = self.second and self.t >= 3
+            return SimpleNamespace(boxes=self.boxes * (np.nan if lost else 1.0))
+
+    status, message = _message(LateLoss, "deterministic")
+    assert status == "failed" and message.startswith(
+        "two runs with seed 0 differ from frame 3 (largest difference inf px)"), message
+
+
+def test_boxes_of_zero_width_or_height_are_well_formed():
+    class Flat(Still):
+        def step(self, frame):
+            return SimpleNamespace(boxes=self.boxes * [1, 1, 0, 1])
+
+    assert _message(Flat, "boxes")[0] == "passed"
+
+
+def test_a_deterministic_tracker_that_loses_its_target_is_deterministic():
+    # NaN in both runs at the same frames is no difference.
+    class LosesAlike(Still):
+        def step(self, frame):
+            self.t = getattr(self, "t", 0) + 1
+            return SimpleNamespace(boxes=self.boxes * (np.nan if self.t >= 3 else 1.0))
+
+    assert _message(LosesAlike, "deterministic")[0] == "passed"
