@@ -500,30 +500,31 @@ def test_a_rate_is_judged_with_a_tolerance_and_a_pass_names_its_runs():
         "passed", "IoU >= 0.5 in all 16 frames in 2 of 2 runs")
 
 
-class _TwoViews(Follower):
-    """Tells the two views of the equivariance check apart by the order trackers are
-    built in: the first one built tracks view A (the scene's top-left crop), the
-    next view B; ``on_b`` changes B's estimates or raises."""
+def _views(on_b, base=Follower, parity=0):
+    """A ``base`` tracker whose every other instance calls ``on_b(t, boxes)`` at step t:
+    ``boxes`` is a copy of its estimate, changed in place or replaced by what ``on_b``
+    returns (or ``on_b`` raises). Instances count from 1 in the order they are built;
+    those with ``built % 2 == parity`` are changed. Trackers are built in a fixed order:
+    view A then view B in the equivariance check (parity 0 changes view B), and in the
+    determinism check one for the claim, then the two runs of each scene (parity 1
+    changes each second run)."""
 
-    built = 0
+    class Views(base):
+        built = 0
 
-    def __init__(self):
-        type(self).built += 1
-        self.view_b = type(self).built % 2 == 0
+        def __init__(self):
+            type(self).built += 1
+            self.changed = type(self).built % 2 == parity
 
-    def step(self, frame):
-        est = super().step(frame)
-        self.t = getattr(self, "t", 0) + 1
-        if self.view_b:
-            self.on_b(self.t, est.boxes)
-        return est
+        def step(self, frame):
+            boxes = np.array(super().step(frame).boxes)
+            self.t = getattr(self, "t", 0) + 1
+            if self.changed:
+                out = on_b(self.t, boxes)
+                boxes = boxes if out is None else out
+            return SimpleNamespace(boxes=boxes)
 
-    def on_b(self, t, boxes):
-        pass
-
-
-def _views(on_b):
-    return type("Views", (_TwoViews,), {"built": 0, "on_b": staticmethod(on_b)})
+    return Views
 
 
 def test_a_good_tracker_is_equivariant_and_both_views_are_the_same_crop():
@@ -689,21 +690,11 @@ def test_an_exactly_equivariant_tracker_passes_a_tolerance_of_zero():
 
 
 def test_determinism_names_the_first_frame_that_differs_in_one_coordinate():
-    class LateJitter(Still):
-        built = 0
+    def jitter(t, boxes):
+        if t >= 3:
+            boxes[0, 0] += 0.25
 
-        def __init__(self):
-            type(self).built += 1
-            self.second = type(self).built % 2 == 1  # built after the claim: run b
-
-        def step(self, frame):
-            self.t = getattr(self, "t", 0) + 1
-            boxes = self.boxes.copy()
-            if self.second and self.t >= 3:
-                boxes[0, 0] += 0.25
-            return SimpleNamespace(boxes=boxes)
-
-    status, message = _message(LateJitter, "deterministic")
+    status, message = _message(_views(jitter, Still, parity=1), "deterministic")
     assert status == "failed" and message.startswith(
         "two runs with seed 0 differ from frame 3 (largest difference 0.25 px)"), message
 
@@ -711,21 +702,11 @@ def test_determinism_names_the_first_frame_that_differs_in_one_coordinate():
 def test_a_drift_of_exactly_the_tolerance_is_not_named_as_the_first_failure():
     # Integer boxes (Still): view B off by exactly 1 px (the tolerance) at frame 2, then
     # by 3 px from frame 3: frame 3 is the first beyond the tolerance.
-    class StillViews(Still):
-        built = 0
+    def drift(t, boxes):
+        if t >= 2:
+            boxes[:, 1] += 1.0 if t == 2 else 3.0
 
-        def __init__(self):
-            type(self).built += 1
-            self.view_b = type(self).built % 2 == 0
-
-        def step(self, frame):
-            self.t = getattr(self, "t", 0) + 1
-            boxes = self.boxes.copy()
-            if self.view_b and self.t >= 2:
-                boxes[:, 1] += 1.0 if self.t == 2 else 3.0
-            return SimpleNamespace(boxes=boxes)
-
-    status, message = _message(StillViews, "translation_equivariance")
+    status, message = _message(_views(drift, Still), "translation_equivariance")
     assert status == "failed" and message.endswith(
         "moved the estimated centre by 3.00 px more at frame 3 (tolerance 1 px)"), message
 
@@ -740,19 +721,11 @@ def test_a_target_lost_in_both_views_alike_passes_a_tolerance_of_zero():
 
 
 def test_determinism_names_a_second_run_that_loses_the_target():
-    class LateLoss(Still):
-        built = 0
+    def lose(t, boxes):
+        if t >= 3:
+            boxes[:] = np.nan
 
-        def __init__(self):
-            type(self).built += 1
-            self.second = type(self).built % 2 == 1
-
-        def step(self, frame):
-            self.t = getattr(self, "t", 0) + 1
-            lost = self.second and self.t >= 3
-            return SimpleNamespace(boxes=self.boxes * (np.nan if lost else 1.0))
-
-    status, message = _message(LateLoss, "deterministic")
+    status, message = _message(_views(lose, Still, parity=1), "deterministic")
     assert status == "failed" and message.startswith(
         "two runs with seed 0 differ from frame 3 (largest difference inf px)"), message
 
@@ -799,18 +772,6 @@ def test_a_malformed_last_estimate_is_no_box_in_the_equivariance_check():
     from scenegen.testing.checks import _scene
 
     last = len(_scene("shifted")[0]) - 1
-
-    class BadLastInB(Still):
-        built = 0
-
-        def __init__(self):
-            type(self).built += 1
-            self.view_b = type(self).built % 2 == 0
-
-        def step(self, frame):
-            self.t = getattr(self, "t", 0) + 1
-            bad = self.view_b and self.t == last
-            return SimpleNamespace(boxes=self.boxes[:, :3] if bad else self.boxes)
-
-    assert _message(BadLastInB, "translation_equivariance") == (
+    bad_last = _views(lambda t, boxes: boxes[:, :3] if t == last else None, Still)
+    assert _message(bad_last, "translation_equivariance") == (
         "failed", f"the target is lost (NaN) in only one of the two views from frame {last}")
