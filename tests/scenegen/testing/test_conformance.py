@@ -188,25 +188,28 @@ def test_determinism_only_where_claimed():
     )
 
 
+class DriftsOnOddSeeds(Follower):
+    """Follows its target with an even seed, 20 px to its right with an odd one."""
+
+    def __init__(self, rng=0):
+        self.drift = rng % 2
+
+    def step(self, frame):
+        est = super().step(frame)
+        est.boxes[:, 0] += 20 * self.drift
+        return est
+
+
 def test_a_rate_over_repeats_judges_a_stochastic_tracker():
-    class OddSeedsDrift(Follower):
-        def __init__(self, rng=0):
-            self.drift = rng % 2
-
-        def step(self, frame):
-            est = super().step(frame)
-            est.boxes[:, 0] += 20 * self.drift
-            return est
-
     opts = {"checks": ["keeps_lone_target"], "repeats": 4}
-    half = check_tracker(OddSeedsDrift, report=True, min_pass_rate=0.5, **opts)
+    half = check_tracker(DriftsOnOddSeeds, report=True, min_pass_rate=0.5, **opts)
     assert half.passed and half.results[0].message.endswith("in 2 of 4 runs")
-    strict = check_tracker(OddSeedsDrift, report=True, min_pass_rate=0.75, **opts)
+    strict = check_tracker(DriftsOnOddSeeds, report=True, min_pass_rate=0.75, **opts)
     assert strict.results[0].message.startswith(
         "passed 2 of 4 runs, below the required rate 0.75: seed 1: IoU fell to"
     )
     # Three failing runs are given, and how many more there were (were silently left out).
-    many = check_tracker(OddSeedsDrift, report=True, **{**opts, "repeats": 10})
+    many = check_tracker(DriftsOnOddSeeds, report=True, **{**opts, "repeats": 10})
     message = many.results[0].message
     assert message.startswith("passed 5 of 10 runs") and message.count("seed ") == 3
     assert message.endswith("; and 2 more failing runs"), message
@@ -470,16 +473,6 @@ def test_the_first_malformed_box_of_a_frame_is_named():
     status, message = _message(TwoBad, "boxes")
     assert status == "failed" and "pair: frame 1: box 0 is [" in message, message
     assert "box 1 is" not in message
-
-
-class DriftsOnOddSeeds(Follower):
-    def __init__(self, rng=0):
-        self.drift = rng % 2
-
-    def step(self, frame):
-        est = super().step(frame)
-        est.boxes[:, 0] += 20 * self.drift
-        return est
 
 
 @pytest.mark.parametrize(("repeats", "tail"), [(6, ""), (8, "; and 1 more failing runs")])
