@@ -1,7 +1,8 @@
 """A FIFO in place of any file of an output folder: one line, never a wait.
 
-Every file of an experiment folder, a benchmark folder with kept tracks, a dataset folder
-and a report folder (about 20 s for its 90 files) is replaced in turn by a FIFO.
+Every file of an experiment folder, a benchmark folder with kept tracks and a dataset
+folder is replaced in turn by a FIFO; in a report folder, one file of each kind (the fast
+suite: 11 of its 90 files) or every file (``slow``: 50-90 s on 2 cores).
 ``scenegen validate`` must name it in one line (exit 1) and the command that wrote the
 folder, run again, must refuse it in one line (exit 2), both at once: opening a FIFO waits
 for a writer that never comes.
@@ -39,10 +40,30 @@ def _files(folder: Path) -> list[Path]:
     return sorted(p.relative_to(folder) for p in folder.rglob("*") if p.is_file())
 
 
-def _each_file_a_fifo(src: Path, work: Path, again: list[str], capsys, deadline) -> int:
-    """Replace each file of ``src`` (in a copy at ``work``) by a FIFO in turn; validate and
-    the command ``again`` (``-o work`` appended) must each give one line naming it."""
-    names = _files(src)
+def _kind(rel: Path) -> tuple[str, ...]:
+    """A report file's kind: its path with the experiment's name left out, and a run
+    record's name too (every experiment folder is read by the same code)."""
+    parts = rel.parts
+    if parts[0] != "experiments":
+        return parts
+    rest = parts[2:]
+    return ("experiments", "runs", rel.suffix) if rest[0] == "runs" else ("experiments", *rest)
+
+
+def _one_of_each_kind(names: list[Path]) -> list[Path]:
+    first: dict[tuple[str, ...], Path] = {}
+    for rel in names:
+        first.setdefault(_kind(rel), rel)
+    return list(first.values())
+
+
+def _each_file_a_fifo(
+    src: Path, work: Path, again: list[str], capsys, deadline, names: list[Path] | None = None
+) -> int:
+    """Replace each file of ``src`` (or each of ``names``; in a copy at ``work``) by a FIFO
+    in turn; validate and the command ``again`` (``-o work`` appended) must each give one
+    line naming it."""
+    names = _files(src) if names is None else names
     for rel in names:
         shutil.rmtree(work, ignore_errors=True)
         shutil.copytree(src, work)
@@ -82,9 +103,29 @@ def test_every_file_of_a_benchmark_folder_and_its_dataset(tmp_path, capsys, dead
     assert n == 2  # manifest.json and a shard
 
 
-def test_every_file_of_a_report_folder(tmp_path, capsys, deadline):
-    again = ["experiment", "all", "--runs", "1", "--scenes", "1", "--quick", "--jobs", "1"]
-    src = tmp_path / "report"
-    assert main([*again, "-o", str(src)]) == 0
-    n = _each_file_a_fifo(src, tmp_path / "w", again, capsys, deadline)
+REPORT = ["experiment", "all", "--runs", "1", "--scenes", "1", "--quick", "--jobs", "1"]
+
+
+@pytest.fixture(scope="module")
+def report(tmp_path_factory) -> Path:
+    src = tmp_path_factory.mktemp("report") / "report"
+    assert main([*REPORT, "-o", str(src)]) == 0
+    return src
+
+
+def test_one_file_of_each_kind_of_a_report_folder(report, tmp_path, capsys, deadline):
+    names = _one_of_each_kind(_files(report))
+    kinds = {"/".join(_kind(rel)) for rel in names}
+    # the index, the report's results, and each experiment's results, table, figures
+    # (five names among the six experiments) and run records
+    assert {"index.html", "results.json", "experiments/results.json", "experiments/table.md",
+            "experiments/runs/.json", "experiments/ordering_probability.png",
+            "experiments/centre_error.png"} <= kinds, kinds  # fmt: skip
+    assert len(names) == 11, names
+    _each_file_a_fifo(report, tmp_path / "w", REPORT, capsys, deadline, names)
+
+
+@pytest.mark.slow
+def test_every_file_of_a_report_folder(report, tmp_path, capsys, deadline):
+    n = _each_file_a_fifo(report, tmp_path / "w", REPORT, capsys, deadline)
     assert n > 80
