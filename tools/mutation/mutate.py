@@ -378,6 +378,20 @@ MODULES: dict[str, Module] = {
          "tests/scenegen/testing/test_plugin.py"),
         _NO_SHRINK,
     ),
+    # How the checks are run and reported: a check's outcome from what it raised, the
+    # skip of every check after a failed protocol, the options, the report's verdicts
+    # and texts, the pytest parametrisation and the Markdown table.
+    "conformance": Module(
+        "scenegen/testing/conformance.py",
+        ("ConformanceReport.passed", "ConformanceReport.failed", "ConformanceReport.status",
+         "ConformanceReport.names", "ConformanceReport.as_dict", "ConformanceReport.__str__",
+         "_run_check", "check_tracker", "make_options", "_names", "_entries",
+         "parametrize_with_checks", "_Check.__call__", "checks_table"),
+        ("tests/scenegen/testing/test_conformance.py",
+         "tests/trackers/test_tracker_conformance.py",
+         "tests/scenegen/testing/test_plugin.py"),
+        _NO_SHRINK,
+    ),
     "distribution": Module(
         "scenegen/testing/distribution.py",
         ("_runs", "distribution_difference", "assert_distribution_matches"),

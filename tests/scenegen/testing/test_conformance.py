@@ -59,7 +59,12 @@ def test_a_still_tracker_passes_the_protocol_checks_and_fails_to_keep_a_moving_t
 def test_not_a_tracker_fails_protocol_and_skips_the_rest():
     report = check_tracker(lambda: SimpleNamespace(init=lambda f, b: None), report=True)
     assert report.results[0].status == "failed" and "no step method" in report.results[0].message
-    assert {r.status for r in report.results[1:]} == {"skipped"}
+    # every other check once, in order, skipped for that reason (mutation testing: the
+    # second check dropped, or protocol listed again as skipped, passed)
+    assert report.names() == list(CHECKS)
+    assert [(r.status, r.message) for r in report.results[1:]] == [
+        ("skipped", "not a tracker (see protocol)")
+    ] * (len(CHECKS) - 1)
 
 
 def test_a_factory_returning_a_class_fails_protocol():
@@ -305,6 +310,34 @@ def test_parametrize_with_checks_makes_one_test_per_check(factory, check, reques
             check(factory)
     else:
         check(factory)
+
+
+def test_a_parametrized_check_passes_skips_or_fails_as_its_check_did():
+    # Found by mutation testing: a passed check made a skipped test (a skip is not a
+    # failure, so every test of the plugin still "passed"), and a factory without tests.
+    mark = parametrize_with_checks([Still, (Follower, {"handles_occlusion": False})])
+    names, params = mark.args
+    assert names == ("factory", "check")
+    assert [p.id for p in params] == [f"{who}-{n}" for who in ("Still", "Follower")
+                                      for n in CHECKS]  # fmt: skip
+    by_id = {p.id: p.values for p in params}
+    factory, check = by_id["Follower-protocol"]
+    try:
+        assert check(factory) is None  # passed: neither skipped nor failed
+    except pytest.skip.Exception as why:  # would only skip this test, not fail it
+        pytest.fail(f"a passed check skipped its test: {why}")
+    factory, check = by_id["Still-recovers_after_occlusion"]
+    with pytest.raises(pytest.skip.Exception, match="recovers_after_occlusion: the tracker"):
+        check(factory)
+    factory, check = by_id["Still-keeps_lone_target"]
+    with pytest.raises(AssertionError, match="Still: keeps_lone_target: IoU fell"):
+        check(factory)
+
+
+def test_options_are_keywords_only():
+    # check_tracker(Still, True) must not be read as report=True
+    with pytest.raises(TypeError):
+        check_tracker(Still, True)
 
 
 def test_docstring_example_runs():
