@@ -32,7 +32,8 @@ bench: $(STAMP)
 # Mutation score of the formula modules (cosmic-ray; long, not part of `make test`).
 # MODULES: a subset (resampling particle stages sampling meanshift ms-trackers sok hybrid
 # annealed shm kalman metrics mot mot-io stats runner summary motion compose ground-truth
-# quantize profiles direct integral histogram checks conformance compare distribution);
+# quantize profiles direct integral histogram checks conformance compare distribution
+# strategies);
 # SAMPLE: mutants per module (0: all). Results in build/mutate/<module>.txt. Some
 # functions of one module only: tools/mutation/mutate.py MODULE --only FUNCTION ...
 MODULES ?=

@@ -585,8 +585,7 @@ def _draw_clutter(draw: Any, width: int, height: int, min_size: int, margin: flo
     )
 
 
-@st.composite
-def _scene_configs(
+def _draw_scene(
     draw: Any,
     widths: tuple[int, int],
     heights: tuple[int, int],
@@ -666,6 +665,10 @@ def _scene_configs(
     )
     _note_config(config, None)
     return config
+
+
+# Plain functions wrapped, not decorated: the draws can be called with another ``draw``.
+_scene_configs = st.composite(_draw_scene)
 
 
 def _textured(draw: Any, app: Appearance) -> Appearance:
@@ -914,8 +917,7 @@ def boxes(
     return _boxes(w * step, h * step, lo_i, math.floor(hi * step), ins, step)
 
 
-@st.composite
-def _boxes(
+def _draw_box(
     draw: Any, width: int, height: int, lo: int, hi: int, inside: bool, step: int
 ) -> NDArray[np.float64]:
     # All in units of 1/step pixel.
@@ -928,3 +930,6 @@ def _boxes(
         x = draw(st.integers(1 - bw, width - 1))
         y = draw(st.integers(1 - bh, height - 1))
     return np.array([x, y, bw, bh], dtype=np.float64) / step
+
+
+_boxes = st.composite(_draw_box)

@@ -1228,3 +1228,29 @@ EQUIVALENT["checks"] = [  # noqa: F821
      "lost = sum(int(np.isnan(runs[n].boxes[ 0:, :, 0]).sum()) for n in ran)",
      "frame 0 holds the initial boxes, the ground truth of targets present: never NaN"),
 ]
+
+# 2026-12-06 (stop 52), every mutant of the hypothesis strategies (541 in scope).
+_FITS = ("the canvas less twice the margin is at least min_size >= 1 (_check_fits, on the "
+         "smallest canvas a scene may draw), and so are max_size and every target's side: "
+         "the max() with 1 never acts, so max() with 0 is the same")
+EQUIVALENT["strategies"] = [  # noqa: F821
+    ("def _draw_camera(draw: Any, n_frames: int) -> Camera | None:",
+     "def _draw_camera(draw: Any, n_frames: int) -> Camera & None:", _ANNOTATION),
+    ("def _draw_photometric(draw: Any) -> Photometric | None:",
+     "def _draw_photometric(draw: Any) -> Photometric & None:", _ANNOTATION),
+    ("configs: SearchStrategy[SceneConfig] | None = None,",
+     "configs: SearchStrategy[SceneConfig] & None = None,", _ANNOTATION),
+    ("seeds: SearchStrategy[int] | None = None,",
+     "seeds: SearchStrategy[int] & None = None,", _ANNOTATION),
+    ("max_size: float | None = None,", "max_size: float & None = None,", _ANNOTATION),
+    ("span_w = max(1, min(max_size, int(width - 2 * margin)))",
+     "span_w = max( 0, min(max_size, int(width - 2 * margin)))", _FITS),
+    ("span_h = max(1, min(max_size, int(height - 2 * margin)))",
+     "span_h = max( 0, min(max_size, int(height - 2 * margin)))", _FITS),
+    ("ow = max(1, min(tw + 2 * pad, int(width - 2 * margin)))",
+     "ow = max( 0, min(tw + 2 * pad, int(width - 2 * margin)))", _FITS),
+    ("oh = max(1, min(th + 2 * pad, int(height - 2 * margin)))",
+     "oh = max( 0, min(th + 2 * pad, int(height - 2 * margin)))", _FITS),
+    ("plain = ClutterSpec(count=0)", "plain = ClutterSpec(count= 1)",
+     "only the default palette and n_colors are read from it"),
+]

@@ -392,6 +392,22 @@ MODULES: dict[str, Module] = {
          "tests/scenegen/testing/test_plugin.py"),
         _NO_SHRINK,
     ),
+    # The scenes users' property tests draw: every drawn value within the strategy's
+    # arguments (sizes, margins, speeds, noise, frames, roles), entities that fit the
+    # canvas, the realistic switches, boxes. The _check_* argument checks only word
+    # errors, but _check_fits decides which canvases can be drawn at all.
+    "strategies": Module(
+        "scenegen/testing/strategies.py",
+        ("_check_fits", "_hundredths", "_draw_appearance", "ar2_params", "_draw_ar2",
+         "entity_specs", "_draw_entity", "scene_configs", "_draw_occluder",
+         "_draw_distractor", "_draw_background", "_draw_clutter", "_draw_scene",
+         "_textured", "_realistic_entities", "_realistic_clutter", "_draw_real_background",
+         "_draw_camera", "_draw_photometric", "sequences", "_sequences", "boxes", "_draw_box"),
+        # with shrinking: the strategies' promise to shrink to simple scenes is tested
+        ("tests/scenegen/testing/test_strategy_ranges.py",
+         "tests/scenegen/testing/test_strategies.py",
+         "tests/scenegen/testing/test_readable_failures.py"),
+    ),
     "distribution": Module(
         "scenegen/testing/distribution.py",
         ("_runs", "distribution_difference", "assert_distribution_matches"),

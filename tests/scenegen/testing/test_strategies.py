@@ -200,13 +200,14 @@ def test_bad_arguments_raise_invalid_argument_at_call(strategy, kwargs, message)
         strategy(**kwargs)
 
 
-def test_bad_drawn_seed_is_reported():
+@pytest.mark.parametrize("seed", [-1, True, 1.5])  # True and 1.5 found by mutation testing
+def test_bad_drawn_seed_is_reported(seed):
     @settings(database=None, max_examples=1, phases=[Phase.generate])
-    @given(sequences(scene_configs(max_frames=1), seeds=st.just(-1)))
+    @given(sequences(scene_configs(max_frames=1), seeds=st.just(seed)))
     def draw(seq):
         raise AssertionError("not reached: drawing must fail")
 
-    with pytest.raises(InvalidArgument, match="non-negative"):
+    with pytest.raises(InvalidArgument, match="seeds must be non-negative integers"):
         draw()
 
 
