@@ -5,9 +5,10 @@ Users' property tests trust both halves: a range drawn too wide makes their test
 scenes the strategy promised not to draw (an occluder past the margin, a target starting
 outside the frame); a range drawn too narrow silently leaves out the scenes they meant to
 test (a target touching the border, the largest size, the slowest camera). Mutation
-testing (``tools/mutation/mutate.py strategies``) found both kinds untested: the checks
-below are the strategies' code and docstrings restated as bounds, over configs only (no
-rendering: hundreds of examples cost about a second), and ``find`` for each end.
+testing (``tools/mutation/mutate.py strategies``) found both kinds untested. Below, the
+docstrings' bounds are checked on drawn configs (no rendering: hundreds of examples cost
+about a second), and each end of each range is pinned exactly by running the draws with
+``Ends``, a stand-in for ``hypothesis.strategies`` that draws ends.
 """
 
 from __future__ import annotations
