@@ -16,9 +16,13 @@ $(STAMP): $(BIN)/python pyproject.toml
 demo: $(STAMP)
 	$(BIN)/scenegen demo -o report
 
+# The fast suite runs in TEST_JOBS worker processes (pytest-xdist), a test module per
+# worker at a time so that a module's shared fixtures are built once; 2 fits a 2-core
+# machine. TEST_JOBS=0 runs it in this process.
+TEST_JOBS ?= 2
 test: $(STAMP)
 	$(BIN)/ruff check scenegen trackers tests tools
-	HYPOTHESIS_PROFILE=$${HYPOTHESIS_PROFILE:-$$( [ -n "$$CI" ] && echo ci || echo dev )} $(BIN)/python -m pytest -q
+	HYPOTHESIS_PROFILE=$${HYPOTHESIS_PROFILE:-$$( [ -n "$$CI" ] && echo ci || echo dev )} $(BIN)/python -m pytest -q -n $(TEST_JOBS) --dist loadscope
 
 test-slow: $(STAMP)
 	$(BIN)/python -m pytest -q -m slow

@@ -100,7 +100,12 @@ _GENERATOR_MODULES = (
     "render/*.py",
     "sequence.py",
 )
-_written_key = pytest.StashKey[list[tuple[str, str]]]()
+# An expectation written under --scenegen-regen is recorded as a user property of its test
+# (name _WROTE, value the file's path): user properties travel with the test's reports, so
+# the list at the end of the run is complete under pytest-xdist too, where the tests run in
+# worker processes and only the reports reach the process that prints the summary.
+_WROTE = "scenegen-regen-wrote"
+_summary_name = "scenegen-regen-summary"
 
 
 def pytest_addoption(parser: pytest.Parser) -> None:
@@ -132,7 +137,7 @@ def pytest_configure(config: pytest.Config) -> None:
         "markers",
         "scenegen_tolerance(atol=0.0, rtol=0.0): default tolerances of scenegen_expect",
     )
-    config.stash[_written_key] = []
+    config.pluginmanager.register(_RegenSummary(), _summary_name)
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
@@ -141,13 +146,25 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
             item.add_marker(pytest.mark.scenegen)
 
 
-def pytest_terminal_summary(terminalreporter: Any, config: pytest.Config) -> None:
-    written = config.stash.get(_written_key, [])
-    if not written:
-        return
-    terminalreporter.section("scenegen --scenegen-regen")
-    for path, what in written:
-        terminalreporter.write_line(f"{what}: {path}")
+class _RegenSummary:
+    """Collects the expectations written under ``--scenegen-regen`` from the tests'
+    reports and lists them at the end of the run."""
+
+    def __init__(self) -> None:
+        self.written: list[str] = []
+
+    def pytest_runtest_logreport(self, report: pytest.TestReport) -> None:
+        # The teardown report carries every property the test recorded, once.
+        if report.when == "teardown":
+            self.written += [str(value) for name, value in report.user_properties
+                             if name == _WROTE]  # fmt: skip
+
+    def pytest_terminal_summary(self, terminalreporter: Any) -> None:
+        if not self.written:
+            return
+        terminalreporter.section("scenegen --scenegen-regen")
+        for path in self.written:
+            terminalreporter.write_line(f"wrote: {path}")
 
 
 @lru_cache(maxsize=1)
@@ -459,7 +476,6 @@ def scenegen_expect(request: pytest.FixtureRequest) -> Callable[..., None]:
     regen = bool(request.config.getoption("--scenegen-regen"))
     marker = request.node.get_closest_marker("scenegen_tolerance")
     default_atol, default_rtol = _marker_tolerance(marker) if marker else (0.0, 0.0)
-    written = request.config.stash[_written_key]
 
     def check(key: str, actual: Any, atol: float | None = None, rtol: float | None = None) -> None:
         rel = _check_key(key)
@@ -471,7 +487,7 @@ def scenegen_expect(request: pytest.FixtureRequest) -> Callable[..., None]:
             rtol=default_rtol if rtol is None else rtol,
             regen=regen,
         ):
-            written.append((str(path), "wrote"))
+            request.node.user_properties.append((_WROTE, str(path)))
 
     return check
 
@@ -486,12 +502,11 @@ def scenegen_expect_distribution(request: pytest.FixtureRequest) -> Callable[...
 
     folder = _fixtures_dir(request.config) / "expected"
     regen = bool(request.config.getoption("--scenegen-regen"))
-    written = request.config.stash[_written_key]
 
     def check(key: str, samples: Any, z: float = DEFAULT_Z, atol: float = 0.0) -> None:
         rel = _check_key(key)
         path = folder.joinpath(*rel.parent.parts) / f"{rel.name}.npy"
         if assert_distribution_matches(path, samples, z=z, atol=atol, regen=regen):
-            written.append((str(path), "wrote"))
+            request.node.user_properties.append((_WROTE, str(path)))
 
     return check

@@ -8,6 +8,7 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+import tempfile
 import textwrap
 import time
 from pathlib import Path
@@ -230,14 +231,19 @@ def test_a_bad_temporary_folder_does_not_stop_a_guarded_read(tmp_path, case):
     assert (done.returncode, done.stderr) == (0, "")
 
 
-def test_no_usable_temporary_folder_is_one_line_naming_tmpdir(tmp_path):
-    env = {**os.environ, "TMPDIR": str(tmp_path / "missing")}
-    done = subprocess.run([sys.executable, "-c", _READ_IN_A_FRESH_PROCESS, "none",
-                           str(tmp_path / "missing"), FIXTURE],
-                          capture_output=True, text=True, env=env, timeout=120)  # fmt: skip
+def test_no_usable_temporary_folder_is_one_line_naming_tmpdir():
+    # A short base, so that the folder is refused for being missing and not for its
+    # length: pytest's tmp_path (longer under pytest-xdist, /popen-gwN/) may be too long
+    # for a socket path already; that reason is checked by the test above.
+    with tempfile.TemporaryDirectory(prefix="sg-", dir="/tmp") as short:
+        missing = os.path.join(short, "missing")
+        env = {**os.environ, "TMPDIR": missing}
+        done = subprocess.run([sys.executable, "-c", _READ_IN_A_FRESH_PROCESS, "none",
+                               missing, FIXTURE],
+                              capture_output=True, text=True, env=env, timeout=120)  # fmt: skip
     assert done.returncode == 2
     assert done.stderr == (
         "scenegen: error: no usable temporary folder to start child processes in (TMPDIR="
-        f"{str(tmp_path / 'missing')!r}; {tmp_path / 'missing'}: No such file or directory): "
+        f"{missing!r}; {missing}: No such file or directory): "
         "set TMPDIR to a writable folder with a short path\n"
     )

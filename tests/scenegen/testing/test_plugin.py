@@ -137,6 +137,46 @@ def test_expect_regen_then_compare_then_detect_change(pytester):
     changed.stdout.fnmatch_lines(["*boxes.npy: 1 of 8 values differ beyond atol=0.01*"])
 
 
+def test_the_plugin_under_pytest_xdist(pytester):
+    # With -n 2 the tests run in two worker processes. The list of written expectations
+    # was empty then (each worker kept its own; the summary is printed by the controller),
+    # so `pytest -n auto --scenegen-regen` wrote files without saying which.
+    pytester.makepyfile(
+        test_a="""
+        import numpy as np
+
+        def test_a(scenegen_expect, scenegen_sequence):
+            seq = scenegen_sequence("kams-a", seed=3, frames=2)
+            scenegen_expect("a", np.asarray(seq.gt.box[:, 0]))
+        """,
+        test_b="""
+        import numpy as np
+
+        def test_b(scenegen_expect_distribution, scenegen_sequence):
+            seq = scenegen_sequence("kams-a", seed=3, frames=2)
+            scenegen_expect_distribution("b/runs", np.asarray(seq.gt.box[:, 0, :2]) + [[0], [1]])
+        """,
+    )
+    regen = pytester.runpytest("-q", "-n", "2", "--dist", "load", "--scenegen-regen")
+    regen.assert_outcomes(passed=2)
+    expected = pytester.path / "fixtures" / "expected"
+    wrote = sorted(line for line in regen.stdout.lines if line.startswith("wrote: "))
+    assert wrote == [f"wrote: {expected / 'a.npy'}", f"wrote: {expected / 'b' / 'runs.npy'}"]
+    assert "bringing up nodes" in regen.stdout.str()  # xdist's workers ran the tests
+    # One cache entry although both workers asked for the scene; the next run compares.
+    cached = list((pytester.path / ".pytest_cache" / "d" / "scenegen").glob("*.h5"))
+    assert len(cached) == 1
+    again = pytester.runpytest("-q", "-n", "2", "--scenegen-regen")
+    again.assert_outcomes(passed=2)
+    # An unchanged expectation is not rewritten; a distribution always is (new runs).
+    assert [line for line in again.stdout.lines if line.startswith("wrote: ")] == [
+        f"wrote: {expected / 'b' / 'runs.npy'}"
+    ]
+    pytester.runpytest("-q", "-n", "2").assert_outcomes(passed=2)
+    np.save(expected / "a.npy", np.load(expected / "a.npy") + 1)
+    pytester.runpytest("-q", "-n", "2").assert_outcomes(passed=1, failed=1)
+
+
 def test_fixture_reads_committed_files_and_checks_digests(pytester):
     folder = pytester.path / "data"
     folder.mkdir()
