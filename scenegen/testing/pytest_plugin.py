@@ -40,6 +40,10 @@ scenegen_expect_distribution
 Every sequence the fixtures return holds in-memory, read-only numpy arrays (they are
 shared between tests).
 
+The fixtures work under pytest-xdist: every cached or expected file is written to a
+temporary name and renamed, and the list ``--scenegen-regen`` prints is gathered from the
+tests' reports, so it names what every worker wrote.
+
 ``<fixtures>`` is ``--scenegen-fixtures DIR`` (relative to the folder pytest is run from,
 as other command-line paths are), else the ini option ``scenegen_fixtures`` (relative to
 the rootdir), else ``<rootdir>/fixtures``.
