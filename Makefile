@@ -24,8 +24,10 @@ test: $(STAMP)
 	$(BIN)/ruff check scenegen trackers tests tools
 	HYPOTHESIS_PROFILE=$${HYPOTHESIS_PROFILE:-$$( [ -n "$$CI" ] && echo ci || echo dev )} $(BIN)/python -m pytest -q -n $(TEST_JOBS) --dist loadscope
 
+# The long tests: one module (the damage suites) holds most of their time, so they are
+# shared test by test (worksteal), not module by module.
 test-slow: $(STAMP)
-	$(BIN)/python -m pytest -q -m slow
+	$(BIN)/python -m pytest -q -m slow -n $(TEST_JOBS) --dist worksteal
 
 lint: $(STAMP)
 	$(BIN)/ruff check scenegen trackers tests tools
