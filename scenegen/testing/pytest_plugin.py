@@ -109,7 +109,7 @@ _GENERATOR_MODULES = (
 # the list at the end of the run is complete under pytest-xdist too, where the tests run in
 # worker processes and only the reports reach the process that prints the summary.
 _WROTE = "scenegen-regen-wrote"
-_summary_name = "scenegen-regen-summary"
+_SUMMARY_NAME = "scenegen-regen-summary"
 
 
 def pytest_addoption(parser: pytest.Parser) -> None:
@@ -141,7 +141,7 @@ def pytest_configure(config: pytest.Config) -> None:
         "markers",
         "scenegen_tolerance(atol=0.0, rtol=0.0): default tolerances of scenegen_expect",
     )
-    config.pluginmanager.register(_RegenSummary(), _summary_name)
+    config.pluginmanager.register(_RegenSummary(), _SUMMARY_NAME)
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
