@@ -120,3 +120,40 @@ def test_only_selects_functions_of_the_scope_and_line_ranges(tool, tmp_path):
     assert tool.only_spans(path, mod, ("second", "2-3", "9")) == [(7, 14), (2, 3), (9, 9)]
     with pytest.raises(SystemExit, match="neither a line range nor a function"):
         tool.only_spans(path, mod, ("outside",))
+
+
+def test_the_report_lists_the_mutants_killed_by_the_timeout(tool, tmp_path, monkeypatch,
+                                                            capsys):
+    """A timed-out mutant counts as killed, and the report lists it to be checked (a loop
+    that cannot end, or a survivor that ran out of time under a short --timeout)."""
+    from cosmic_ray.work_db import use_db
+    from cosmic_ray.work_item import (
+        MutationSpec,
+        TestOutcome,
+        WorkerOutcome,
+        WorkItem,
+        WorkResult,
+    )
+
+    path = tmp_path / "module.py"
+    path.write_text(SOURCE)
+    mod = tool.Module(str(path), ("first", "second"), ("tests/some_test.py",))
+    monkeypatch.setattr(tool, "BUILD", tmp_path)
+    row = _rows("if x == 0:")[0]
+    diff = "--- a/module.py\n+++ b/module.py\n-    if x == 0:\n+    if x == -1:\n"
+    outcomes = {"failed": (TestOutcome.KILLED, "1 failed"),
+                "looped": (TestOutcome.KILLED, "timeout"),
+                "kept": (TestOutcome.SURVIVED, "3 passed")}
+    session = tmp_path / "toy.sqlite"
+    with use_db(str(session)) as db:
+        for job, (outcome, output) in outcomes.items():
+            spec = MutationSpec(str(path), "core/NumberReplacer", 0, (row, 11), (row, 12))
+            db.add_work_item(WorkItem(job, [spec]))
+            db.set_result(job, WorkResult(worker_outcome=WorkerOutcome.NORMAL, output=output,
+                                          test_outcome=outcome, diff=diff))
+    assert tool.report("toy", mod, session) == (2, 1, 0)
+    head = capsys.readouterr().out
+    assert "2 killed / 3 non-equivalent mutants = 66.7 % (1 of the killed by the timeout" in head
+    text = (tmp_path / "toy.txt").read_text()
+    assert f"TIMEOUT looped line {row}: if x == 0: -> if x == -1:" in text
+    assert "TIMEOUT failed" not in text and "SURVIVED kept" in text

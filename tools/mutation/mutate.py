@@ -3,7 +3,7 @@
 Usage::
 
     python tools/mutation/mutate.py [MODULE ...] [--count] [--report] [--retest]
-        [--sample N] [--only ITEM ...]
+        [--sample N] [--only ITEM ...] [--timeout SECONDS]
 
 MODULE is a key of ``MODULES`` (default: all, one after another). For each module:
 
@@ -22,7 +22,10 @@ MODULE is a key of ``MODULES`` (default: all, one after another). For each modul
    ranges of the file, e.g. the functions added since the module's last full run;
 4. the module's test command (the fast tests that guard it, selected by path) must pass
    on the unmutated copy; then ``cosmic-ray exec`` runs it once per mutant, stopping at
-   the first failure (``-x``); a mutant is killed if a test fails or times out;
+   the first failure (``-x``); a mutant is killed if a test fails or times out (the limit
+   is the larger of the module's ``min_timeout`` and 4 x the baseline run, or
+   ``--timeout``; the report lists each timed-out mutant as TIMEOUT, to be checked: a
+   loop that cannot end, or a survivor that ran out of time);
 5. the score and the surviving mutants (with their diffs) are written to
    ``build/mutate/<module>.txt`` and printed. A surviving mutant listed in
    ``equivalent.py`` is reported as equivalent: an entry names its line by text, and
@@ -701,8 +704,8 @@ def report(name: str, mod: Module, session: Path,
     from cosmic_ray.work_db import use_db
     from cosmic_ray.work_item import TestOutcome, WorkerOutcome
 
-    killed = survived = incompetent = equivalent = 0
-    lines, eq_lines = [], []
+    killed = survived = incompetent = equivalent = timed_out = 0
+    lines, eq_lines, timeout_lines = [], [], []
     entries, sites = equivalents(name, mod)
     with use_db(str(session)) as db:
         specs = {item.job_id: item.mutations[0] for item in db.work_items}
@@ -726,12 +729,18 @@ def report(name: str, mod: Module, session: Path,
                 incompetent += 1
             else:
                 killed += 1
+                if result.output == "timeout":  # cosmic-ray's output for a timed-out run
+                    timed_out += 1
+                    spec = specs[job]
+                    timeout_lines.append(f"TIMEOUT {job} line {spec.start_pos[0]}: "
+                                         f"{' -> '.join(_changed_lines(result.diff or ''))}")
     total = killed + survived
     score = 100.0 * killed / total if total else float("nan")
     head = (f"{name}: {mod.path}: {killed} killed / {total} non-equivalent mutants = "
-            f"{score:.1f} % ({equivalent} equivalent, {incompetent} incompetent; "
-            f"tests: {' '.join(mod.tests)})")
+            f"{score:.1f} % ({timed_out} of the killed by the timeout, {equivalent} "
+            f"equivalent, {incompetent} incompetent; tests: {' '.join(mod.tests)})")
     (BUILD / f"{name}.txt").write_text(head + "\n\n" + "\n".join(eq_lines) + "\n\n"
+                                       + "\n".join(timeout_lines) + "\n\n"
                                        + "\n".join(lines))
     print(head, flush=True)
     return killed, survived, incompetent
@@ -750,7 +759,7 @@ def reset_survivors(session: Path) -> None:
 
 
 def run(name: str, mod: Module, *, count_only: bool, report_only: bool, sample: int,
-        retest: bool, only: tuple[str, ...] = ()) -> None:
+        retest: bool, only: tuple[str, ...] = (), timeout: float | None = None) -> None:
     session = BUILD / f"{name}.sqlite"
     rows = only_spans(ROOT / mod.path, mod, only) if only else None
     equivalents(name, mod)  # refuse ambiguous entries before any run
@@ -766,7 +775,8 @@ def run(name: str, mod: Module, *, count_only: bool, report_only: bool, sample: 
         raise SystemExit(f"{name}: the tests fail on the unmutated sources:\n"
                          f"{base.stdout[-3000:]}")
     baseline = time.monotonic() - start
-    cfg = write_config(name, mod, timeout=max(mod.min_timeout, 4 * baseline))
+    limit = timeout if timeout is not None else max(mod.min_timeout, 4 * baseline)
+    cfg = write_config(name, mod, timeout=limit)
     stamp = BUILD / f"{name}.sha256"
     digest = hashlib.sha256((ROOT / mod.path).read_bytes()).hexdigest()
     if session.exists() and (not stamp.exists() or stamp.read_text() != digest):
@@ -777,7 +787,8 @@ def run(name: str, mod: Module, *, count_only: bool, report_only: bool, sample: 
     if retest:
         reset_survivors(session)
     n = filter_session(session, mod, sample, only)
-    print(f"{name}: {n} mutants in scope (baseline test run {baseline:.1f} s)", flush=True)
+    print(f"{name}: {n} mutants in scope (baseline test run {baseline:.1f} s, timeout "
+          f"{limit:.0f} s)", flush=True)
     if count_only:
         return
     cosmic("exec", str(cfg), str(session))
@@ -799,7 +810,14 @@ def main(argv: list[str] | None = None) -> int:
                         help="(one module) run and report only the mutants of these "
                              "functions of its scope (qualified names) and line ranges of "
                              "its file (FIRST-LAST or LINE); the sample is drawn from them")
+    parser.add_argument("--timeout", type=float, default=None, metavar="SECONDS",
+                        help="the limit of one mutant's test run (default: the larger of "
+                             "the module's least timeout and 4 x the baseline run); a "
+                             "timed-out mutant counts as killed and is listed as TIMEOUT "
+                             "in the report, to be checked")
     args = parser.parse_args(argv)
+    if args.timeout is not None and not args.timeout > 0:
+        parser.error(f"--timeout {args.timeout}: must be a positive number of seconds")
     unknown = [m for m in args.modules if m not in MODULES]
     if unknown:
         parser.error(f"unknown module {unknown[0]!r}; valid: {', '.join(MODULES)}")
@@ -808,7 +826,8 @@ def main(argv: list[str] | None = None) -> int:
     BUILD.mkdir(parents=True, exist_ok=True)
     for name in args.modules or list(MODULES):
         run(name, MODULES[name], count_only=args.count, report_only=args.report,
-            sample=args.sample, retest=args.retest, only=tuple(args.only))
+            sample=args.sample, retest=args.retest, only=tuple(args.only),
+            timeout=args.timeout)
     return 0
 
 
