@@ -1146,6 +1146,36 @@ EQUIVALENT["sampling"] += [  # noqa: F821
      "slot or at an equal row either way"),
 ]
 
+# 2026-12-07 (stop 54), every mutant of sampling (131 in scope), run to the end with
+# --timeout 120 (the survivors' test runs took 35-45 s); these survived:
+EQUIVALENT["sampling"] += [  # noqa: F821
+    ("slot = (slot + np.uint64(1)) & mask", "slot = (slot + np.uint64( 2)) & mask",
+     "probing every other slot: the table has a power-of-two size of at least 2 N, so the "
+     "slots of the start's parity number at least N, more than the at most N - 1 rows "
+     "stored before any insertion, and the probe reaches a free slot; an equal row was "
+     "stored at the first free slot of the same sequence, which slots never leave, so "
+     "it is met before any free slot"),
+    ("while size < 2 * n:", "while size < 1 * n:",
+     "a table of at least N slots instead of 2 N: at most N - 1 rows are stored before "
+     "any insertion, so linear probing still reaches a free slot or an equal row (the "
+     "probes are longer, the count the same)"),
+    *[("h ^= h >> np.uint64(29)", f"h ^= h >> np.uint64( {m})", _HASH) for m in (28, 30)],
+    ("h = np.uint64(1469598103934665603)", "h = np.uint64( 1469598103934665602)", _HASH),
+    ("if u != u or v != v or a != a:", "if u != u or v != v and a != a:",
+     "a shortcut: a row whose NaN is in v or a alone then goes through the table, where "
+     "it equals no stored row (NaN != NaN) and is counted once as new, as the shortcut "
+     "counts it; stored, it equals no later row either; the table (at least 2 N slots) "
+     "never fills"),
+    ("cdf = np.empty(weights.shape[0])", "cdf = np.empty(weights.shape[ -1])",
+     "the weights are one-dimensional: shape[-1] is shape[0]"),
+    ("n_groups = sizes.shape[0]", "n_groups = sizes.shape[ -1]",
+     "the group sizes are one-dimensional: shape[-1] is shape[0]"),
+    ("break", "continue",
+     "after storing a new row: the probe reads the slot again, finds that row, which "
+     "equals itself (no row with a NaN reaches the table), and breaks there",
+     "_count_distinct", "out[obj] += 1"),
+]
+
 # 2026-12-06 (stop 49), wider samples of the two kernel modules not re-run since 12-03:
 # quantize 60 of 140 (59 killed), profiles 40 of 152 (34 killed; the cone's rounding,
 # "+ -0.5", is killed by test_a_cone_weight_below_one_fixed_point_unit_rounds_to_one).
