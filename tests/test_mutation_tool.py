@@ -157,3 +157,12 @@ def test_the_report_lists_the_mutants_killed_by_the_timeout(tool, tmp_path, monk
     text = (tmp_path / "toy.txt").read_text()
     assert f"TIMEOUT looped line {row}: if x == 0: -> if x == -1:" in text
     assert "TIMEOUT failed" not in text and "SURVIVED kept" in text
+
+
+@pytest.mark.parametrize("value", ["0", "-5", "nan", "inf"])
+def test_a_timeout_that_is_not_a_positive_finite_number_is_refused(tool, value, capsys):
+    with pytest.raises(SystemExit) as exc:
+        tool.main(["sampling", "--count", "--timeout", value])
+    assert exc.value.code == 2
+    assert f"--timeout {float(value)}: must be a positive, finite number" in \
+        capsys.readouterr().err

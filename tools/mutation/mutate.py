@@ -816,8 +816,9 @@ def main(argv: list[str] | None = None) -> int:
                              "timed-out mutant counts as killed and is listed as TIMEOUT "
                              "in the report, to be checked")
     args = parser.parse_args(argv)
-    if args.timeout is not None and not args.timeout > 0:
-        parser.error(f"--timeout {args.timeout}: must be a positive number of seconds")
+    if args.timeout is not None and not 0 < args.timeout < float("inf"):
+        parser.error(f"--timeout {args.timeout}: must be a positive, finite number of "
+                     f"seconds")
     unknown = [m for m in args.modules if m not in MODULES]
     if unknown:
         parser.error(f"unknown module {unknown[0]!r}; valid: {', '.join(MODULES)}")
