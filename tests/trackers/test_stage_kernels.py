@@ -34,6 +34,7 @@ from trackers.kernels.stages import (
     clip_centres,
     effective_uv,
     gather_pair,
+    group_weights,
     normalise_groups_checked,
     normalise_rows,
     numpy_reduceat_sum,
@@ -345,6 +346,27 @@ def test_reassemble_is_the_numpy_mixture_reassembly(sizes):
     np.testing.assert_allclose(np.exp(got_log), want_m, rtol=1e-12)
 
 
+@pytest.mark.parametrize("place", [0, 1, -1])
+def test_group_shifts_take_each_groups_maximum_wherever_it_is(place):
+    # The maximum of each group at its first, second or last place: a scan that skipped
+    # a place left a largest weight above 1 there, and the reassembly's shifts (the same
+    # kernel) off the maximum.
+    rng = np.random.default_rng(9)
+    sizes = np.array([1, 2, 3, 4, 150], dtype=np.int64)
+    starts = np.cumsum(sizes) - sizes
+    x = rng.normal(0, 5, int(sizes.sum()))
+    for s, n in zip(starts, sizes, strict=True):
+        x[s + place % n] = x[s : s + n].max() + 1.0
+    top = np.repeat(np.maximum.reduceat(x, starts), sizes)
+    got = group_weights(x, sizes)
+    assert np.array_equal(got, np.exp(x - top))
+    assert np.array_equal(np.maximum.reduceat(got, starts), np.ones(sizes.size))
+    logpi = x + rng.normal(0, 1, x.size)
+    want_w, want_m = _reassemble_numpy(x, logpi, sizes)
+    got_w, got_m, _ = reassemble(x, logpi, sizes, np.log(sizes / sizes.sum()))
+    assert np.array_equal(got_w, want_w) and np.array_equal(got_m, want_m)
+
+
 def test_weighted_mean_and_diagnostics_are_the_numpy_ones():
     rng = np.random.default_rng(6)
     particles = rng.normal(100, 30, (300, 7, 3))
@@ -357,7 +379,8 @@ def test_weighted_mean_and_diagnostics_are_the_numpy_ones():
     wk = normalised_weights(rng.normal(0, 3, (300, 7)), axis=0)  # one column per object
     mean, _ = weighted_mean_states(wk, particles)
     assert np.array_equal(mean, (wk[:, :, None] * particles).sum(axis=0))
-    for sigma in ([2.0, 2.0, 0.001], [0.0, 3.0, 1.0]):
+    # σ below 1 px too: a kernel that took σ² <= 1 for σ = 0 left var / σ² out there.
+    for sigma in ([2.0, 2.0, 0.001], [0.0, 3.0, 1.0], [0.5, 1.0, 0.5]):
         want = effective_dynamics(particles, sigma)[:, :2].mean(axis=1)
         assert np.array_equal(effective_uv(var, np.array(sigma)), want, equal_nan=True)
     x2, p2 = gather_pair(particles, particles * 2, np.array([3, 3, 0], dtype=np.int64))

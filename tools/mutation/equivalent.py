@@ -1284,3 +1284,18 @@ EQUIVALENT["strategies"] = [  # noqa: F821
     ("plain = ClutterSpec(count=0)", "plain = ClutterSpec(count= 1)",
      "only the default palette and n_colors are read from it"),
 ]
+
+# 2026-12-07 (stop 55), every mutant of the DPS formulas of the compiled stages (146 in
+# scope: the stage log-weights, the reassembly, the group shifts and normalisation, the
+# AR2 propagation, the effective dynamics); 129 killed, 17 survived: 9 listed above, 2
+# killed by new tests (σ² > 1 for σ² > 0 in _effective_uv; a group's maximum that skips
+# its second value), these 6 equivalent.
+EQUIVALENT["stages"] += [  # noqa: F821
+    ("c = sizes.shape[0]", "c = sizes.shape[ -1]", _STAGES_1D),
+    ("n = stage.shape[0]", "n = stage.shape[ -1]", _STAGES_1D),
+    ("top = np.empty(sizes.shape[0])", "top = np.empty(sizes.shape[ -1])", _STAGES_1D),
+    ("out = np.empty(logw.shape[0])", "out = np.empty(logw.shape[ -1])", _STAGES_1D),
+    ("for c in range(sizes.shape[0]):", "for c in range(sizes.shape[ -1]):", _STAGES_1D),
+    ("e = np.empty(2)", "e = np.empty( 3)",
+     "a third slot of the (u, v) effective dynamics that nothing writes or reads"),
+]
