@@ -710,11 +710,11 @@ def report(name: str, mod: Module, session: Path,
     with use_db(str(session)) as db:
         specs = {item.job_id: item.mutations[0] for item in db.work_items}
         for job, result in db.results:
+            spec = specs[job]
             if result.worker_outcome == WorkerOutcome.SKIPPED or (
-                    rows is not None and not _in_spans(specs[job].start_pos[0], rows)):
+                    rows is not None and not _in_spans(spec.start_pos[0], rows)):
                 continue
             if result.test_outcome == TestOutcome.SURVIVED:
-                spec = specs[job]
                 why = equivalent_reason(entries, sites, spec.start_pos[0],
                                         *_changed_lines(result.diff or ""))
                 if why:
@@ -731,7 +731,6 @@ def report(name: str, mod: Module, session: Path,
                 killed += 1
                 if result.output == "timeout":  # cosmic-ray's output for a timed-out run
                     timed_out += 1
-                    spec = specs[job]
                     timeout_lines.append(f"TIMEOUT {job} line {spec.start_pos[0]}: "
                                          f"{' -> '.join(_changed_lines(result.diff or ''))}")
     total = killed + survived
