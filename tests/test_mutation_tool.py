@@ -166,3 +166,35 @@ def test_a_timeout_that_is_not_a_positive_finite_number_is_refused(tool, value, 
     assert exc.value.code == 2
     assert f"--timeout {float(value)}: must be a positive, finite number" in \
         capsys.readouterr().err
+
+
+def test_retest_with_only_resets_only_the_survivors_on_its_lines(tool, tmp_path):
+    """``--retest --only F`` runs F's survivors again and keeps every other result: a
+    survivor outside F whose result were forgotten would be skipped as outside the choice
+    and drop out of the module's report."""
+    from cosmic_ray.work_db import use_db
+    from cosmic_ray.work_item import (
+        MutationSpec,
+        TestOutcome,
+        WorkerOutcome,
+        WorkItem,
+        WorkResult,
+    )
+
+    inside, outside = _rows("if x == 0:")[0], _rows("return x + y + z")[0]
+    jobs = {"in-kept": (inside, TestOutcome.SURVIVED), "in-killed": (inside, TestOutcome.KILLED),
+            "out-kept": (outside, TestOutcome.SURVIVED),
+            "in-broken": (inside, TestOutcome.INCOMPETENT)}
+    session = tmp_path / "toy.sqlite"
+    with use_db(str(session)) as db:
+        for job, (row, outcome) in jobs.items():
+            spec = MutationSpec("module.py", "core/NumberReplacer", 0, (row, 0), (row, 1))
+            db.add_work_item(WorkItem(job, [spec]))
+            db.set_result(job, WorkResult(worker_outcome=WorkerOutcome.NORMAL, output="",
+                                          test_outcome=outcome, diff=""))
+    assert tool.reset_survivors(session, [(inside, inside)]) == 2
+    with use_db(str(session)) as db:
+        assert {job for job, _ in db.results} == {"in-killed", "out-kept"}
+    assert tool.reset_survivors(session) == 1  # no --only: every survivor
+    with use_db(str(session)) as db:
+        assert {job for job, _ in db.results} == {"in-killed"}

@@ -297,6 +297,54 @@ def test_invalid_weights_leave_the_kernels_for_the_checked_path():
     assert not finite
 
 
+@pytest.mark.parametrize("bad", ["pi", "g"])
+@pytest.mark.parametrize("value", [-1.0, np.inf])
+def test_one_invalid_factor_leaves_the_kernels_though_the_product_sums_positive(bad, value):
+    # Either π or g alone is invalid (a negative or infinite entry) while the other is
+    # valid and the group's π g still sums to a positive, finite-looking total: both
+    # factors are checked, not just their product, and the checked numpy path raises.
+    a, b = np.array([2.0, 1.0, 1.0]), np.array([1.0, 1.0, 1.0])
+    if bad == "pi":
+        a[1] = value
+    else:
+        b[1] = value
+    sizes, uniforms = np.array([3], dtype=np.int64), np.array([0.5])
+    x, prev = np.zeros((3, 1, 3)), np.zeros((3, 1, 3))
+    ll, log_g = np.zeros((3, 1)), np.zeros(3)
+    assert weighted_resample_gather(a, b, sizes, uniforms, SYSTEMATIC, x, prev, ll,
+                                    log_g) is None
+    assert resample_propagate(a, b, sizes, uniforms, SYSTEMATIC, x, prev, ll, log_g,
+                              np.zeros(3, dtype=np.int64), np.zeros((3, 3)), np.zeros((1, 3)),
+                              np.ones(3), 2.0, -1.0) is None
+    with pytest.raises(ValueError), np.errstate(invalid="ignore"):
+        weighted_resample_groups(a, b, sizes, rng=np.random.default_rng(0))
+
+
+def test_a_single_particle_is_resampled_and_propagated():
+    # N = 1 (one group of one particle): its own ancestor, weight 1, and the next stage's
+    # AR2 states of that one particle.
+    rng = np.random.default_rng(11)
+    x, prev, _ = _set(rng, 1)
+    x0, p0 = x.copy(), prev.copy()
+    ll, log_g = rng.normal(size=(1, 4)), rng.normal(size=1)
+    sizes, uniforms = np.array([1], dtype=np.int64), np.array([0.3])
+    obj = np.array([2], dtype=np.int64)
+    noise = rng.standard_normal((1, 3))
+    mean, sig = np.zeros((4, 3)), np.array([2.0, 2.0, 0.001])
+    out = resample_propagate(np.array([0.7]), np.array([1.3]), sizes, uniforms, SYSTEMATIC,
+                             x, prev, ll, log_g, obj, noise, mean, sig, 2.0, -1.0)
+    assert out is not None
+    w, gx, gp, gll, gg, new = out
+    assert np.array_equal(w, [1.0]) and np.array_equal(gll, ll) and np.array_equal(gg, log_g)
+    # The inputs are left alone; the gathered copies are propagated (in place, as
+    # propagate_objects does).
+    assert np.array_equal(x, x0) and np.array_equal(prev, p0)
+    want = propagate_objects(x0, p0, obj, noise, mean, sig, 2.0, -1.0)
+    assert new.shape == (1, 3) and np.array_equal(new, want)
+    assert np.array_equal(gx, x0) and np.array_equal(gp, p0)
+    assert not np.array_equal(gx, x)  # the stage's object moved
+
+
 def test_a_group_whose_weights_times_g_sum_to_zero_leaves_the_kernels():
     # π and g are each finite and non-negative, but no particle of group 1 has both
     # positive: π g sums to 0 there, nothing can be drawn, and the kernels must hand the

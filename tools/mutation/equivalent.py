@@ -1299,3 +1299,46 @@ EQUIVALENT["stages"] += [  # noqa: F821
     ("e = np.empty(2)", "e = np.empty( 3)",
      "a third slot of the (u, v) effective dynamics that nothing writes or reads"),
 ]
+# 2026-12-07 (stop 57), every mutant of the weighted resampling and gathers of the
+# compiled stages (85 in scope: _gather_pair, _gather_placed, _weighted_resample_gather,
+# _scope and the two wrappers, _resample_propagate; 12 of them in the sample of 12-06):
+# 64 killed, 21 survived: 5 listed above, 2 killed by new tests (one invalid factor, π
+# or g, whose product still sums positive; a single particle, N = 1), these 14
+# equivalent.
+_DISCARDED = ("an early return's unused slot: the wrapper returns None whenever the "
+              "weights are empty, and _resample_propagate never reads the ancestors")
+_ANNOTATION = "an annotation: never evaluated (from __future__ import annotations)"
+EQUIVALENT["stages"] += [  # noqa: F821
+    *[("return w, x2, prev2, ll2, g2, np.empty((0, 3))",
+       f"return w, x2, prev2, ll2, g2, np.empty({m})", _DISCARDED)
+      for m in ("(0, 2)", "( 1, 3)", "(0, 4)")],
+    ("return np.empty(0), np.empty(0, dtype=np.int64), x, prev, ll, log_g",
+     "return np.empty(0), np.empty( 1, dtype=np.int64), x, prev, ll, log_g", _DISCARDED,
+     "_weighted_resample_gather", "if not (_valid(a) and _valid(b)):"),
+    ("return np.empty(0), np.empty(0, dtype=np.int64), x, prev, ll, log_g",
+     "return np.empty(0), np.empty( 1, dtype=np.int64), x, prev, ll, log_g", _DISCARDED,
+     "_weighted_resample_gather", "if not ok:"),
+    ("if w.shape[0] == 0:", "if w.shape[ -1] == 0:", _STAGES_1D),
+    ("if w.shape[0] == 0:", "if w.shape[0] == -1:",
+     "never true: invalid weights then propagate the unchanged x, prev (a copy's worth of "
+     "work), and the wrapper still returns None, the weights being empty"),
+    ("n = idx.shape[0]", "n = idx.shape[ -1]", _STAGES_1D),
+    ("return None if out[0].shape[0] == 0 else out",
+     "return None if out[0].shape[ -1] == 0 else out", _STAGES_1D,
+     "weighted_resample_gather"),
+    ("return None if out[0].shape[0] == 0 else out",
+     "return None if out[ 1].shape[0] == 0 else out",
+     "out[1] is the ancestors (N,), empty exactly when the weights are (not so in "
+     "resample_propagate, whose out[1] is x: that copy's mutant is killed)",
+     "weighted_resample_gather"),
+    ("new[i] = 1.0 / b[idx[i]]", "new[i] = 2.0 / b[idx[i]]",
+     "the new weights are normalised per group next: doubling is exact in binary floating "
+     "point and cancels, bit for bit, unless 1/g is within a factor 2 of overflow "
+     "(g < 1.2e-308; g = exp(log g − max) reaches it only for log-weight spreads over "
+     "708, where the group's sum overflows anyway)"),
+    ("placed: NDArray[np.bool_] | None = None,", "placed: NDArray[np.bool_] & None = None,",
+     _ANNOTATION, ("weighted_resample_gather", "resample_propagate")),
+    ("def _scope(placed: NDArray[np.bool_] | None) -> tuple[bool, NDArray[np.bool_]]:",
+     "def _scope(placed: NDArray[np.bool_] & None) -> tuple[bool, NDArray[np.bool_]]:",
+     _ANNOTATION),
+]

@@ -44,7 +44,8 @@ A session database per module (``build/mutate/<module>.sqlite``) keeps the resul
 running again resumes with the mutants not yet run (a wider ``--sample`` or ``--only``
 adds the mutants it newly selects). ``--count`` only initialises and prints how many
 mutants would run; ``--report`` only prints the stored results; ``--retest`` runs the
-survivors again.
+survivors again (with ``--only``, only those on its lines: the other survivors keep their
+results instead of being skipped as outside the choice).
 """
 
 from __future__ import annotations
@@ -745,16 +746,26 @@ def report(name: str, mod: Module, session: Path,
     return killed, survived, incompetent
 
 
-def reset_survivors(session: Path) -> None:
+def reset_survivors(session: Path, spans: list[tuple[int, int]] | None = None) -> int:
     """Forget the results of the surviving (and incompetent) mutants, so that exec runs
-    them again."""
+    them again; with ``spans`` (``--only``), only of those on the spans' lines: a
+    survivor outside them would otherwise lose its result and be skipped as outside
+    the choice. Return how many were reset."""
     import sqlite3
 
+    from cosmic_ray.work_db import use_db
+
+    with use_db(str(session)) as db:
+        rows = {item.job_id: item.mutations[0].start_pos[0] for item in db.work_items}
     con = sqlite3.connect(session)
     with con:
-        con.execute("DELETE FROM work_results WHERE test_outcome IN "
-                    "('SURVIVED', 'INCOMPETENT')")
+        jobs = [job for (job,) in con.execute(
+            "SELECT job_id FROM work_results WHERE test_outcome IN "
+            "('SURVIVED', 'INCOMPETENT')")
+            if spans is None or _in_spans(rows[job], spans)]
+        con.executemany("DELETE FROM work_results WHERE job_id = ?", [(j,) for j in jobs])
     con.close()
+    return len(jobs)
 
 
 def run(name: str, mod: Module, *, count_only: bool, report_only: bool, sample: int,
@@ -784,7 +795,7 @@ def run(name: str, mod: Module, *, count_only: bool, report_only: bool, sample: 
         cosmic("init", str(cfg), str(session))
         stamp.write_text(digest)
     if retest:
-        reset_survivors(session)
+        reset_survivors(session, only_spans(TREE / mod.path, mod, only) if only else None)
     n = filter_session(session, mod, sample, only)
     print(f"{name}: {n} mutants in scope (baseline test run {baseline:.1f} s, timeout "
           f"{limit:.0f} s)", flush=True)
@@ -801,7 +812,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--count", action="store_true", help="only count the mutants")
     parser.add_argument("--report", action="store_true", help="only print stored results")
     parser.add_argument("--retest", action="store_true",
-                        help="run the surviving mutants again (after adding tests)")
+                        help="run the surviving mutants again (after adding tests); with --only, "
+                             "those on its lines")
     parser.add_argument("--sample", type=int, default=25,
                         help="run a seeded sample of at most this many mutants per module "
                              "(default 25; 0: all)")
