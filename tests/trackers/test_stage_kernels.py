@@ -297,6 +297,20 @@ def test_invalid_weights_leave_the_kernels_for_the_checked_path():
     assert not finite
 
 
+def _both_kernels_leave(a, b, sizes, uniforms):
+    """Whether weighted_resample_gather and resample_propagate both return None (hand the
+    set to the checked numpy path) for π ``a`` and g ``b`` of N one-object particles."""
+    n = a.shape[0]
+    x, prev = np.zeros((n, 1, 3)), np.zeros((n, 1, 3))
+    ll, log_g = np.zeros((n, 1)), np.zeros(n)
+    gathered = weighted_resample_gather(a, b, sizes, uniforms, SYSTEMATIC, x, prev, ll,
+                                        log_g)
+    fused = resample_propagate(a, b, sizes, uniforms, SYSTEMATIC, x, prev, ll, log_g,
+                               np.zeros(n, dtype=np.int64), np.zeros((n, 3)),
+                               np.zeros((1, 3)), np.ones(3), 2.0, -1.0)
+    return gathered is None and fused is None
+
+
 @pytest.mark.parametrize("bad", ["pi", "g"])
 @pytest.mark.parametrize("value", [-1.0, np.inf])
 def test_one_invalid_factor_leaves_the_kernels_though_the_product_sums_positive(bad, value):
@@ -308,14 +322,8 @@ def test_one_invalid_factor_leaves_the_kernels_though_the_product_sums_positive(
         a[1] = value
     else:
         b[1] = value
-    sizes, uniforms = np.array([3], dtype=np.int64), np.array([0.5])
-    x, prev = np.zeros((3, 1, 3)), np.zeros((3, 1, 3))
-    ll, log_g = np.zeros((3, 1)), np.zeros(3)
-    assert weighted_resample_gather(a, b, sizes, uniforms, SYSTEMATIC, x, prev, ll,
-                                    log_g) is None
-    assert resample_propagate(a, b, sizes, uniforms, SYSTEMATIC, x, prev, ll, log_g,
-                              np.zeros(3, dtype=np.int64), np.zeros((3, 3)), np.zeros((1, 3)),
-                              np.ones(3), 2.0, -1.0) is None
+    sizes = np.array([3], dtype=np.int64)
+    assert _both_kernels_leave(a, b, sizes, np.array([0.5]))
     with pytest.raises(ValueError), np.errstate(invalid="ignore"):
         weighted_resample_groups(a, b, sizes, rng=np.random.default_rng(0))
 
@@ -351,14 +359,7 @@ def test_a_group_whose_weights_times_g_sum_to_zero_leaves_the_kernels():
     # set to the checked numpy path (which raises) instead of returning weights.
     a, b = np.array([1.0, 2.0, 1.0, 0.0]), np.array([1.0, 1.0, 0.0, 3.0])
     sizes = np.array([2, 2], dtype=np.int64)
-    uniforms = np.array([0.5, 0.5])
-    x, prev = np.zeros((4, 1, 3)), np.zeros((4, 1, 3))
-    ll, log_g = np.zeros((4, 1)), np.zeros(4)
-    assert weighted_resample_gather(a, b, sizes, uniforms, SYSTEMATIC, x, prev, ll,
-                                    log_g) is None
-    assert resample_propagate(a, b, sizes, uniforms, SYSTEMATIC, x, prev, ll, log_g,
-                              np.zeros(4, dtype=np.int64), np.zeros((4, 3)), np.zeros((1, 3)),
-                              np.ones(3), 2.0, -1.0) is None
+    assert _both_kernels_leave(a, b, sizes, np.array([0.5, 0.5]))
     with pytest.raises(ValueError, match="positive sum"):
         weighted_resample_groups(a, b, sizes, rng=np.random.default_rng(0))
 
