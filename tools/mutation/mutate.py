@@ -560,12 +560,13 @@ def _in_spans(row: int, spans: list[tuple[int, int]]) -> bool:
     return any(a <= row <= b for a, b in spans)
 
 
-def filter_session(session: Path, mod: Module, sample: int,
-                   only: tuple[str, ...] = ()) -> int:
+def filter_session(session: Path, mod: Module, sample: int, only: tuple[str, ...] = (),
+                   chosen: list[tuple[int, int]] | None = None) -> int:
     """Skip the mutations outside the scope and the non-canonical ones, and all but a
     seeded sample of ``sample`` of the rest (0: keep all); with ``only``, also those
-    outside its functions and line ranges. Return how many are kept. The skips of a
-    previous call are undone first, so a wider choice runs the mutants it adds."""
+    outside its functions and line ranges (``chosen``: their spans, when the caller has
+    them from :func:`only_spans`). Return how many are kept. The skips of a previous
+    call are undone first, so a wider choice runs the mutants it adds."""
     import sqlite3
 
     import numpy as np
@@ -578,7 +579,8 @@ def filter_session(session: Path, mod: Module, sample: int,
     con.close()
     spans = scope_lines(TREE / mod.path, mod.scope)
     if only:
-        chosen = only_spans(TREE / mod.path, mod, only)
+        if chosen is None:
+            chosen = only_spans(TREE / mod.path, mod, only)
         spans = [(a, b) for a, b in chosen if any(c <= a and b <= d for c, d in spans)]
         if len(spans) < len(chosen):
             raise SystemExit(f"--only {' '.join(only)}: a line range outside the scope")
@@ -771,6 +773,7 @@ def reset_survivors(session: Path, spans: list[tuple[int, int]] | None = None) -
 def run(name: str, mod: Module, *, count_only: bool, report_only: bool, sample: int,
         retest: bool, only: tuple[str, ...] = (), timeout: float | None = None) -> None:
     session = BUILD / f"{name}.sqlite"
+    # The spans of --only, computed once: the tree made below is a copy of these sources.
     rows = only_spans(ROOT / mod.path, mod, only) if only else None
     equivalents(name, mod)  # refuse ambiguous entries before any run
     if report_only:
@@ -795,8 +798,8 @@ def run(name: str, mod: Module, *, count_only: bool, report_only: bool, sample: 
         cosmic("init", str(cfg), str(session))
         stamp.write_text(digest)
     if retest:
-        reset_survivors(session, only_spans(TREE / mod.path, mod, only) if only else None)
-    n = filter_session(session, mod, sample, only)
+        reset_survivors(session, rows)
+    n = filter_session(session, mod, sample, only, rows)
     print(f"{name}: {n} mutants in scope (baseline test run {baseline:.1f} s, timeout "
           f"{limit:.0f} s)", flush=True)
     if count_only:
