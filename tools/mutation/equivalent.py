@@ -1134,6 +1134,15 @@ EQUIVALENT["stages"] += [  # noqa: F821
      "shared means weights has one column: column -1 is column 0"),
 ]
 
+# 2026-12-07 (stop 58), every mutant of the estimate's mean and variance and of the
+# states' boxes (_weighted_mean_states, _state_boxes: 64 in scope, --timeout 240), run to
+# the end: 62 killed, one equivalent listed above, this one survived:
+EQUIVALENT["stages"] += [  # noqa: F821
+    ("total = np.zeros((k, 3))", "total = np.zeros((k, 4))",
+     "a fourth column of the sums that nothing writes: the variance reads avg[o, c] for "
+     "c < 3 only, and avg is not returned"),
+]
+
 # 2026-12-06 (stop 50), every mutant of sampling (136 in scope), stopped after 41 for
 # the session's time: 36 killed, 5 survived. "particles + 1.0" is killed by
 # test_count_distinct_tells_values_apart_closer_than_any_shift_keeps; "cdf[stop - 1] = 2.0"
