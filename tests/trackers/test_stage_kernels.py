@@ -440,11 +440,12 @@ def test_weighted_mean_and_diagnostics_are_the_numpy_ones():
 def test_row_max_shift_and_normalise_rows_are_the_numpy_ones():
     # The per-object weights of the bootstrap filter: each row minus its maximum, then
     # numpy's exp, then each row over its sum. The maximum sits in the first column, in
-    # the last, inside, and alone (N = 1).
+    # the second (a scan that began at column 2 missed it), in the last, inside, and alone
+    # (N = 1); and N = 2.
     rng = np.random.default_rng(9)
     x = rng.normal(0, 50, (5, 40))
-    x[0, 0], x[1, -1], x[2, 17] = 900.0, 900.0, 900.0
-    for logw in (x, x[:, :1]):
+    x[0, 0], x[1, -1], x[2, 17], x[3, 1] = 900.0, 900.0, 900.0, 900.0
+    for logw in (x, x[:, :1], x[:, :2]):
         want = logw - logw.max(axis=1, keepdims=True)
         assert np.array_equal(row_max_shift(logw), want)
         e = np.exp(want)

@@ -1143,6 +1143,20 @@ EQUIVALENT["stages"] += [  # noqa: F821
      "c < 3 only, and avg is not returned"),
 ]
 
+# 2026-12-07 (stop 58), every mutant of the row sums, the shifts by the maximum, the
+# normalisations and the box clipping (89 in scope, --timeout 240): 77 killed, 7
+# survivors already listed; "range( 2, x.shape[1])" in _row_max_shift (the maximum in
+# the second column) is killed by test_row_max_shift_and_normalise_rows_are_the_numpy_ones;
+# these survived:
+_ROW_TERMS = "a, the terms added to the row sums (N,), is one-dimensional: shape[-1] is shape[0]"
+EQUIVALENT["stages"] += [  # noqa: F821
+    ("for i in range(1, x.shape[0]):", "for i in range(1, x.shape[ -1]):", _STAGES_1D),
+    ("for i in range(1, x.shape[0]):", "for i in range( 0, x.shape[0]):",
+     "the maximum starts at x[0]: comparing x[0] with it again changes nothing"),
+    ("out = np.empty(a.shape[0])", "out = np.empty(a.shape[ -1])", _ROW_TERMS),
+    ("for r in range(a.shape[0]):", "for r in range(a.shape[ -1]):", _ROW_TERMS),
+]
+
 # 2026-12-06 (stop 50), every mutant of sampling (136 in scope), stopped after 41 for
 # the session's time: 36 killed, 5 survived. "particles + 1.0" is killed by
 # test_count_distinct_tells_values_apart_closer_than_any_shift_keeps; "cdf[stop - 1] = 2.0"
