@@ -70,6 +70,20 @@ def test_sums_replicate_numpy_to_the_bit(n):
     assert np.array_equal(numpy_reduceat_sum(x, sizes), np.add.reduceat(x, starts))
 
 
+def test_reduceat_sum_keeps_the_sign_of_zero_groups():
+    # A group whose terms are all -0.0 sums to -0.0 in numpy at every size (its rest
+    # starts at -0.0 below 8 terms); a group of +0.0 and -0.0 to +0.0. array_equal cannot
+    # tell the zeros apart: the sign bits are compared too.
+    x = np.concatenate([np.full(n, -0.0) for n in range(1, 20)] + [[0.0, -0.0, -0.0]])
+    sizes = np.array([*range(1, 20), 3], dtype=np.int64)
+    starts = np.concatenate([[0], np.cumsum(sizes)[:-1]])
+    want = np.add.reduceat(x, starts)
+    got = numpy_reduceat_sum(x, sizes)
+    assert np.array_equal(got, want)
+    assert np.array_equal(np.signbit(got), np.signbit(want))
+    assert np.signbit(want[:-1]).all() and not np.signbit(want[-1])
+
+
 @pytest.mark.parametrize("k", [1, 2, 3, 7, 8, 9, 16, 17, 128, 129, 300])
 def test_add_row_sums_is_numpy_row_sums(k):
     # Rows of 8 or more terms are summed pairwise by numpy, shorter ones in order; both,

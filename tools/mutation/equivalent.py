@@ -1157,6 +1157,17 @@ EQUIVALENT["stages"] += [  # noqa: F821
     ("for r in range(a.shape[0]):", "for r in range(a.shape[ -1]):", _ROW_TERMS),
 ]
 
+# 2026-12-07 (stop 58), every mutant of _numpy_sum and _numpy_reduceat_sum (13): 11
+# killed; the two survivors showed that a group of 2-8 terms all -0.0 summed to +0.0
+# where np.add.reduceat gives -0.0 (numpy starts its short loop at -0.0; _pairwise_block
+# now does, test_reduceat_sum_keeps_the_sign_of_zero_groups). Since then they are these:
+_EMPTY_REST = ("a group of one: its element plus the empty rest's sum, which is -0.0, is the "
+               "element itself (x + -0.0 is x for every x, -0.0 and NaN included)")
+EQUIVALENT["stages"] += [  # noqa: F821
+    ("if n > 1:", "if n >= 1:", _EMPTY_REST),
+    ("if n > 1:", "if n > 0:", _EMPTY_REST),
+]
+
 # 2026-12-06 (stop 50), every mutant of sampling (136 in scope), stopped after 41 for
 # the session's time: 36 killed, 5 survived. "particles + 1.0" is killed by
 # test_count_distinct_tells_values_apart_closer_than_any_shift_keeps; "cdf[stop - 1] = 2.0"

@@ -72,7 +72,9 @@ def _pairwise_block(a, lo, n):
     """numpy's pairwise sum of a[lo:lo + n] for n <= 128: sequential below 8, else eight
     interleaved accumulators combined as a tree, then the remainder."""
     if n < 8:
-        res = 0.0
+        # numpy starts this loop at -0.0, so that terms that are all -0.0 sum to -0.0:
+        # np.add.reduceat's group (first + the rest's pairwise sum) keeps that sign.
+        res = -0.0
         for i in range(lo, lo + n):
             res += a[i]
         return res
