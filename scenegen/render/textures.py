@@ -12,6 +12,7 @@ entity's texture is keyed by its own name.
 
 from __future__ import annotations
 
+import io
 import re
 from functools import lru_cache
 from pathlib import Path
@@ -72,13 +73,17 @@ def _load_cached(source: str, cwd: str) -> NDArray[np.uint8]:
         if img is not None and img.ndim == 3:
             img = cv2.cvtColor(img[..., :3], cv2.COLOR_BGR2RGB)
         if img is None:
+            buf = io.BytesIO()
             try:
                 import skimage.io
 
-                img = skimage.io.imread(str(path))
+                # From memory: imageio's probing of its plugins opens a path and leaves
+                # the file open (a ResourceWarning) when none of them can read it.
+                buf = io.BytesIO(path.read_bytes())
+                img = skimage.io.imread(buf)
             except Exception as err:  # any reader failure: one line naming the file
                 text = str(err).strip().splitlines()
-                why = text[0] if text else type(err).__name__
+                why = text[0].replace(repr(buf), path.name) if text else type(err).__name__
                 raise ConfigError(f"cannot read image file {source!r}: {why}") from None
         if img.ndim not in (2, 3) or img.size == 0:
             raise ConfigError(f"image file {source!r} is not a 2-D image (shape {img.shape})")

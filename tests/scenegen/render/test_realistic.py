@@ -351,6 +351,43 @@ def test_an_unreadable_image_file_is_one_line(tmp_path, content):
     assert "cannot read image file" in msg and "text.png" in msg and "\n" not in msg
 
 
+def test_an_unreadable_image_file_leaves_no_file_open(tmp_path):
+    # imageio's probing of its plugins opened the path and left it open when no plugin
+    # could read it (a ResourceWarning once collected): the fallback now reads from memory.
+    import gc
+    import warnings
+
+    from scenegen.render.textures import load_source
+
+    path = tmp_path / "text.png"
+    path.write_bytes(b"not an image\n")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        with pytest.raises(ConfigError, match="cannot read image file .*text.png"):
+            load_source(str(path), "background.source")
+        gc.collect()
+    assert not [w for w in caught if issubclass(w.category, ResourceWarning)]
+
+
+def test_an_image_opencv_refuses_is_read_by_scikit_image(tmp_path, monkeypatch):
+    # OpenCV raises on some files (more pixels than it allows): scikit-image reads them.
+    import cv2
+
+    from scenegen.render import textures
+
+    img = np.zeros((10, 12, 3), dtype=np.uint8)
+    img[:, :6] = (0, 0, 255)  # BGR red on the left half
+    path = tmp_path / "refused.png"
+    cv2.imwrite(str(path), img)
+
+    def refuse(*args, **kwargs):
+        raise cv2.error("OpenCV(5.0.0) loadsave.cpp:1: error: (-215:Assertion failed) pixels")
+
+    monkeypatch.setattr(textures.cv2, "imread", refuse)
+    got = textures.load_source(str(path), "background.source")
+    np.testing.assert_array_equal(got, img[..., ::-1])
+
+
 @pytest.mark.parametrize("name", scenegen.presets.realistic_names())
 def test_realistic_presets_ground_truth_and_round_trip(name):
     cfg = scenegen.presets.get(name)
