@@ -1,11 +1,14 @@
 """Benchmark rows of the generator and of HDF5 writing.
 
 Baselines measured in the same run: a plain numpy compositor (per entity, boolean-mask
-assignment) for rendering, and h5py writing the same arrays with the same filter for I/O.
+assignment) for rendering, and h5py writing the same arrays with the same filter for I/O,
+plainly and then made durable as ``scenegen.write`` makes it (written beside the target,
+flushed to disk, renamed onto it, the folder flushed).
 """
 
 from __future__ import annotations
 
+import os
 import tempfile
 from dataclasses import replace
 from pathlib import Path
@@ -19,7 +22,7 @@ from scenegen.io import COMPRESSIONS, filter_options, write, write_scenario
 from scenegen.lab.bench.core import BenchRow, median_time
 from scenegen.render.plan import generate, plan
 
-__all__ = ["numpy_render", "realistic_rows", "run", "sizes"]
+__all__ = ["numpy_render", "realistic_rows", "run", "sizes", "write_rows"]
 
 
 def numpy_render(scn) -> np.ndarray:
@@ -73,7 +76,8 @@ def run(repeats: int = 5) -> list[BenchRow]:
     list of BenchRow
         Generation of ``kams-d`` and ``dps-synthetic`` against :func:`numpy_render`, the
         rows of :func:`realistic_rows`, and writing ``kams-d`` with each compression
-        against plain h5py, all in frames/s.
+        against plain h5py (and plain h5py made durable, for comparison), all in
+        frames/s.
     """
     rows: list[BenchRow] = []
     for preset, goal in (("kams-d", 2000.0), ("dps-synthetic", 1000.0)):
@@ -92,16 +96,35 @@ def run(repeats: int = 5) -> list[BenchRow]:
             )
         )  # fmt: skip
     rows += realistic_rows(repeats)
+    return rows + write_rows(repeats)
+
+
+def write_rows(repeats: int = 5) -> list[BenchRow]:
+    """Writing ``kams-d`` with each compression: plain h5py (the baseline), plain h5py
+    made durable, and ``scenegen.write``.
+
+    Parameters
+    ----------
+    repeats : int, default 5
+        Each figure is a median over ``max(1, repeats // 2)`` timings.
+
+    Returns
+    -------
+    list of BenchRow
+        Three rows per compression of :data:`scenegen.io.COMPRESSIONS`, in frames/s; the
+        last two with their ratio to the first, the last with the goal.
+    """
+    rows: list[BenchRow] = []
     seq = generate("kams-d", seed=0)
     t_n = seq.n_frames
     with tempfile.TemporaryDirectory() as d:
         for comp in COMPRESSIONS:
             filt = filter_options(comp)
 
-            def raw(filt=filt):
+            def raw(filt=filt, name="raw.h5"):
                 # The same content written with plain h5py calls: frames and labels with
                 # the filter, ground truth and one dataset per template.
-                with h5py.File(Path(d) / "raw.h5", "w") as f:
+                with h5py.File(Path(d) / name, "w") as f:
                     for key in ("frames", "labels"):
                         arr = getattr(seq, key)
                         f.create_dataset(key, data=arr, chunks=(1, *arr.shape[1:]), **filt)
@@ -110,14 +133,29 @@ def run(repeats: int = 5) -> list[BenchRow]:
                     for eid, tpl in seq.templates.items():
                         f.create_dataset(f"templates/{eid}", data=tpl)
 
+            def durable(filt=filt):
+                # The same, made durable with plain os calls: what the atomic write costs
+                # beyond h5py without any of scenegen's seals.
+                raw(filt, ".durable.h5.tmp")
+                _flush(Path(d) / ".durable.h5.tmp")
+                os.replace(Path(d) / ".durable.h5.tmp", Path(d) / "durable.h5")
+                _flush(Path(d))
+
             def ours(comp=comp):
                 write(Path(d) / "ours.h5", seq, compression=comp)
 
             b = median_time(raw, max(1, repeats // 2))
+            b_d = median_time(durable, max(1, repeats // 2))
             o = median_time(ours, max(1, repeats // 2))
             group = f"write kams-d (frames, labels, gt, 601 templates), {comp}"
             name_b = "plain h5py, same content (baseline)"
             rows.append(BenchRow(group, name_b, b / t_n, t_n / b, "frames/s"))
+            rows.append(
+                BenchRow(
+                    group, "plain h5py + fsync + rename + fsync of the folder", b_d / t_n,
+                    t_n / b_d, "frames/s", baseline=name_b, ratio=b / b_d,
+                )
+            )  # fmt: skip
             rows.append(
                 BenchRow(
                     group, "scenegen.write (atomic)", o / t_n, t_n / o,
@@ -126,6 +164,14 @@ def run(repeats: int = 5) -> list[BenchRow]:
                 )
             )  # fmt: skip
     return rows
+
+
+def _flush(path: Path) -> None:
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
 
 
 def realistic_rows(repeats: int = 5) -> list[BenchRow]:
