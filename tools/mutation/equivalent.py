@@ -1376,3 +1376,30 @@ EQUIVALENT["stages"] += [  # noqa: F821
      "def _scope(placed: NDArray[np.bool_] & None) -> tuple[bool, NDArray[np.bool_]]:",
      _ANNOTATION),
 ]
+
+# 2026-12-07 (stop 59), every mutant of numpy's pairwise sum (_pairwise_block: 80, all
+# killed, one by the timeout: `i += 0`, a loop that cannot end; _pairwise: 94), run to
+# the end: of _pairwise's 12 survivors, 2 listed above, 1 killed by a new test (a half of
+# exactly 128 terms split as 64 + 64), these 9 equivalent.
+_STACK = ("the explicit stack of the pairwise recursion uses one frame (and holds at most "
+          "one pending value) per halving of N / 128: 63 would take N of about 2**69, and "
+          "a longer stack is never reached")
+EQUIVALENT["stages"] += [  # noqa: F821
+    ("f_lo = np.empty(64, dtype=np.int64)", "f_lo = np.empty( 65, dtype=np.int64)", _STACK),
+    ("f_n = np.empty(64, dtype=np.int64)", "f_n = np.empty( 63, dtype=np.int64)", _STACK),
+    ("f_state = np.empty(64, dtype=np.int64)", "f_state = np.empty( 63, dtype=np.int64)",
+     _STACK),
+    ("f_state = np.empty(64, dtype=np.int64)", "f_state = np.empty( 65, dtype=np.int64)",
+     _STACK),
+    ("vals = np.empty(64)", "vals = np.empty( 63)", _STACK),
+    ("vals = np.empty(64)", "vals = np.empty( 65)", _STACK),
+    ("n2 = m // 2", "n2 = m / 2",
+     "a float half: n2 - n2 % 8 is then 8 floor(m / 16) as a float, the same multiple of "
+     "8 as with integer division, stored exactly into the int64 stack (m < 2**53)"),
+    ("if n <= _BLOCK:", "if n < _BLOCK:",
+     "a sum of exactly 128 terms goes onto the stack, whose first frame (m = 128 <= "
+     "_BLOCK) sums it with _pairwise_block: the same sum"),
+    ("f_state[top] = 2", "f_state[top] = 3",
+     "the frame's third visit: every state but 0 and 1 takes the last branch (left + "
+     "right)"),
+]
