@@ -19,6 +19,7 @@ import numpy as np
 
 from scenegen import presets
 from scenegen.io import COMPRESSIONS, filter_options, write, write_scenario
+from scenegen.io.atomic import _fsync as _flush  # the flush scenegen.write does
 from scenegen.lab.bench.core import BenchRow, median_time
 from scenegen.render.plan import generate, plan
 
@@ -134,8 +135,8 @@ def write_rows(repeats: int = 5) -> list[BenchRow]:
                         f.create_dataset(f"templates/{eid}", data=tpl)
 
             def durable(filt=filt):
-                # The same, made durable with plain os calls: what the atomic write costs
-                # beyond h5py without any of scenegen's seals.
+                # The same, made durable with scenegen.write's flush and os.replace: what
+                # the atomic write costs beyond h5py without any of scenegen's seals.
                 raw(filt, ".durable.h5.tmp")
                 _flush(Path(d) / ".durable.h5.tmp")
                 os.replace(Path(d) / ".durable.h5.tmp", Path(d) / "durable.h5")
@@ -164,14 +165,6 @@ def write_rows(repeats: int = 5) -> list[BenchRow]:
                 )
             )  # fmt: skip
     return rows
-
-
-def _flush(path: Path) -> None:
-    fd = os.open(path, os.O_RDONLY)
-    try:
-        os.fsync(fd)
-    finally:
-        os.close(fd)
 
 
 def realistic_rows(repeats: int = 5) -> list[BenchRow]:
