@@ -1213,13 +1213,9 @@ EQUIVALENT["sampling"] += [  # noqa: F821
 # 2026-12-06 (stop 49), wider samples of the two kernel modules not re-run since 12-03:
 # quantize 60 of 140 (59 killed), profiles 40 of 152 (34 killed; the cone's rounding,
 # "+ -0.5", is killed by test_a_cone_weight_below_one_fixed_point_unit_rounds_to_one).
-EQUIVALENT["quantize"] = [  # noqa: F821
-    ("h_top = np.int32(h_bins - 1)", "h_top = np.int32(h_bins + 1)",
-     "the hue bin's clamp is never reached: h6 < 6 d for every colour (where r is the "
-     "largest and g < b, h6 = 6 d - (b - g) <= 6 d - 1; otherwise h6 <= 5 d), so the "
-     "float32 floor of h6 h_bins / (6 d) stays below h_bins (checked on all 2**24 "
-     "colours)"),
-]
+# quantize's one equivalent then, the hue bin's clamp (h_bins - 1 -> h_bins + 1), and a
+# second one found by the full run of 2026-12-07 (-> h_bins - 0) showed the clamp can never
+# act (h6 <= 6 d - 1); it was removed from the kernel, so quantize lists none.
 EQUIVALENT["profiles"] += [  # noqa: F821
     ("kbuf[c - c0] = 0", "kbuf[c - c0] = -1", _UNCOVERED),
     ("n_levels = a_fixed.shape[0]", "n_levels = a_fixed.shape[ -1]",

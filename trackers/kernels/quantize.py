@@ -99,7 +99,6 @@ def _quantize_hsv(frame, h_bins, s_bins, v_bins, s_thr, v_thr):
     sbf = np.float32(s_bins)
     vbf = np.float32(v_bins)
     v_offset = np.int32(h_bins * s_bins)
-    h_top = np.int32(h_bins - 1)
     s_top = np.int32(s_bins - 1)
     v_top = np.int32(v_bins - 1)
     s_n = np.int32(s_bins)
@@ -119,7 +118,10 @@ def _quantize_hsv(frame, h_bins, s_bins, v_bins, s_thr, v_thr):
             h6g = b - r + 2 * d
             h6b = r - g + 4 * d
             h6 = h6r if mx == r else (h6g if mx == g else h6b)
-            hb = min(np.int32(np.float32(h6) * hbf / np.float32(6 * max(d, one))), h_top)
+            # No clamp: h6 <= 6 d - 1 (where r is the largest and g < b, h6 = 6 d - (b - g);
+            # otherwise h6 <= 5 d), so h6 h_bins / (6 d) lies at least 1 / 1530 below
+            # h_bins, far more than float32's rounding: the floor is below h_bins.
+            hb = np.int32(np.float32(h6) * hbf / np.float32(6 * max(d, one)))
             sb = min(np.int32(np.float32(d) * sbf / np.float32(max(mx, one))), s_top)
             vb = min(np.int32(np.float32(mx) * vbf / np.float32(255)), v_top)
             # S >= s_min and V >= v_min, i.e. d / mx >= s_min and mx / 255 >= v_min, with

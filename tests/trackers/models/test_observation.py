@@ -281,7 +281,8 @@ def _reference_hsv(frame, hb, sb, vb, s_min, v_min):
     d = mx - mn
     h6 = np.where(mx == r, np.where(g < b, g - b + 6 * d, g - b),
                   np.where(mx == g, b - r + 2 * d, r - g + 4 * d))
-    hbin = np.minimum(h6 * hb // np.maximum(6 * d, 1), hb - 1)
+    hbin = h6 * hb // np.maximum(6 * d, 1)
+    assert hbin.max() < hb  # H < 1: the hue needs no clamp (the kernel has none)
     sbin = np.minimum(d * sb // np.maximum(mx, 1), sb - 1)
     vbin = np.minimum(mx * vb // 255, vb - 1)
     # The documented rule, in exact rationals: S >= floor(s_min 2**20) / 2**20, i.e.
