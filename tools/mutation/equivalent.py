@@ -1232,6 +1232,18 @@ EQUIVALENT["profiles"] += [  # noqa: F821
      "recompute a row's weights where they have not changed: the same weights"),
 ]
 
+# 2026-12-07 (stop 60), every mutant of the pixel ranges and the kernels' row weights
+# (_first_inside, _pixel_range, _cone_weights, _epanechnikov_weights, _level_args): 37,
+# 34 killed, the 3 others the clipping's bounds taken inclusively; and of the box kernel's
+# rectangles (_level_rects): 29.
+EQUIVALENT["profiles"] += [  # noqa: F821
+    ("for lv in range(fracs.shape[0]):", "for lv in range(fracs.shape[ -1]):",
+     "the level fractions are one-dimensional: shape[-1] is shape[0]"),
+    ("if i0 < 0:", "if i0 <= 0:", "a first index of exactly 0 is set to 0: the same index"),
+    ("if i0 < 0:", "if i0 < 1:", "a first index of exactly 0 is set to 0: the same index"),
+    ("if i1 > n:", "if i1 >= n:", "an end index of exactly n is set to n: the same index"),
+]
+
 # 2026-12-06 (stop 50), the comparisons users pin their trackers with, every mutant:
 # compare 30 (23 killed at first; 6 survivors killed by new tests in test_compare.py),
 # distribution 101 (83 killed at first; 17 survivors killed by new tests in
