@@ -969,13 +969,11 @@ EQUIVALENT["direct"] = [  # noqa: F821
      "stay at the zeros set above; only the column table or rectangles are computed",
      ("_accumulate", "_accumulate_support")),
 ]
-_UNCOVERED = ("_box_row_weights' last loop (columns no covering rectangle holds) never runs: "
-              "the last rectangle (fraction l / L = 1 exactly) has the box's own pixel range, "
-              "so every row of the box is covered, and the level loop ends with lo == hi")
-EQUIVALENT["profiles"] = [  # noqa: F821
-    ("kbuf[c - c0] = 0", "kbuf[c - c0] = 1", _UNCOVERED),
-    ("kbuf[c - c0] = 0", "kbuf[c + c0] = 0", _UNCOVERED),
-]
+# The three mutants of _box_row_weights' last loop (the columns of a row no rectangle
+# covers), listed here until 2026-12-07 (stop 61) because the histogram paths never pass
+# such a row, are killed since by test_a_rows_weights_sum_the_levels_covering_each_pixel,
+# which calls the function on the rows just above and below the box.
+EQUIVALENT["profiles"] = []  # noqa: F821
 EQUIVALENT["histogram"] = [  # noqa: F821
     # 2026-12-05, the path choice made observable (region_paths, and the direct-path mask
     # _region_distances returns): "n_groups += 0" and the "n_boxes > 0" guard were
@@ -1217,14 +1215,8 @@ EQUIVALENT["sampling"] += [  # noqa: F821
 # second one found by the full run of 2026-12-07 (-> h_bins - 0) showed the clamp can never
 # act (h6 <= 6 d - 1); it was removed from the kernel, so quantize lists none.
 EQUIVALENT["profiles"] += [  # noqa: F821
-    ("kbuf[c - c0] = 0", "kbuf[c - c0] = -1", _UNCOVERED),
     ("n_levels = a_fixed.shape[0]", "n_levels = a_fixed.shape[ -1]",
      "a_fixed is one-dimensional: shape[-1] is shape[0]"),
-    ("for lv in range(n_levels - 1, first - 1, -1):",
-     "for lv in range(n_levels - 1, first - 2, -1):",
-     "one more pass below the first covering level: the pass at that level leaves lo == hi, "
-     "so the extra pass writes no column (and the row is always covered: "
-     + _UNCOVERED.split(": ", 1)[1] + ")"),
     ("if r < b < nxt:", "if r < b <= nxt:",
      "a bound equal to the current next change sets it to the same row"),
     ("for e in range(2):", "for e in range( 3):",
@@ -1246,6 +1238,19 @@ EQUIVALENT["profiles"] += [  # noqa: F821
     ("if i0 < 0:", "if i0 <= 0:", "a first index of exactly 0 is set to 0: the same index"),
     ("if i0 < 0:", "if i0 < 1:", "a first index of exactly 0 is set to 0: the same index"),
     ("if i1 > n:", "if i1 >= n:", "an end index of exactly n is set to n: the same index"),
+]
+
+# 2026-12-07 (stop 61), every mutant of box_kernel_levels and _box_row_weights (77, 25 of
+# them in earlier runs): 70 killed at first. Killed since by new tests in
+# test_box_kernel.py: 16 levels refused (levels < 16; the extreme counts are accepted),
+# and the four mutants that write a row no rectangle covers (the last loop's three, and
+# "first - 2", which fills such a row with the box's level weight). Equivalent:
+EQUIVALENT["profiles"] += [  # noqa: F821
+    ("if ihi <= ilo:", "if ihi < ilo:",
+     "an inner level whose columns in [lo, hi) are empty at ilo == ihi = v: both write "
+     "[lo, hi) with the same weight, and the mutant leaves lo == hi == v instead of hi; "
+     "the rectangles nest (test_the_outermost_rectangle_is_the_box_and_the_rectangles_"
+     "nest), so every further level's columns are [v, v) as well and write nothing"),
 ]
 
 # 2026-12-06 (stop 50), the comparisons users pin their trackers with, every mutant:

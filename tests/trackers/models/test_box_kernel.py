@@ -20,6 +20,7 @@ from trackers.kernels.histogram import (
     region_distances,
     region_histograms,
 )
+from trackers.kernels.profiles import _box_row_weights, _level_args, _level_rects, _pixel_range
 
 
 def _pixels(lo: float, size: float, n: int) -> np.ndarray:
@@ -68,6 +69,54 @@ def test_level_weights_follow_the_epanechnikov_profile_at_mid_radius():
     shell = np.cumsum(weights[::-1])[::-1]  # weight of a pixel in shell l
     np.testing.assert_allclose(shell, 1 - ((np.arange(1, 5) - 0.5) / 4) ** 2, rtol=0, atol=1e-15)
     assert np.all(weights > 0)
+
+
+@pytest.mark.parametrize("levels", [1, 16])
+def test_the_extreme_level_counts_are_accepted(levels):
+    fractions, weights = box_kernel_levels(levels)
+    np.testing.assert_array_equal(fractions, np.arange(1, levels + 1) / levels)
+    shell = np.cumsum(weights[::-1])[::-1]
+    np.testing.assert_allclose(shell, 1 - ((np.arange(1, levels + 1) - 0.5) / levels) ** 2,
+                               rtol=0, atol=1e-15)
+
+
+def _level_rectangles(box, levels, rows, cols):
+    fracs, a_fixed = _level_args(KERNEL_BOX, levels)
+    rects = np.empty((levels, 4), dtype=np.int64)
+    _level_rects(*map(float, box), fracs, rows, cols, rects)
+    return rects, a_fixed
+
+
+@given(x=st.floats(-20, 70), y=st.floats(-20, 50), w=st.floats(0.6, 60),
+       h=st.floats(0.6, 60), levels=st.integers(1, 16))
+def test_the_outermost_rectangle_is_the_box_and_the_rectangles_nest(x, y, w, h, levels):
+    # The histogram paths visit the rows and columns _pixel_range gives the box and take a
+    # row's weights from _box_row_weights: every row they visit is covered by the
+    # outermost rectangle, and the inner ones lie inside the outer ones.
+    rects, _ = _level_rectangles((x, y, w, h), levels, 41, 63)
+    assert tuple(rects[-1]) == _pixel_range(y, h, 41) + _pixel_range(x, w, 63)
+    inner, outer = rects[:-1], rects[1:]
+    assert np.all((outer[:, 0] <= inner[:, 0]) & (inner[:, 1] <= outer[:, 1]))
+    assert np.all((outer[:, 2] <= inner[:, 2]) & (inner[:, 3] <= outer[:, 3]))
+
+
+@pytest.mark.parametrize("levels", [1, 3, 16])
+def test_a_rows_weights_sum_the_levels_covering_each_pixel(levels):
+    # Every column of the row is written (the buffer starts as garbage): the sum of a_l
+    # over the rectangles holding the pixel, and 0 on rows no rectangle covers (just above
+    # and below the box).
+    rects, a_fixed = _level_rectangles((7.3, 5.8, 31.4, 22.7), levels, 48, 64)
+    r0, r1, c0, c1 = rects[-1]
+    n = c1 - c0
+    cols = np.arange(c0, c1)
+    for r in range(r0 - 2, r1 + 2):
+        kbuf = np.full(n, -7, dtype=np.int64)
+        _box_row_weights(kbuf, n, c0, r, rects, a_fixed)
+        inside = ((rects[:, 0] <= r) & (r < rects[:, 1]))[:, None] & (
+            (rects[:, 2:3] <= cols) & (cols < rects[:, 3:4]))
+        np.testing.assert_array_equal(kbuf, (inside * a_fixed[:, None]).sum(axis=0))
+        if not r0 <= r < r1:
+            assert not kbuf.any()
 
 
 @pytest.mark.parametrize("bad", [0, 17, 2.5, True, -1])
