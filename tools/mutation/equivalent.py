@@ -970,9 +970,10 @@ EQUIVALENT["direct"] = [  # noqa: F821
      ("_accumulate", "_accumulate_support")),
 ]
 # The three mutants of _box_row_weights' last loop (the columns of a row no rectangle
-# covers), listed here until 2026-12-07 (stop 61) because the histogram paths never pass
-# such a row, are killed since by test_a_rows_weights_sum_the_levels_covering_each_pixel,
-# which calls the function on the rows just above and below the box.
+# covers; two listed here on 2026-12-03, one on 12-06 below) were excused until 2026-12-07
+# (stop 61) because the histogram paths never pass such a row; they are killed since by
+# test_a_rows_weights_sum_the_levels_covering_each_pixel, which calls the function on the
+# rows just above and below the box.
 EQUIVALENT["profiles"] = []  # noqa: F821
 EQUIVALENT["histogram"] = [  # noqa: F821
     # 2026-12-05, the path choice made observable (region_paths, and the direct-path mask
