@@ -47,6 +47,7 @@ from typing import Any
 from scenegen.errors import ConfigError, DataError
 
 __all__ = [
+    "PRELOAD",
     "TIMEOUT",
     "Unreadable",
     "beat",
@@ -65,6 +66,13 @@ __all__ = [
 TIMEOUT = 10.0
 """Default deadline in seconds: the longest a reader may go without progress on a file
 not yet known to be sound (override with ``SCENEGEN_READ_TIMEOUT``)."""
+
+PRELOAD = ("scenegen.io.guard", "h5py", "scenegen.io.validate")
+"""Modules the fork server imports once, before it forks any guarded child: what the
+children run (:func:`survey`, the checks of :mod:`scenegen.io.validate`). A child that had
+to import the checks itself would pay about 0.11 s each time (scipy.ndimage, the presets);
+the server pays it once, when the process makes its first guarded read (``scenegen
+bench --only guarded``)."""
 
 _PR_SET_PDEATHSIG = 1
 _BEAT_EVERY = 0.2  # seconds between heartbeats sent to the parent, at most
@@ -242,8 +250,9 @@ def _context() -> Any:
         return multiprocessing.get_context("fork")
     if "forkserver" in methods:
         ctx = multiprocessing.get_context("forkserver")
-        # Children fork from a server that has h5py imported already: ~10 ms per child.
-        ctx.set_forkserver_preload(["scenegen.io.guard", "h5py"])
+        # Children fork from a server that has imported what they run (PRELOAD). It takes
+        # effect when this process starts its fork server (a LocalPool may start it first).
+        ctx.set_forkserver_preload(list(PRELOAD))
         return ctx
     return multiprocessing.get_context("spawn")
 

@@ -22,6 +22,7 @@ MODULES = (
     "scenegen.lab.bench.meanshift",
     "scenegen.lab.bench.shm",
     "scenegen.lab.bench.reliability",
+    "scenegen.lab.bench.guarded",
     "scenegen.lab.bench.scaling",
     "scenegen.lab.bench.datasets",
 )

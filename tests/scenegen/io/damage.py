@@ -304,8 +304,32 @@ def content(path: str) -> str:
 
 
 def run_case(argvs: list[list[str]], inner_timeout: float) -> list[tuple[int, str]]:
-    """Run ``scenegen`` verbs in this (guarded) process: their exit codes and stderr."""
+    """Run ``scenegen`` verbs in this (guarded) process: their exit codes and stderr.
+
+    The verbs run as in a program of their own. A guarded child skips the metadata
+    preflight of :func:`scenegen.io.guard.preflight` (it is time-boxed already); a user's
+    process does not, so the preflight is restored here: the readers' guarded children
+    are forked from this process, each with ``inner_timeout``. Without it, a verb that
+    opens the file before its check (``export`` asking whether it holds results) ran its
+    first read unguarded, and a looping file stalled the whole case (seen at
+    ``SCENEGEN_DAMAGE_SCALE=8``: an old-format file with a zeroed global heap).
+    """
+    import multiprocessing
+
+    from scenegen.io import guard
+
     os.environ["SCENEGEN_READ_TIMEOUT"] = str(inner_timeout)
+    if guard.in_child():
+        import threading
+
+        from tqdm import tqdm
+
+        guard._conn = None  # preflight runs: this process no longer counts as a child
+        guard._context = lambda: multiprocessing.get_context("fork")  # as in a child
+        # A progress bar's default lock is a semaphore registered with multiprocessing's
+        # resource tracker; this child ends by os._exit, which leaves it registered (the
+        # tracker then warns of "leaked semaphore objects" at the end of the session).
+        tqdm.set_lock(threading.RLock())
     from scenegen.cli import main
 
     out = []

@@ -247,3 +247,28 @@ def test_no_usable_temporary_folder_is_one_line_naming_tmpdir():
         f"{missing!r}; {missing}: No such file or directory): "
         "set TMPDIR to a writable folder with a short path\n"
     )
+
+
+_MODULES_IN_A_GUARDED_CHILD = """
+import sys
+from scenegen.io import guard
+
+if __name__ == "__main__":
+    # eval: a builtin, so the child runs it without importing anything of this script
+    print(",".join(guard.call(eval, "sorted(set(PRELOAD) & set(sys.modules))", label="x")))
+"""
+
+
+def test_the_fork_server_has_imported_what_guarded_children_run(tmp_path):
+    """A child forked by a fresh process's fork server finds the checks imported already
+    (each child importing ``scenegen.io.validate`` itself cost ~0.11 s a check)."""
+    from scenegen.io.validate import _checked
+
+    assert {guard.survey.__module__, _checked.__module__} <= set(guard.PRELOAD)
+    script = tmp_path / "probe.py"
+    script.write_text(_MODULES_IN_A_GUARDED_CHILD)
+    done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True,
+                          timeout=120, cwd=tmp_path)  # fmt: skip
+    assert (done.returncode, done.stderr) == (0, "")
+    # The forkserver ignores a module it cannot import: a misspelt name would show here.
+    assert done.stdout.strip().split(",") == sorted(guard.PRELOAD)
