@@ -206,7 +206,7 @@ def test_bench_only_that_matches_nothing_is_a_usage_error(capsys):
     assert main(["bench", "--only", "nothing", "--repeats", "1"]) == 2
     assert capsys.readouterr().err.strip() == (
         "scenegen: error: --only 'nothing' matches no bench module; modules: generation, "
-        "particle, stepshare, meanshift, shm, reliability, scaling, datasets")  # fmt: skip
+        "particle, stepshare, meanshift, shm, reliability, guarded, scaling, datasets")  # fmt: skip
 
 
 def test_an_mp4_preview_of_frames_the_encoder_refuses_names_their_size(tmp_path, capsys):
