@@ -20,6 +20,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+from collections.abc import Callable
 from pathlib import Path
 
 from scenegen import presets
@@ -63,7 +64,7 @@ def _first_read(path: Path) -> float:
     return float(out.stdout.strip().splitlines()[-1])
 
 
-def _timed_on_copies(fn, copies: _Copies, repeats: int) -> float:  # noqa: ANN001
+def _timed_on_copies(fn: Callable[[str], object], copies: _Copies, repeats: int) -> float:
     """Median seconds of ``fn(path)`` on fresh copies, the copying not timed."""
     paths: list[str] = []
 
